@@ -1,0 +1,241 @@
+//! The explicit periodic micro-geometry (thesis ch. 2): the cylinder segments that both the
+//! analytic model approximates and the ray tracer renders exactly.
+//!
+//! * The floor is the plane z = 0; every yarn is a circular cylinder of its thread's radius whose
+//!   axis lies at the thread's height above the floor, cut by the floor.
+//! * Warp thread i runs along +Y at x = X_i; weft thread j runs along +X at y = Y_j, where
+//!   X_0 = 0 and X_{i+1} = X_i + spacing_i (likewise Y). The period is Px = sum of warp spacings
+//!   by Py = sum of weft spacings and tiles the plane.
+//! * Only floats are modelled (the thesis ignores the non-cylindrical parts of threads): a float of
+//!   a thread over crossing threads a..=b is one segment. Unless given, its extent along its axis
+//!   runs from the surface of the crossing thread before it to the surface of the one after it:
+//!   [P_{a-1} + r_{a-1}, P_{b+1} - r_{b+1}], so a float over f threads at spacing s between crossing
+//!   threads of radius r is (f + 1) s - 2 r long (the thesis's twill: 3 * 3.1 - 3 = 6.3 and
+//!   2 * 3.1 - 3 = 3.2). A given `segment_length` is centred in that room.
+//! * Segment ends are flat caps (discs cut by the floor). A thread that never goes under is an
+//!   endless cylinder.
+
+use crate::fabric::Fabric;
+use crate::weave::{Float, Group};
+use std::f64::consts::PI;
+
+/// One cylinder segment (a float) of the period.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Segment {
+    /// Warp (along +Y) or weft (along +X).
+    pub group: Group,
+    /// Thread index within its group in the period.
+    pub thread: usize,
+    /// The float in the weave this segment realises.
+    pub float: Float,
+    /// Coordinate of the axis across the segment: x for a warp, y for a weft.
+    pub axis: f64,
+    /// Cylinder radius.
+    pub radius: f64,
+    /// Height of the axis above the floor.
+    pub height: f64,
+    /// Extent along the axis (y for a warp, x for a weft), `None` when endless.
+    pub extent: Option<(f64, f64)>,
+}
+
+impl Segment {
+    /// Highest point of the segment above the floor.
+    pub fn top(&self) -> f64 {
+        self.height + self.radius
+    }
+}
+
+/// The periodic micro-geometry of a fabric.
+#[derive(Clone, Debug)]
+pub struct Geometry {
+    /// The fabric it was built from.
+    pub fabric: Fabric,
+    /// X_i of each warp thread.
+    pub warp_pos: Vec<f64>,
+    /// Y_j of each weft thread.
+    pub weft_pos: Vec<f64>,
+    /// Period size (Px, Py).
+    pub period: (f64, f64),
+    /// All segments of one period.
+    pub segments: Vec<Segment>,
+}
+
+fn positions(spacings: impl Iterator<Item = f64>) -> (Vec<f64>, f64) {
+    let mut pos = Vec::new();
+    let mut acc = 0.0;
+    for s in spacings {
+        pos.push(acc);
+        acc += s;
+    }
+    (pos, acc)
+}
+
+/// Unwrapped position of thread `k` (any integer) of group `g`.
+pub fn thread_position(fabric: &Fabric, g: Group, k: isize) -> f64 {
+    let threads = &fabric.group(g).threads;
+    let n = threads.len() as isize;
+    let (pos, period) = positions(threads.iter().map(|t| t.spacing));
+    let q = k.div_euclid(n);
+    pos[k.rem_euclid(n) as usize] + q as f64 * period
+}
+
+/// Radius of thread `k` (any integer, taken modulo the period) of group `g`.
+pub fn thread_radius(fabric: &Fabric, g: Group, k: isize) -> f64 {
+    let threads = &fabric.group(g).threads;
+    threads[k.rem_euclid(threads.len() as isize) as usize].radius
+}
+
+/// The room a float of thread `t` of group `g` has between the surfaces of the crossing threads
+/// before and after it, along its axis (unwrapped coordinates).
+pub fn derived_float_extent(fabric: &Fabric, g: Group, _t: usize, fl: Float) -> (f64, f64) {
+    let c = g.other();
+    let a = fl.start as isize;
+    let b = a + fl.len as isize; // first crossing thread after the float
+    let lo = thread_position(fabric, c, a - 1) + thread_radius(fabric, c, a - 1);
+    let hi = thread_position(fabric, c, b) - thread_radius(fabric, c, b);
+    (lo, hi)
+}
+
+/// Area of a cylinder's cross-section above the floor, for radius `r` and axis height `h`.
+pub fn area_above_floor(r: f64, h: f64) -> f64 {
+    let h = h.clamp(-r, r);
+    r * r * (PI / 2.0 + (h / r).asin()) + h * (r * r - h * h).sqrt()
+}
+
+/// Height of the equal-area rectangle of width 2r standing for a cylinder seen side-on
+/// (thesis eq. 3.1, h = pi r / 4 for a half cylinder; generalised to an axis at height `h`).
+pub fn equal_area_height(r: f64, h: f64) -> f64 {
+    area_above_floor(r, h) / (2.0 * r)
+}
+
+impl Geometry {
+    /// Builds the micro-geometry of a validated fabric.
+    pub fn new(fabric: &Fabric) -> Geometry {
+        let (warp_pos, px) = positions(fabric.warp.threads.iter().map(|t| t.spacing));
+        let (weft_pos, py) = positions(fabric.weft.threads.iter().map(|t| t.spacing));
+        let mut segments = Vec::new();
+        for g in [Group::Warp, Group::Weft] {
+            let pos = match g {
+                Group::Warp => &warp_pos,
+                Group::Weft => &weft_pos,
+            };
+            for (t, yarn) in fabric.group(g).threads.iter().enumerate() {
+                for fl in fabric.weave.floats(g, t) {
+                    let extent = if fl.endless {
+                        None
+                    } else {
+                        let (lo, hi) = derived_float_extent(fabric, g, t, fl);
+                        Some(match yarn.segment_length {
+                            Some(len) => {
+                                let mid = 0.5 * (lo + hi);
+                                (mid - 0.5 * len, mid + 0.5 * len)
+                            }
+                            None => (lo, hi),
+                        })
+                    };
+                    segments.push(Segment {
+                        group: g,
+                        thread: t,
+                        float: fl,
+                        axis: pos[t],
+                        radius: yarn.radius,
+                        height: yarn.height,
+                        extent,
+                    });
+                }
+            }
+        }
+        Geometry {
+            fabric: fabric.clone(),
+            warp_pos,
+            weft_pos,
+            period: (px, py),
+            segments,
+        }
+    }
+
+    /// Unwrapped position of thread `k` of group `g`.
+    pub fn position(&self, g: Group, k: isize) -> f64 {
+        let (pos, p) = match g {
+            Group::Warp => (&self.warp_pos, self.period.0),
+            Group::Weft => (&self.weft_pos, self.period.1),
+        };
+        let n = pos.len() as isize;
+        pos[k.rem_euclid(n) as usize] + k.div_euclid(n) as f64 * p
+    }
+
+    /// Period length along the axis of group `g` (the direction its threads run).
+    pub fn period_along(&self, g: Group) -> f64 {
+        match g {
+            Group::Warp => self.period.1,
+            Group::Weft => self.period.0,
+        }
+    }
+
+    /// Period length across group `g` (the direction its threads are spaced in).
+    pub fn period_across(&self, g: Group) -> f64 {
+        match g {
+            Group::Warp => self.period.0,
+            Group::Weft => self.period.1,
+        }
+    }
+
+    /// Index into `segments` of the float of thread `thread` (group `g`) covering crossing
+    /// `cross` (any integer), or `None` when the thread is under there.
+    pub fn segment_at(&self, g: Group, thread: usize, cross: isize) -> Option<usize> {
+        let n = self.fabric.weave.n(g.other()) as isize;
+        let n = n as usize;
+        let c = cross.rem_euclid(n as isize) as usize;
+        self.segments.iter().position(|s| {
+            s.group == g
+                && s.thread == thread
+                && (s.float.endless || (c + n - s.float.start) % n < s.float.len)
+        })
+    }
+
+    /// Highest point of any yarn above the floor.
+    pub fn max_top(&self) -> f64 {
+        self.segments.iter().map(Segment::top).fold(0.0, f64::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn twill() -> Fabric {
+        Fabric::from_json_str(
+            r#"{"pattern": [[1,1,0],[0,1,1],[1,0,1]],
+                "warp": {"radius": 1.5, "spacing": 3.1}, "weft": {"radius": 1.5, "spacing": 3.1}}"#,
+            "t",
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn thesis_twill_segment_lengths() {
+        // Fig. 4.7: lengths 6.3 (float over two) and 3.2 (float over one), spacing 3.1, radius 1.5.
+        let g = Geometry::new(&twill());
+        for s in &g.segments {
+            let (a, b) = s.extent.unwrap();
+            let want = if s.group == Group::Warp { 6.3 } else { 3.2 };
+            assert!((b - a - want).abs() < 1e-12, "{s:?}");
+        }
+        assert_eq!(g.segments.len(), 6);
+    }
+
+    #[test]
+    fn equal_area_rectangle_of_half_cylinder() {
+        assert!((equal_area_height(2.0, 0.0) - PI * 2.0 / 4.0).abs() < 1e-15);
+        assert!((area_above_floor(1.0, 0.999999999) - PI).abs() < 1e-4);
+        assert!(area_above_floor(1.0, -1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn segment_lookup() {
+        let g = Geometry::new(&twill());
+        let s = g.segment_at(Group::Warp, 0, 3).unwrap(); // crossing 0 (= 3 mod 3), warp 0 over weft 0
+        assert_eq!(g.segments[s].float.start, 2);
+        assert!(g.segment_at(Group::Warp, 0, 1).is_none()); // warp 0 under weft 1
+    }
+}

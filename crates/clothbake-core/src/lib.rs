@@ -1,0 +1,18 @@
+//! clothbake-core: the BRDF of woven cloth derived from its yarn geometry, after
+//! Gang Huo, *Local Illumination Models from Surface Geometry* (UBC, 1993), chapters 2-4,
+//! with an exact ray tracer of the same micro-geometry as ground truth.
+//!
+//! Frame: +X weft direction, +Y warp direction, +Z macro normal. `wi` points toward the light,
+//! `wo` toward the eye. Quantities follow the thesis: the reflected *intensity* I for unit incident
+//! intensity (pi times radiance; a flat Lambertian facet gives rho_d cos(theta_i)) and the BRDF
+//! f_r = I / (pi cos(theta_i)) in 1/sr.
+
+pub mod fabric;
+pub mod geometry;
+pub mod vec3;
+pub mod weave;
+
+pub use fabric::{Fabric, FabricError, Material};
+pub use geometry::Geometry;
+pub use vec3::{UnitVec3, Vec3};
+pub use weave::{Group, Weave};

@@ -1,0 +1,155 @@
+//! Small 3-vector algebra and unit directions in the fabric's local frame.
+//!
+//! Frame: +X is the weft direction, +Y the warp direction, +Z the macro normal.
+//! Angles: `theta` from +Z, `phi` from +X toward +Y, both in radians unless a name says degrees.
+
+use std::ops::{Add, Mul, Neg, Sub};
+
+/// A plain 3-vector.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Vec3 {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+}
+
+impl Vec3 {
+    /// Builds a vector from its components.
+    pub const fn new(x: f64, y: f64, z: f64) -> Self {
+        Self { x, y, z }
+    }
+    /// Dot product.
+    pub fn dot(self, o: Vec3) -> f64 {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+    /// Euclidean length.
+    pub fn length(self) -> f64 {
+        self.dot(self).sqrt()
+    }
+    /// Cross product.
+    pub fn cross(self, o: Vec3) -> Vec3 {
+        Vec3::new(
+            self.y * o.z - self.z * o.y,
+            self.z * o.x - self.x * o.z,
+            self.x * o.y - self.y * o.x,
+        )
+    }
+    /// True when every component is finite.
+    pub fn is_finite(self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.z.is_finite()
+    }
+}
+
+impl Add for Vec3 {
+    type Output = Vec3;
+    fn add(self, o: Vec3) -> Vec3 {
+        Vec3::new(self.x + o.x, self.y + o.y, self.z + o.z)
+    }
+}
+impl Sub for Vec3 {
+    type Output = Vec3;
+    fn sub(self, o: Vec3) -> Vec3 {
+        Vec3::new(self.x - o.x, self.y - o.y, self.z - o.z)
+    }
+}
+impl Mul<f64> for Vec3 {
+    type Output = Vec3;
+    fn mul(self, s: f64) -> Vec3 {
+        Vec3::new(self.x * s, self.y * s, self.z * s)
+    }
+}
+impl Neg for Vec3 {
+    type Output = Vec3;
+    fn neg(self) -> Vec3 {
+        Vec3::new(-self.x, -self.y, -self.z)
+    }
+}
+
+/// A direction of unit length. Constructed only through normalising constructors,
+/// so every `UnitVec3` in the program is finite and has length 1 (to rounding).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UnitVec3(Vec3);
+
+impl UnitVec3 {
+    /// +Z, the macro normal of the fabric.
+    pub const Z: UnitVec3 = UnitVec3(Vec3::new(0.0, 0.0, 1.0));
+
+    /// Normalises `v`; `None` for a zero-length or non-finite vector.
+    pub fn new(v: Vec3) -> Option<Self> {
+        let l = v.length();
+        if !(l.is_finite() && l > 1e-300) {
+            return None;
+        }
+        Some(UnitVec3(v * (1.0 / l)))
+    }
+
+    /// The direction at polar angle `theta` (from +Z) and azimuth `phi` (from +X toward +Y), radians.
+    pub fn from_spherical(theta: f64, phi: f64) -> Self {
+        let (st, ct) = theta.sin_cos();
+        let (sp, cp) = phi.sin_cos();
+        UnitVec3(Vec3::new(st * cp, st * sp, ct))
+    }
+
+    /// As [`UnitVec3::from_spherical`] with angles in degrees.
+    pub fn from_degrees(theta_deg: f64, phi_deg: f64) -> Self {
+        Self::from_spherical(theta_deg.to_radians(), phi_deg.to_radians())
+    }
+
+    /// The polar angle from +Z and the azimuth from +X (radians, azimuth in (-pi, pi]).
+    pub fn to_spherical(self) -> (f64, f64) {
+        (self.0.z.clamp(-1.0, 1.0).acos(), self.0.y.atan2(self.0.x))
+    }
+
+    /// The underlying vector.
+    pub fn get(self) -> Vec3 {
+        self.0
+    }
+    /// Cosine of the angle to the macro normal +Z.
+    pub fn cos_theta(self) -> f64 {
+        self.0.z
+    }
+    /// Mirror image under x -> -x.
+    pub fn mirror_x(self) -> Self {
+        UnitVec3(Vec3::new(-self.0.x, self.0.y, self.0.z))
+    }
+    /// Mirror image under y -> -y.
+    pub fn mirror_y(self) -> Self {
+        UnitVec3(Vec3::new(self.0.x, -self.0.y, self.0.z))
+    }
+    /// Rotation by +90 degrees about +Z: (x, y) -> (-y, x).
+    pub fn rotate_z90(self) -> Self {
+        UnitVec3(Vec3::new(-self.0.y, self.0.x, self.0.z))
+    }
+}
+
+impl std::ops::Deref for UnitVec3 {
+    type Target = Vec3;
+    fn deref(&self) -> &Vec3 {
+        &self.0
+    }
+}
+
+/// The half vector of two unit directions, `None` when they are opposite.
+pub fn half_vector(a: UnitVec3, b: UnitVec3) -> Option<UnitVec3> {
+    UnitVec3::new(a.get() + b.get())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spherical_round_trip() {
+        let d = UnitVec3::from_degrees(35.0, 120.0);
+        let (t, p) = d.to_spherical();
+        assert!((t.to_degrees() - 35.0).abs() < 1e-12);
+        assert!((p.to_degrees() - 120.0).abs() < 1e-12);
+        assert!((d.length() - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn zero_vector_is_not_a_direction() {
+        assert!(UnitVec3::new(Vec3::default()).is_none());
+        assert!(UnitVec3::new(Vec3::new(f64::NAN, 0.0, 1.0)).is_none());
+    }
+}
