@@ -7,12 +7,19 @@
 //! intensity (pi times radiance; a flat Lambertian facet gives rho_d cos(theta_i)) and the BRDF
 //! f_r = I / (pi cos(theta_i)) in 1/sr.
 
+pub mod analytic;
 pub mod fabric;
+pub mod facet;
 pub mod geometry;
+pub mod raytrace;
+pub mod reflect;
 pub mod vec3;
 pub mod weave;
 
 pub use fabric::{Fabric, FabricError, Material};
+pub use facet::{Facet, FacetIntensity, FacetModel};
 pub use geometry::Geometry;
 pub use vec3::{UnitVec3, Vec3};
 pub use weave::{Group, Weave};
+pub use analytic::AnalyticModel;
+pub use reflect::{intensity_to_brdf, Reflection};

@@ -1,0 +1,34 @@
+//! The output quantity: reflected intensity split into diffuse and specular parts, and the BRDF.
+
+use crate::vec3::UnitVec3;
+use std::f64::consts::PI;
+
+/// Reflected intensity for unit incident intensity (thesis units: pi times radiance), RGB.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Reflection {
+    /// Diffuse part I_d.
+    pub i_d: [f64; 3],
+    /// Specular part I_s.
+    pub i_s: [f64; 3],
+}
+
+impl Reflection {
+    /// Total intensity I = I_d + I_s.
+    pub fn total(&self) -> [f64; 3] {
+        std::array::from_fn(|k| self.i_d[k] + self.i_s[k])
+    }
+
+    /// The BRDF f_r = I / (pi cos theta_i) in 1/sr (zero for light at or below the horizon).
+    pub fn brdf(&self, wi: UnitVec3) -> [f64; 3] {
+        intensity_to_brdf(self.total(), wi)
+    }
+}
+
+/// f_r = I / (pi cos theta_i): a flat Lambertian facet of albedo rho gives rho / pi.
+pub fn intensity_to_brdf(i: [f64; 3], wi: UnitVec3) -> [f64; 3] {
+    let c = wi.cos_theta();
+    if c <= 0.0 {
+        return [0.0; 3];
+    }
+    std::array::from_fn(|k| i[k] / (PI * c))
+}
