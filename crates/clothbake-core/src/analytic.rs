@@ -1,28 +1,468 @@
-//! The analytic direct-reflection model (thesis ch. 3-4). (Being written.)
+//! The analytic direct-reflection model (thesis ch. 3-4).
+//!
+//! Preprocessing ([`AnalyticModel::new`]) cuts every segment of the period into *pieces*, one per
+//! crossing it floats over (the piece's cross-section sees that crossing row's neighbours), builds
+//! for each piece the active-occluder tables of its two cross-section sides and for each segment
+//! those of its two ends (sec. 3.2), and merges identical pieces into independent *units* with
+//! multiplicities D_i (eq. 4.11). Evaluation ([`AnalyticModel::eval`]) then, per unit:
+//!
+//! 1. arc: above-floor arc, minus self-shadowing/self-blocking (Poulin & Fournier), minus the
+//!    arc the active neighbour hides from L and from E (eqs 3.4-3.5);
+//! 2. length: the segment's length minus what the active occluders at its ends hide from L and
+//!    from E (eq. 3.6), intersected with the piece (sec. 4.1's length code and its "case 2" with
+//!    a mixed neighbourhood follow from treating each piece on its own);
+//! 3. projected areas S_vi, S_v (eqs 4.2-4.3, with the |E_p| factor that makes the areas of warp
+//!    and weft pieces comparable) and the arc integrals of the facet terms with the
+//!    cos(theta - theta_E) correction (eqs 4.4-4.10);
+//! 4. the area-weighted average I = sum D_i I_i / sum D_i S_v,i (eq. 4.11 and its pseudocode).
 
-use crate::fabric::Fabric;
-use crate::facet::FacetModel;
+use crate::arc::{diffuse_integral, huo_specular_integral, projected_width, Arc, Projected};
+use crate::fabric::{Fabric, Material};
+use crate::facet::{Facet, FacetModel};
+use crate::geometry::{equal_area_height, Geometry, Segment};
+use crate::quad::integrate;
 use crate::reflect::Reflection;
-use crate::vec3::UnitVec3;
+use crate::shadowing::{occluded_arc, occluded_length, ActiveTable, ArcOcclusion, Occluder};
+use crate::vec3::{UnitVec3, Vec3};
+use crate::weave::Group;
+use std::f64::consts::PI;
+
+/// Below this, a projected component counts as zero (direction in a symmetry plane).
+const EPS: f64 = 1e-12;
+
+/// Per-segment data shared by its pieces.
+#[derive(Clone, Debug, PartialEq)]
+struct SegmentData {
+    group: Group,
+    radius: f64,
+    height: f64,
+    /// Height of the segment's equal-area rectangle (eq. 3.1), its top in axial profiles.
+    top: f64,
+    /// Extent along the axis; `None` when endless.
+    extent: Option<(f64, f64)>,
+    /// Occluders beyond the +axis end and beyond the -axis end.
+    end_plus: ActiveTable,
+    end_minus: ActiveTable,
+    material: Material,
+}
+
+/// An independent unit: a piece of a segment with its cross-section neighbourhood.
+#[derive(Clone, Debug)]
+struct Unit {
+    seg: SegmentData,
+    /// Range of the piece along the axis.
+    range: (f64, f64),
+    /// Occluders on the +c side and on the -c side of the cross-section.
+    side_plus: ActiveTable,
+    side_minus: ActiveTable,
+    /// Number of identical pieces in the period (D_i).
+    count: u32,
+}
+
+/// Inventory of the preprocessing, for reports and tests.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UnitSummary {
+    /// Warp or weft.
+    pub group: Group,
+    /// Multiplicity D_i.
+    pub count: u32,
+    /// Piece length along the axis.
+    pub length: f64,
+    /// Entries in the four active-occluder tables (+c, -c, +axis end, -axis end).
+    pub table_sizes: [usize; 4],
+}
 
 /// The thesis's analytic model of one fabric, with its look-up tables built once.
 #[derive(Clone, Debug)]
 pub struct AnalyticModel {
     facet: FacetModel,
-    _fabric: Fabric,
+    units: Vec<Unit>,
+}
+
+fn frame(g: Group) -> (Vec3, Vec3) {
+    // (c: across the segment, a: along its axis)
+    match g {
+        Group::Warp => (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)),
+        Group::Weft => (Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 0.0, 0.0)),
+    }
+}
+
+fn rem(k: isize, n: usize) -> usize {
+    k.rem_euclid(n as isize) as usize
+}
+
+/// The copy (period shift) of segment `s`'s extent that covers axis coordinate `p`.
+fn extent_near(s: &Segment, p: f64, period: f64) -> (f64, f64) {
+    let (e0, e1) = s.extent.expect("finite float");
+    let q = ((p - 0.5 * (e0 + e1)) / period).round();
+    (e0 + q * period, e1 + q * period)
+}
+
+/// Occluders on one side (`dir` = +1 or -1 along c) of the cross-section of segment `seg`
+/// at crossing `cross`: one period of neighbours plus the segment's own repetition.
+fn side_profile(geo: &Geometry, seg: &Segment, cross: isize, dir: isize) -> Vec<Occluder> {
+    let g = seg.group;
+    let c = g.other();
+    let weave = &geo.fabric.weave;
+    let (ng, nc) = (weave.n(g), weave.n(c));
+    let cross_yarn = geo.fabric.group(c).threads[rem(cross, nc)];
+    let cross_top = equal_area_height(cross_yarn.radius, cross_yarn.height);
+    let mut out = Vec::new();
+    let mut last_box = None;
+    for m in 1..=ng as isize {
+        let tt = seg.thread as isize + dir * m;
+        let p = geo.position(g, tt);
+        let yarn = geo.fabric.group(g).threads[rem(tt, ng)];
+        if weave.on_top(g, rem(tt, ng), rem(cross, nc)) {
+            out.push(Occluder { u: dir as f64 * (p - seg.axis), z: yarn.height, rho: yarn.radius });
+            last_box = None;
+        } else {
+            // The crossing thread floats over thread tt: seen side-on, an equal-area rectangle.
+            let si = geo.segment_at(c, rem(cross, nc), tt).expect("crossing thread is on top");
+            let (e0, e1) = extent_near(&geo.segments[si], p, geo.period_across(g));
+            let key = (si, (e0 * 1e6).round() as i64);
+            if last_box == Some(key) {
+                continue;
+            }
+            last_box = Some(key);
+            let u = if dir > 0 { e0 - seg.axis } else { seg.axis - e1 };
+            out.push(Occluder { u, z: cross_top, rho: 0.0 });
+        }
+    }
+    out
+}
+
+/// Occluders beyond one end (`dir` = +1: the +axis end) of a finite segment, along its axis:
+/// crossing threads seen end-on (discs) and the thread's own next floats (rectangles).
+fn end_profile(geo: &Geometry, seg: &Segment, top: f64, dir: isize) -> Vec<Occluder> {
+    let g = seg.group;
+    let c = g.other();
+    let weave = &geo.fabric.weave;
+    let nc = weave.n(c);
+    let (y0, y1) = seg.extent.expect("finite float");
+    let (a, f) = (seg.float.start as isize, seg.float.len as isize);
+    let mut out = Vec::new();
+    let mut last_box = None;
+    for j in 0..nc as isize {
+        let k = if dir > 0 { a + f + j } else { a - 1 - j };
+        let p = geo.position(c, k);
+        if weave.on_top(g, seg.thread, rem(k, nc)) {
+            let si = geo.segment_at(g, seg.thread, k).expect("own float");
+            let (e0, e1) = extent_near(&geo.segments[si], p, geo.period_along(g));
+            let key = (si, (e0 * 1e6).round() as i64);
+            if last_box == Some(key) {
+                continue;
+            }
+            last_box = Some(key);
+            let u = if dir > 0 { e0 - y1 } else { y0 - e1 };
+            out.push(Occluder { u, z: top, rho: 0.0 });
+        } else {
+            let yarn = geo.fabric.group(c).threads[rem(k, nc)];
+            let u = if dir > 0 { p - y1 } else { y0 - p };
+            out.push(Occluder { u, z: yarn.height, rho: yarn.radius });
+            last_box = None;
+        }
+    }
+    out
+}
+
+fn table_key(t: &ActiveTable, out: &mut Vec<f64>) {
+    out.push(t.entries.len() as f64);
+    for (psi, o) in &t.entries {
+        out.extend([*psi, o.u, o.z, o.rho]);
+    }
 }
 
 impl AnalyticModel {
-    /// Preprocesses the weave period (units, multiplicities, active-cylinder tables).
+    /// Preprocesses the weave period: pieces, active-occluder tables (the cylinder scan),
+    /// and independent units with their multiplicities.
     pub fn new(fabric: &Fabric, facet: FacetModel) -> Self {
-        AnalyticModel { facet, _fabric: fabric.clone() }
+        let geo = Geometry::new(fabric);
+        let mut units: Vec<(Vec<f64>, Unit)> = Vec::new();
+        for seg in &geo.segments {
+            let g = seg.group;
+            let c = g.other();
+            let top = equal_area_height(seg.radius, seg.height);
+            let (end_plus, end_minus) = match seg.extent {
+                Some(_) => (
+                    ActiveTable::scan(&end_profile(&geo, seg, top, 1)),
+                    ActiveTable::scan(&end_profile(&geo, seg, top, -1)),
+                ),
+                None => Default::default(),
+            };
+            let data = SegmentData {
+                group: g,
+                radius: seg.radius,
+                height: seg.height,
+                top,
+                extent: seg.extent,
+                end_plus,
+                end_minus,
+                material: fabric.group(g).material,
+            };
+            let mid = |k: isize| 0.5 * (geo.position(c, k - 1) + geo.position(c, k));
+            let a = seg.float.start as isize;
+            let f = seg.float.len as isize;
+            for m in 0..f {
+                let k = a + m;
+                let lo = match seg.extent {
+                    Some((y0, _)) if m == 0 => y0,
+                    _ => mid(k),
+                };
+                let hi = match seg.extent {
+                    Some((_, y1)) if m == f - 1 => y1,
+                    _ => mid(k + 1),
+                };
+                let unit = Unit {
+                    seg: data.clone(),
+                    range: (lo, hi),
+                    side_plus: ActiveTable::scan(&side_profile(&geo, seg, k, 1)),
+                    side_minus: ActiveTable::scan(&side_profile(&geo, seg, k, -1)),
+                    count: 1,
+                };
+                // Key: everything the unit's reflection depends on, relative to its segment.
+                let origin = seg.extent.map_or(lo, |e| e.0);
+                let mut key = vec![
+                    g as u8 as f64,
+                    seg.radius,
+                    seg.height,
+                    seg.extent.map_or(-1.0, |e| e.1 - e.0),
+                    lo - origin,
+                    hi - origin,
+                ];
+                let mat = data.material;
+                key.extend(mat.albedo);
+                key.extend([mat.specular, mat.exponent]);
+                for t in [&unit.side_plus, &unit.side_minus, &data.end_plus, &data.end_minus] {
+                    table_key(t, &mut key);
+                }
+                let same = |k2: &Vec<f64>| {
+                    k2.len() == key.len() && k2.iter().zip(&key).all(|(x, y)| (x - y).abs() < 1e-9)
+                };
+                match units.iter_mut().find(|(k2, _)| same(k2)) {
+                    Some((_, u)) => u.count += 1,
+                    None => units.push((key, unit)),
+                }
+            }
+        }
+        AnalyticModel {
+            facet,
+            units: units.into_iter().map(|(_, u)| u).collect(),
+        }
     }
+
     /// The facet model in use.
     pub fn facet(&self) -> FacetModel {
         self.facet
     }
-    /// Directly reflected intensity toward `wo` for unit light from `wi` (eq. 4.11).
-    pub fn eval(&self, _wi: UnitVec3, _wo: UnitVec3) -> Reflection {
-        Reflection::default()
+
+    /// The independent units of the period (eq. 4.11's m units and their D_i).
+    pub fn units(&self) -> Vec<UnitSummary> {
+        self.units
+            .iter()
+            .map(|u| UnitSummary {
+                group: u.seg.group,
+                count: u.count,
+                length: u.range.1 - u.range.0,
+                table_sizes: [
+                    u.side_plus.entries.len(),
+                    u.side_minus.entries.len(),
+                    u.seg.end_plus.entries.len(),
+                    u.seg.end_minus.entries.len(),
+                ],
+            })
+            .collect()
+    }
+
+    /// Directly reflected intensity toward `wo` for unit light from `wi` (eq. 4.11): the
+    /// visible-area-weighted average over the units of the period. Zero when either direction
+    /// is at or below the horizon.
+    pub fn eval(&self, wi: UnitVec3, wo: UnitVec3) -> Reflection {
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return Reflection::default();
+        }
+        let (l, e) = (wi.get(), wo.get());
+        let mut s_total = 0.0;
+        let mut i_d = [0.0; 3];
+        let mut i_s = 0.0;
+        for u in &self.units {
+            let seg = &u.seg;
+            let (c, a) = frame(seg.group);
+            let lp = Projected { c: l.dot(c), z: l.z };
+            let ep = Projected { c: e.dot(c), z: e.z };
+            let floor = Arc::above_floor(seg.radius, seg.height);
+            let vis = self.side_arc(u, ep).meet(floor);
+            let lit = self.side_arc(u, lp).meet(floor);
+            let (vis_len, lit_len) = (self.end_interval(u, e.dot(a), e.z), self.end_interval(u, l.dot(a), l.z));
+            let l_v = overlap(u.range, vis_len);
+            if vis.is_empty() || l_v <= 0.0 {
+                continue;
+            }
+            let d = u.count as f64;
+            s_total += d * l_v * projected_width(seg.radius, vis, ep);
+            let l_vi = overlap(u.range, meet(vis_len, lit_len));
+            let vi = vis.meet(lit);
+            if vi.is_empty() || l_vi <= 0.0 {
+                continue;
+            }
+            let w = d * l_vi * seg.radius;
+            let (kd, ks) = self.arc_integral(&seg.material, seg.group, vi, wi, wo, lp, ep);
+            for k in 0..3 {
+                i_d[k] += w * kd * seg.material.albedo[k];
+            }
+            i_s += w * ks;
+        }
+        if s_total <= 0.0 {
+            return Reflection::default();
+        }
+        Reflection {
+            i_d: i_d.map(|x| x / s_total),
+            i_s: [i_s / s_total; 3],
+        }
+    }
+
+    /// Arc of the unit's cross-section that faces `v` and is not hidden by a neighbour on the
+    /// side `v` comes from (self-shadowing/blocking plus eqs 3.4-3.5 via the active table).
+    fn side_arc(&self, u: &Unit, v: Projected) -> Arc {
+        let mut arc = Arc::facing(v);
+        let theta = v.angle();
+        let (table, psi, mirrored) = if v.c > EPS {
+            (&u.side_plus, theta, false)
+        } else if v.c < -EPS {
+            (&u.side_minus, PI - theta, true)
+        } else {
+            return arc;
+        };
+        let Some(o) = table.active(psi) else { return arc };
+        match occluded_arc(u.seg.radius, u.seg.height, o, psi) {
+            ArcOcclusion::None => {}
+            ArcOcclusion::All => arc.hi = arc.lo,
+            ArcOcclusion::UpTo(t) if mirrored => arc.hi = arc.hi.min(PI - t),
+            ArcOcclusion::UpTo(t) => arc.lo = arc.lo.max(t),
+        }
+        arc
+    }
+
+    /// Interval along the axis not hidden by the occluders at the end that direction
+    /// (axial component `va`, vertical `vz`) comes from (eq. 3.6 via the active table).
+    fn end_interval(&self, u: &Unit, va: f64, vz: f64) -> (f64, f64) {
+        let Some((y0, y1)) = u.seg.extent else {
+            return (f64::NEG_INFINITY, f64::INFINITY);
+        };
+        let (table, psi) = if va > EPS {
+            (&u.seg.end_plus, vz.atan2(va))
+        } else if va < -EPS {
+            (&u.seg.end_minus, vz.atan2(-va))
+        } else {
+            return (y0, y1);
+        };
+        let hidden = table.active(psi).map_or(0.0, |o| occluded_length(u.seg.top, o, psi));
+        if va > 0.0 {
+            (y0, y1 - hidden)
+        } else {
+            (y0 + hidden, y1)
+        }
+    }
+
+    /// Integrals over the arc of the facet's diffuse factor and specular intensity, each times
+    /// N.E (the cos(theta - theta_E) correction of eqs 4.7 and 4.9, times |E_p|).
+    #[allow(clippy::too_many_arguments)]
+    fn arc_integral(
+        &self,
+        m: &Material,
+        g: Group,
+        arc: Arc,
+        wi: UnitVec3,
+        wo: UnitVec3,
+        lp: Projected,
+        ep: Projected,
+    ) -> (f64, f64) {
+        let kd = diffuse_integral(arc, lp, ep);
+        if m.specular == 0.0 {
+            return (kd, 0.0);
+        }
+        if self.facet == FacetModel::Huo {
+            let h = wi.get() + wo.get();
+            let hl = h.length();
+            let (c, _) = frame(g);
+            let hp = Projected { c: h.dot(c) / hl, z: h.z / hl };
+            if let Some(s) = huo_specular_integral(arc, hp, ep, m.exponent) {
+                return (kd, m.specular * s);
+            }
+        }
+        // Quadrature of the facet model, split at the specular peak.
+        let (c, _) = frame(g);
+        let (l, e) = (wi.get(), wo.get());
+        let mut f = |t: f64| {
+            let n = c * t.cos() + Vec3::new(0.0, 0.0, t.sin());
+            self.facet.intensity(m, n, l, e).specular * n.dot(e).max(0.0)
+        };
+        let h = l + e;
+        let peak = Projected { c: h.dot(c), z: h.z }.angle().clamp(arc.lo, arc.hi);
+        let tol = 1e-10 * (arc.hi - arc.lo);
+        let s = integrate(&mut f, arc.lo, peak, tol) + integrate(&mut f, peak, arc.hi, tol);
+        (kd, s)
+    }
+}
+
+fn meet(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+    (a.0.max(b.0), a.1.min(b.1))
+}
+
+fn overlap(a: (f64, f64), b: (f64, f64)) -> f64 {
+    let (lo, hi) = meet(a, b);
+    (hi - lo).max(0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fabric(s: &str) -> Fabric {
+        Fabric::from_json_str(s, "t").unwrap()
+    }
+
+    const TWILL: &str = r#"{"pattern": [[1,1,0],[0,1,1],[1,0,1]],
+        "warp": {"radius": 1.5, "spacing": 3.1}, "weft": {"radius": 1.5, "spacing": 3.1}}"#;
+
+    #[test]
+    fn twill_has_three_independent_units() {
+        // Diagonal shift symmetry: every warp float's first piece is alike, every second piece,
+        // and every weft piece.
+        let m = AnalyticModel::new(&fabric(TWILL), FacetModel::Huo);
+        let u = m.units();
+        assert_eq!(u.len(), 3, "{u:?}");
+        assert_eq!(u.iter().map(|x| x.count).sum::<u32>(), 9);
+    }
+
+    #[test]
+    fn normal_light_and_view_on_parallel_cylinders() {
+        // Touching half cylinders (d = 2r): with L = E = +Z nothing is hidden, and
+        // I_d = rho_d int_0^pi sin^2 / int_0^pi sin = rho_d pi / 4.
+        let f = fabric(r#"{"pattern": [[1]], "warp": {"radius": 1, "spacing": 2},
+            "weft": {"radius": 1, "spacing": 2}, }"#.replace(", }", "}").as_str());
+        let m = AnalyticModel::new(&f, FacetModel::Huo);
+        let r = m.eval(UnitVec3::Z, UnitVec3::Z);
+        assert!((r.i_d[0] - 0.4 * PI / 4.0).abs() < 1e-12, "{:?}", r);
+        // Specular: rho_s int_0^pi sin^n sin / 2 = rho_s int sin^11 / 2.
+        let q = integrate(&mut |t: f64| t.sin().powi(11), 0.0, PI, 1e-14);
+        assert!((r.i_s[0] - 0.3 * q / 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn quadrature_path_matches_closed_form() {
+        let f = fabric(TWILL);
+        let m = AnalyticModel::new(&f, FacetModel::Huo);
+        // Same exponent given as a non-integer-looking path: 10 + 1e-13 is not an integer.
+        let mut mat = f.warp.material;
+        mat.exponent = 10.0 + 1e-13;
+        let m2 = AnalyticModel::new(&f.clone().with_material(mat), FacetModel::Huo);
+        for (a, b) in [((30.0, 20.0), (45.0, 200.0)), ((60.0, 90.0), (10.0, 270.0)), ((5.0, 0.0), (70.0, 45.0))] {
+            let wi = UnitVec3::from_degrees(a.0, a.1);
+            let wo = UnitVec3::from_degrees(b.0, b.1);
+            let x = m.eval(wi, wo).i_s[0];
+            let y = m2.eval(wi, wo).i_s[0];
+            assert!((x - y).abs() < 1e-8 * x.max(1e-3), "{x} {y}");
+        }
     }
 }

@@ -8,11 +8,14 @@
 //! f_r = I / (pi cos(theta_i)) in 1/sr.
 
 pub mod analytic;
+pub mod arc;
 pub mod fabric;
 pub mod facet;
 pub mod geometry;
+pub mod quad;
 pub mod raytrace;
 pub mod reflect;
+pub mod shadowing;
 pub mod vec3;
 pub mod weave;
 
