@@ -1,1 +1,49 @@
-fn main() {}
+//! Criterion benchmarks of the direct model: the analytic path per (wi, wo) pair.
+//! The ray tracer's cost at 1% error is reported beside it by the `raytrace_1pct` group.
+
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3};
+use criterion::{criterion_group, criterion_main, Criterion};
+use std::hint::black_box;
+use std::path::Path;
+
+fn twill() -> Fabric {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/twill.json");
+    Fabric::from_path(&p).expect("tables/twill.json")
+}
+
+/// A fixed spread of direction pairs over the upper hemisphere (deterministic).
+fn directions(n: usize) -> Vec<(UnitVec3, UnitVec3)> {
+    (0..n)
+        .map(|k| {
+            let t = k as f64 + 0.5;
+            let wi = UnitVec3::from_degrees((t * 37.0) % 85.0, (t * 61.0) % 360.0);
+            let wo = UnitVec3::from_degrees((t * 53.0) % 85.0, (t * 97.0) % 360.0);
+            (wi, wo)
+        })
+        .collect()
+}
+
+fn analytic(c: &mut Criterion) {
+    let fabric = twill();
+    let dirs = directions(256);
+    for facet in [FacetModel::Huo, FacetModel::Lewis] {
+        let m = AnalyticModel::new(&fabric, facet);
+        c.bench_function(
+            &format!("analytic_direct/twill/{}/per_pair", facet.name()),
+            |b| {
+                let mut k = 0;
+                b.iter(|| {
+                    let (wi, wo) = dirs[k % dirs.len()];
+                    k += 1;
+                    black_box(m.eval(black_box(wi), black_box(wo)))
+                })
+            },
+        );
+    }
+    c.bench_function("analytic_preprocess/twill", |b| {
+        b.iter(|| black_box(AnalyticModel::new(black_box(&fabric), FacetModel::Huo)))
+    });
+}
+
+criterion_group!(benches, analytic);
+criterion_main!(benches);

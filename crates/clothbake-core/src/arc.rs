@@ -40,16 +40,25 @@ impl Arc {
     /// The part of the cylinder above the floor: z = h + r sin(theta) >= 0.
     pub fn above_floor(r: f64, h: f64) -> Arc {
         let t = (h / r).clamp(-1.0, 1.0).asin();
-        Arc { lo: -t, hi: std::f64::consts::PI + t }
+        Arc {
+            lo: -t,
+            hi: std::f64::consts::PI + t,
+        }
     }
     /// Normals facing `v` (N.V > 0): no self-shadowing or self-blocking (Poulin & Fournier).
     pub fn facing(v: Projected) -> Arc {
         let t = v.angle();
-        Arc { lo: t - FRAC_PI_2, hi: t + FRAC_PI_2 }
+        Arc {
+            lo: t - FRAC_PI_2,
+            hi: t + FRAC_PI_2,
+        }
     }
     /// Intersection.
     pub fn meet(self, o: Arc) -> Arc {
-        Arc { lo: self.lo.max(o.lo), hi: self.hi.min(o.hi) }
+        Arc {
+            lo: self.lo.max(o.lo),
+            hi: self.hi.min(o.hi),
+        }
     }
     /// True when the arc has no length.
     pub fn is_empty(self) -> bool {
@@ -109,8 +118,8 @@ pub fn huo_specular_integral(arc: Arc, h: Projected, e: Projected, n: f64) -> Op
 
 /// C_m(u) = integral of cos^m from 0 to u, by C_m = cos^{m-1} sin / m + (m - 1)/m C_{m-2}.
 fn cos_power_integral(m: u32, su: f64, cu: f64, u: f64) -> f64 {
-    let mut acc = if m % 2 == 0 { u } else { su };
-    let mut k = if m % 2 == 0 { 2 } else { 3 };
+    let mut acc = if m.is_multiple_of(2) { u } else { su };
+    let mut k = if m.is_multiple_of(2) { 2 } else { 3 };
     while k <= m {
         acc = cu.powi(k as i32 - 1) * su / k as f64 + (k as f64 - 1.0) / k as f64 * acc;
         k += 2;
@@ -124,7 +133,10 @@ mod tests {
     use crate::quad::integrate;
 
     fn p(t: f64, s: f64) -> Projected {
-        Projected { c: s * t.cos(), z: s * t.sin() }
+        Projected {
+            c: s * t.cos(),
+            z: s * t.sin(),
+        }
     }
 
     #[test]
@@ -139,9 +151,17 @@ mod tests {
         assert!((diffuse_integral(arc, l, e) - q).abs() < 1e-12);
         let h = p(1.4, 0.9);
         for n in [0.0, 1.0, 2.0, 7.0, 10.0, 55.0] {
-            let q = integrate(&mut |t| n_dot(t, h).max(0.0).powf(n) * n_dot(t, e), arc.lo, arc.hi, 1e-14);
+            let q = integrate(
+                &mut |t| n_dot(t, h).max(0.0).powf(n) * n_dot(t, e),
+                arc.lo,
+                arc.hi,
+                1e-14,
+            );
             let c = huo_specular_integral(arc, h, e, n).unwrap();
-            assert!((c - q).abs() < 1e-11 * q.abs().max(1.0), "n={n}: {c} vs {q}");
+            assert!(
+                (c - q).abs() < 1e-11 * q.abs().max(1.0),
+                "n={n}: {c} vs {q}"
+            );
         }
         assert!(huo_specular_integral(arc, h, e, 2.5).is_none());
     }

@@ -148,7 +148,12 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    fn err(&self, field: impl Into<String>, problem: impl Into<String>, fix: impl Into<String>) -> FabricError {
+    fn err(
+        &self,
+        field: impl Into<String>,
+        problem: impl Into<String>,
+        fix: impl Into<String>,
+    ) -> FabricError {
         FabricError {
             file: self.file.to_string(),
             field: field.into(),
@@ -160,8 +165,16 @@ impl Ctx<'_> {
     fn number(&self, field: &str, v: &Value) -> Result<f64, FabricError> {
         match v.as_f64() {
             Some(x) if x.is_finite() => Ok(x),
-            Some(_) => Err(self.err(field, "is not a finite number", "give a finite decimal number")),
-            None => Err(self.err(field, format!("expected a number, found {v}"), "give a decimal number")),
+            Some(_) => Err(self.err(
+                field,
+                "is not a finite number",
+                "give a finite decimal number",
+            )),
+            None => Err(self.err(
+                field,
+                format!("expected a number, found {v}"),
+                "give a decimal number",
+            )),
         }
     }
 
@@ -172,7 +185,11 @@ impl Ctx<'_> {
                 if a.len() != n {
                     return Err(self.err(
                         field,
-                        format!("has {} values but the period has {} threads of this group", a.len(), n),
+                        format!(
+                            "has {} values but the period has {} threads of this group",
+                            a.len(),
+                            n
+                        ),
                         format!("give one number for all threads or exactly {n} values"),
                     ));
                 }
@@ -213,7 +230,12 @@ impl Fabric {
             } else {
                 "fix the JSON syntax or the value's type"
             };
-            cx.err(if path == "." { String::new() } else { path }, inner.to_string(), fix)
+            let path = if path == "." || path == "?" {
+                String::new()
+            } else {
+                path
+            };
+            cx.err(path, inner.to_string(), fix)
         })?;
         Fabric::from_raw(raw, &cx)
     }
@@ -221,7 +243,11 @@ impl Fabric {
     fn from_raw(raw: FabricFile, cx: &Ctx) -> Result<Fabric, FabricError> {
         let _ = raw.description;
         if raw.pattern.is_empty() || raw.pattern[0].is_empty() {
-            return Err(cx.err("pattern", "is empty", "give at least one row with at least one 0/1 cell"));
+            return Err(cx.err(
+                "pattern",
+                "is empty",
+                "give at least one row with at least one 0/1 cell",
+            ));
         }
         let cols = raw.pattern[0].len();
         let mut rows = Vec::with_capacity(raw.pattern.len());
@@ -229,7 +255,10 @@ impl Fabric {
             if row.len() != cols {
                 return Err(cx.err(
                     format!("pattern[{r}]"),
-                    format!("has {} cells but row 0 has {cols}: the pattern is not rectangular", row.len()),
+                    format!(
+                        "has {} cells but row 0 has {cols}: the pattern is not rectangular",
+                        row.len()
+                    ),
                     "give every row the same number of cells (one per warp thread)",
                 ));
             }
@@ -238,13 +267,11 @@ impl Fabric {
                 match v.as_u64() {
                     Some(0) => out.push(false),
                     Some(1) => out.push(true),
-                    _ => {
-                        return Err(cx.err(
-                            format!("pattern[{r}][{c}]"),
-                            format!("is {v}, not 0 or 1"),
-                            "write 1 where the warp passes over the weft, 0 where the weft is on top",
-                        ))
-                    }
+                    _ => return Err(cx.err(
+                        format!("pattern[{r}][{c}]"),
+                        format!("is {v}, not 0 or 1"),
+                        "write 1 where the warp passes over the weft, 0 where the weft is on top",
+                    )),
                 }
             }
             rows.push(out);
@@ -280,7 +307,9 @@ impl Fabric {
     fn check_segment_lengths(&self, cx: &Ctx) -> Result<(), FabricError> {
         for g in [Group::Warp, Group::Weft] {
             for (t, yarn) in self.group(g).threads.iter().enumerate() {
-                let Some(len) = yarn.segment_length else { continue };
+                let Some(len) = yarn.segment_length else {
+                    continue;
+                };
                 for fl in self.weave.floats(g, t) {
                     if fl.endless {
                         continue;
@@ -331,12 +360,19 @@ fn group(cx: &Ctx, name: &str, g: &GroupFile, n: usize) -> Result<YarnGroup, Fab
             }
         };
         if radius[i] <= 0.0 {
-            return Err(cx.err(field("radius"), format!("is {}, must be > 0", radius[i]), "give a positive yarn radius"));
+            return Err(cx.err(
+                field("radius"),
+                format!("is {}, must be > 0", radius[i]),
+                "give a positive yarn radius",
+            ));
         }
-        if !(height[i].abs() < radius[i]) {
+        if height[i].abs() >= radius[i] {
             return Err(cx.err(
                 field("height"),
-                format!("is {}, must lie strictly between -radius and +radius ({})", height[i], radius[i]),
+                format!(
+                    "is {}, must lie strictly between -radius and +radius ({})",
+                    height[i], radius[i]
+                ),
                 "give the height of the cylinder axis above the floor; 0 is a half cylinder",
             ));
         }
@@ -353,7 +389,11 @@ fn group(cx: &Ctx, name: &str, g: &GroupFile, n: usize) -> Result<YarnGroup, Fab
         }
         if let Some(s) = &seg {
             if s[i] <= 0.0 {
-                return Err(cx.err(field("segment_length"), format!("is {}, must be > 0", s[i]), "give a positive length or omit it"));
+                return Err(cx.err(
+                    field("segment_length"),
+                    format!("is {}, must be > 0", s[i]),
+                    "give a positive length or omit it",
+                ));
             }
         }
     }
@@ -385,13 +425,21 @@ fn material(cx: &Ctx, name: &str, m: Option<&MaterialFile>) -> Result<Material, 
                 c
             }
             Value::Array(v) => {
-                return Err(cx.err(&f, format!("has {} values", v.len()), "give one number or three (R, G, B)"))
+                return Err(cx.err(
+                    &f,
+                    format!("has {} values", v.len()),
+                    "give one number or three (R, G, B)",
+                ))
             }
             v => [cx.number(&f, v)?; 3],
         };
         for (k, c) in out.albedo.iter().enumerate() {
             if !(0.0..=1.0).contains(c) {
-                return Err(cx.err(format!("{f}[{k}]"), format!("is {c}, outside [0, 1]"), "give a diffuse albedo between 0 and 1"));
+                return Err(cx.err(
+                    format!("{f}[{k}]"),
+                    format!("is {c}, outside [0, 1]"),
+                    "give a diffuse albedo between 0 and 1",
+                ));
             }
         }
     }
@@ -443,13 +491,28 @@ mod tests {
     fn errors_name_file_and_field() {
         let e = err(&OK.replace("[[1,0],[0,1]]", "[[1,0],[0]]"));
         assert_eq!(e.field, "pattern[1]");
-        assert!(e.to_string().starts_with("t.json: field `pattern[1]`"), "{e}");
+        assert!(
+            e.to_string().starts_with("t.json: field `pattern[1]`"),
+            "{e}"
+        );
         assert_eq!(err(&OK.replace("[[1,0],[0,1]]", "[]")).field, "pattern");
-        assert_eq!(err(&OK.replace("[[1,0],[0,1]]", "[[1,2],[0,1]]")).field, "pattern[0][1]");
+        assert_eq!(
+            err(&OK.replace("[[1,0],[0,1]]", "[[1,2],[0,1]]")).field,
+            "pattern[0][1]"
+        );
         assert_eq!(err(&OK.replace("[1.5, 1.2]", "[1.5]")).field, "weft.radius");
-        assert_eq!(err(&OK.replace("[1.5, 1.2]", "[1.5, -1]")).field, "weft.radius[1]");
-        assert_eq!(err(&OK.replace("\"spacing\": 3.1}", "\"spacing\": 2.0}")).field, "warp.spacing");
-        assert_eq!(err(&OK.replace("[0.5, 0.2, 0.1]", "[0.5, 1.2, 0.1]")).field, "weft.material.albedo[1]");
+        assert_eq!(
+            err(&OK.replace("[1.5, 1.2]", "[1.5, -1]")).field,
+            "weft.radius[1]"
+        );
+        assert_eq!(
+            err(&OK.replace("\"spacing\": 3.1}", "\"spacing\": 2.0}")).field,
+            "warp.spacing"
+        );
+        assert_eq!(
+            err(&OK.replace("[0.5, 0.2, 0.1]", "[0.5, 1.2, 0.1]")).field,
+            "weft.material.albedo[1]"
+        );
         let e = err(&OK.replace("\"albedo\"", "\"exponent\": -1, \"albedo\""));
         assert_eq!(e.field, "weft.material.exponent");
         let e = err(&OK.replace("\"radius\": 1.5,", "\"radius\": 1.5, \"colour\": 1,"));
@@ -457,7 +520,10 @@ mod tests {
         assert!(e.problem.contains("unknown field `colour`"), "{e}");
         let e = err(&OK.replace("\"radius\": 1.5,", "\"radius\": 1.5, \"height\": 1.5,"));
         assert_eq!(e.field, "warp.height");
-        let e = err(&OK.replace("\"radius\": 1.5,", "\"radius\": 1.5, \"segment_length\": 9,"));
+        let e = err(&OK.replace(
+            "\"radius\": 1.5,",
+            "\"radius\": 1.5, \"segment_length\": 9,",
+        ));
         assert_eq!(e.field, "warp.segment_length");
         assert!(err("{").problem.contains("EOF"));
     }

@@ -58,7 +58,11 @@ impl Facet for FacetModel {
             FacetModel::Huo => {
                 let h = l + e;
                 let hl = h.length();
-                let nh = if hl > 0.0 { (n.dot(h) / hl).max(0.0) } else { 0.0 };
+                let nh = if hl > 0.0 {
+                    (n.dot(h) / hl).max(0.0)
+                } else {
+                    0.0
+                };
                 FacetIntensity {
                     diffuse: nl,
                     specular: m.specular * nh.powf(m.exponent),
@@ -96,7 +100,11 @@ mod tests {
     #[test]
     fn lewis_specular_lobe_is_normalised() {
         // Directional albedo of the specular lobe at normal incidence is exactly rho_s.
-        let m = Material { albedo: [0.0; 3], specular: 1.0, exponent: 7.0 };
+        let m = Material {
+            albedo: [0.0; 3],
+            specular: 1.0,
+            exponent: 7.0,
+        };
         let n = Vec3::new(0.0, 0.0, 1.0);
         let (nt, np) = (400, 64);
         let mut sum = 0.0;

@@ -77,7 +77,12 @@ mod tests {
             c *= (100 + k) as f64 / k as f64 / 4.0;
         }
         let want = std::f64::consts::PI * c;
-        let v = integrate(&mut |x: f64| x.cos().powi(200), -1.5707963, 1.5707963, 1e-13);
+        let v = integrate(
+            &mut |x: f64| x.cos().powi(200),
+            -std::f64::consts::FRAC_PI_2,
+            std::f64::consts::FRAC_PI_2,
+            1e-13,
+        );
         assert!((v - want).abs() < 1e-10, "{v} {want}");
     }
 }

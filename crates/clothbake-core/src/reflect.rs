@@ -26,9 +26,9 @@ impl Reflection {
 
 /// f_r = I / (pi cos theta_i): a flat Lambertian facet of albedo rho gives rho / pi.
 pub fn intensity_to_brdf(i: [f64; 3], wi: UnitVec3) -> [f64; 3] {
-    let c = wi.cos_theta();
-    if c <= 0.0 {
+    if !wi.above_horizon() {
         return [0.0; 3];
     }
+    let c = wi.cos_theta();
     std::array::from_fn(|k| i[k] / (PI * c))
 }

@@ -16,6 +16,7 @@
 //!   the line's normal (-sin psi, cos psi): the numerators of eqs 3.4 and 3.5;
 //! * common tangent of two discs: eqs 3.7 (disc-disc), 3.8 (disc-corner), 3.9 (corner-disc).
 
+use crate::arc::{Arc, Projected};
 use std::f64::consts::FRAC_PI_2;
 
 /// An occluder in a profile: a disc centred at (`u`, `z`) of radius `rho` (0 for a rectangle corner).
@@ -161,6 +162,65 @@ pub fn occluded_length(top: f64, o: &Occluder, psi: f64) -> f64 {
     }
 }
 
+/// Eq. 3.6 at the true height z = h + r sin(theta) of each point of `arc` on a cylinder of
+/// radius `r` and axis height `h`, clamped to [0, `max_len`] point by point and averaged with the
+/// projected-width weight N.E = e.c cos(theta) + e.z sin(theta) (closed form, split where the
+/// clamps switch). Falls back to the hidden length at the arc's mean height for an empty arc.
+pub fn mean_occluded_length(
+    r: f64,
+    h: f64,
+    o: &Occluder,
+    psi: f64,
+    arc: Arc,
+    e: Projected,
+    max_len: f64,
+) -> f64 {
+    let (sp, cp) = psi.sin_cos();
+    if arc.is_empty() || sp <= 0.0 {
+        return occluded_length(crate::geometry::equal_area_height(r, h), o, psi).min(max_len);
+    }
+    // l(theta) = a - b sin(theta)
+    let a = (o.support(sp, cp) - h * cp) / sp;
+    let b = r * cp / sp;
+    // Break points: sin(theta) = a / b (l = 0) and (a - max_len) / b (l = max_len).
+    let mut cuts = vec![arc.lo, arc.hi];
+    if b > 0.0 {
+        for x in [a / b, (a - max_len) / b] {
+            if x.abs() < 1.0 {
+                let t = x.asin();
+                for c in [t, std::f64::consts::PI - t, t - 2.0 * std::f64::consts::PI] {
+                    if c > arc.lo && c < arc.hi {
+                        cuts.push(c);
+                    }
+                }
+            }
+        }
+    }
+    cuts.sort_by(f64::total_cmp);
+    // Primitives of w = e.c cos + e.z sin and of sin * w.
+    let pw = |t: f64| e.c * t.sin() - e.z * t.cos();
+    let psw = |t: f64| e.c * 0.5 * t.sin().powi(2) + e.z * (0.5 * t - 0.25 * (2.0 * t).sin());
+    let (mut num, mut den) = (0.0, 0.0);
+    for w in cuts.windows(2) {
+        let (t0, t1) = (w[0], w[1]);
+        let l_mid = a - b * (0.5 * (t0 + t1)).sin();
+        let wsum = pw(t1) - pw(t0);
+        den += wsum;
+        num += if l_mid <= 0.0 {
+            0.0
+        } else if l_mid >= max_len {
+            max_len * wsum
+        } else {
+            a * wsum - b * (psw(t1) - psw(t0))
+        };
+    }
+    if den <= 0.0 {
+        0.0
+    } else {
+        (num / den).clamp(0.0, max_len)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -185,18 +245,33 @@ mod tests {
         for deg in [10.0, 25.0, 40.0, 60.0, 80.0] {
             let psi = f64::to_radians(deg);
             let h = PI * r2 / 4.0;
-            let corner = Occluder { u: r1 + d, z: h, rho: 0.0 };
+            let corner = Occluder {
+                u: r1 + d,
+                z: h,
+                rho: 0.0,
+            };
             if let ArcOcclusion::UpTo(t) = occluded_arc(r1, 0.0, &corner, psi) {
                 assert!((t - eq_3_4(r1, d, h, psi)).abs() < 1e-12, "{deg}");
             }
-            let disc = Occluder { u: r1 + d + r2, z: 0.0, rho: r2 };
+            let disc = Occluder {
+                u: r1 + d + r2,
+                z: 0.0,
+                rho: r2,
+            };
             if let ArcOcclusion::UpTo(t) = occluded_arc(r1, 0.0, &disc, psi) {
                 assert!((t - eq_3_5(r1, r2, d, psi)).abs() < 1e-12, "{deg}");
             }
             let top = PI * r1 / 4.0;
-            let disc = Occluder { u: d + r2, z: 0.0, rho: r2 };
+            let disc = Occluder {
+                u: d + r2,
+                z: 0.0,
+                rho: r2,
+            };
             let want = eq_3_6(r2, d, top, psi).max(0.0);
-            assert!((occluded_length(top, &disc, psi) - want).abs() < 1e-12, "{deg}");
+            assert!(
+                (occluded_length(top, &disc, psi) - want).abs() < 1e-12,
+                "{deg}"
+            );
         }
     }
 
@@ -204,13 +279,25 @@ mod tests {
     fn printed_common_tangents() {
         let (r1, r2, d) = (1.0, 1.6, 0.4);
         // Eq. 3.7: two cylinders on the floor.
-        let a = Occluder { u: 0.0, z: 0.0, rho: r1 };
-        let b = Occluder { u: r1 + d + r2, z: 0.0, rho: r2 };
+        let a = Occluder {
+            u: 0.0,
+            z: 0.0,
+            rho: r1,
+        };
+        let b = Occluder {
+            u: r1 + d + r2,
+            z: 0.0,
+            rho: r2,
+        };
         let want = ((r2 - r1) / (r2 + r1 + d)).asin();
         assert!((common_tangent(&a, &b).unwrap() - want).abs() < 1e-12);
         // Eq. 3.8: from a cylinder to the corner of the rectangle standing for segment 2.
         let h = PI * r2 / 4.0;
-        let corner = Occluder { u: r1 + d, z: h, rho: 0.0 };
+        let corner = Occluder {
+            u: r1 + d,
+            z: h,
+            rho: 0.0,
+        };
         let psi = common_tangent(&a, &corner).unwrap();
         let qa = r1 * r1 + d * d + 2.0 * r1 * d + h * h;
         let qb = 2.0 * r1 * (r1 + d);
@@ -220,8 +307,16 @@ mod tests {
         // Eq. 3.9: from the rectangle corner of segment 1 (length l1) to a cylinder beyond it.
         let l1 = 3.2;
         let h1 = PI * r1 / 4.0;
-        let c1 = Occluder { u: 0.0, z: h1, rho: 0.0 };
-        let c2 = Occluder { u: l1 + d + r2, z: 0.0, rho: r2 };
+        let c1 = Occluder {
+            u: 0.0,
+            z: h1,
+            rho: 0.0,
+        };
+        let c2 = Occluder {
+            u: l1 + d + r2,
+            z: 0.0,
+            rho: r2,
+        };
         let psi = common_tangent(&c1, &c2).unwrap();
         let qa = (l1 + d + r2).powi(2) + h1 * h1;
         let qb = 2.0 * r2 * (l1 + d + r2);
@@ -231,22 +326,78 @@ mod tests {
     }
 
     #[test]
+    fn mean_length_matches_pointwise_quadrature() {
+        let o = Occluder {
+            u: 1.5,
+            z: 0.0,
+            rho: 1.5,
+        };
+        let e = Projected { c: 0.4, z: 0.8 };
+        let arc = Arc { lo: 0.1, hi: 2.9 };
+        for deg in [15.0, 30.0, 50.0, 75.0] {
+            let psi = f64::to_radians(deg);
+            let (r, h, max_len) = (1.5, 0.2, 2.0);
+            let pointwise = |t: f64| {
+                let z = h + r * t.sin();
+                let (sp, cp) = psi.sin_cos();
+                ((o.support(sp, cp) - z * cp) / sp).clamp(0.0, max_len)
+            };
+            let w = |t: f64| e.c * t.cos() + e.z * t.sin();
+            let num = crate::quad::integrate(&mut |t| pointwise(t) * w(t), arc.lo, arc.hi, 1e-12);
+            let den = crate::quad::integrate(&mut |t| w(t), arc.lo, arc.hi, 1e-12);
+            let got = mean_occluded_length(r, h, &o, psi, arc, e, max_len);
+            assert!(
+                (got - num / den).abs() < 1e-6,
+                "{deg}: {got} vs {}",
+                num / den
+            );
+        }
+    }
+
+    #[test]
     fn scan_agrees_with_brute_force_maximum() {
         // A ragged profile: low corners, tall and short discs, one period plus repetition.
         let occ = vec![
-            Occluder { u: 1.6, z: 0.9, rho: 0.0 },
-            Occluder { u: 4.0, z: 0.0, rho: 2.2 },
-            Occluder { u: 6.5, z: 0.4, rho: 0.0 },
-            Occluder { u: 9.0, z: 0.0, rho: 0.8 },
-            Occluder { u: 12.0, z: 0.5, rho: 2.5 },
-            Occluder { u: 15.0, z: 0.0, rho: 1.0 },
+            Occluder {
+                u: 1.6,
+                z: 0.9,
+                rho: 0.0,
+            },
+            Occluder {
+                u: 4.0,
+                z: 0.0,
+                rho: 2.2,
+            },
+            Occluder {
+                u: 6.5,
+                z: 0.4,
+                rho: 0.0,
+            },
+            Occluder {
+                u: 9.0,
+                z: 0.0,
+                rho: 0.8,
+            },
+            Occluder {
+                u: 12.0,
+                z: 0.5,
+                rho: 2.5,
+            },
+            Occluder {
+                u: 15.0,
+                z: 0.0,
+                rho: 1.0,
+            },
         ];
         let t = ActiveTable::scan(&occ);
         assert!(t.entries.len() >= 2);
         for i in 1..200 {
             let psi = i as f64 / 200.0 * FRAC_PI_2;
             let (sp, cp) = psi.sin_cos();
-            let best = occ.iter().map(|o| o.support(sp, cp)).fold(f64::MIN, f64::max);
+            let best = occ
+                .iter()
+                .map(|o| o.support(sp, cp))
+                .fold(f64::MIN, f64::max);
             let got = t.active(psi).unwrap().support(sp, cp);
             assert!((got - best).abs() < 1e-9, "psi {psi}: {got} vs {best}");
         }

@@ -65,6 +65,9 @@ impl Neg for Vec3 {
     }
 }
 
+/// Cosines at or below this count as on or below the horizon (about 90 - 6e-8 degrees).
+pub const HORIZON_COS: f64 = 1e-9;
+
 /// A direction of unit length. Constructed only through normalising constructors,
 /// so every `UnitVec3` in the program is finite and has length 1 (to rounding).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -107,6 +110,11 @@ impl UnitVec3 {
     /// Cosine of the angle to the macro normal +Z.
     pub fn cos_theta(self) -> f64 {
         self.0.z
+    }
+    /// True when the direction is above the horizon: cos(theta) > [`HORIZON_COS`]. Directions at
+    /// the horizon (theta = 90 degrees, whose cosine rounds to about 6e-17) count as below it.
+    pub fn above_horizon(self) -> bool {
+        self.0.z > HORIZON_COS
     }
     /// Mirror image under x -> -x.
     pub fn mirror_x(self) -> Self {

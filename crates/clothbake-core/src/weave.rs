@@ -130,7 +130,12 @@ mod tests {
     use super::*;
 
     fn w(rows: &[&[u8]]) -> Weave {
-        Weave::new(rows.iter().map(|r| r.iter().map(|&v| v == 1).collect()).collect()).unwrap()
+        Weave::new(
+            rows.iter()
+                .map(|r| r.iter().map(|&v| v == 1).collect())
+                .collect(),
+        )
+        .unwrap()
     }
 
     #[test]

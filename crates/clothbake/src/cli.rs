@@ -1,0 +1,315 @@
+//! The command line: clap definitions and the value parsers behind them.
+//!
+//! Layout: `clothbake [--weave FILE]` (default mode: bake a table; reserved, not yet available)
+//! and `clothbake eval --weave FILE --wi THETA,PHI --wo THETA,PHI [...]`. The default mode's
+//! options live in [`BakeArgs`], flattened into [`Cli`], so the bake issue only has to add fields
+//! there and a handler in `main`.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use clothbake_core::{FacetModel, UnitVec3};
+use std::path::PathBuf;
+
+/// Default number of samples (rays) of `--method raytrace`.
+pub const DEFAULT_SAMPLES: usize = 100_000;
+/// Default random seed of `--method raytrace`.
+pub const DEFAULT_SEED: u64 = 1;
+
+/// Bake the BRDF of woven cloth, derived from its yarn geometry (Huo 1993), into tables.
+#[derive(Parser, Debug)]
+#[command(
+    name = "clothbake",
+    version,
+    args_conflicts_with_subcommands = true,
+    after_help = "Angles are in degrees: theta from the macro normal +Z (0 to 90), phi from +X (the weft \
+                  direction) toward +Y (the warp direction). Fabric files: see docs/fabric-format.md \
+                  and tables/*.json."
+)]
+pub struct Cli {
+    /// What to do; without a subcommand clothbake bakes a table (not yet available).
+    #[command(subcommand)]
+    pub command: Option<Command>,
+
+    /// Options of the default mode (baking a table).
+    #[command(flatten)]
+    pub bake: BakeArgs,
+}
+
+/// Options of the default mode, `clothbake --weave FILE` (baking; reserved for a later release).
+#[derive(Args, Debug, Default)]
+pub struct BakeArgs {
+    /// Fabric description to bake into a BRDF table (baking is not yet available; use `eval`).
+    #[arg(long, value_name = "FILE")]
+    pub weave: Option<PathBuf>,
+}
+
+/// The subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Evaluate the reflection of a fabric for one light and one eye direction.
+    Eval(EvalArgs),
+}
+
+/// `clothbake eval`.
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// Fabric description (JSON, see docs/fabric-format.md), e.g. tables/twill.json.
+    #[arg(long, value_name = "FILE")]
+    pub weave: PathBuf,
+
+    /// Direction toward the light, in degrees: theta from +Z (0 to 90), phi from +X toward +Y.
+    #[arg(long, value_name = "THETA,PHI", value_parser = parse_direction, allow_hyphen_values = true)]
+    pub wi: Direction,
+
+    /// Direction toward the eye, in degrees: theta from +Z (0 to 90), phi from +X toward +Y.
+    #[arg(long, value_name = "THETA,PHI", value_parser = parse_direction, allow_hyphen_values = true)]
+    pub wo: Direction,
+
+    /// Analytic model (thesis ch. 3-4) or the ray-traced ground truth of the same geometry.
+    #[arg(long, value_enum, default_value_t = Method::Analytic)]
+    pub method: Method,
+
+    /// Number of samples for --method raytrace [default: 100000].
+    #[arg(long, value_name = "N", value_parser = parse_samples)]
+    pub samples: Option<usize>,
+
+    /// Random seed for --method raytrace [default: 1].
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
+
+    /// Facet reflection model: the thesis's Phong-like terms or Lewis's modified Phong.
+    #[arg(long, value_enum, default_value_t = FacetArg::Huo)]
+    pub facet: FacetArg,
+
+    /// Material overrides, applied to both yarn groups.
+    #[command(flatten)]
+    pub material: MaterialArgs,
+
+    /// Print one JSON object instead of a table: keys I_d, I_s, I (reflected intensity for unit
+    /// incident intensity) and brdf (1/sr), each [r, g, b]; raytrace adds std_err ([r, g, b],
+    /// null when too few samples to estimate it) and samples.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Facet material overrides (the ranges of fabric files, see `clothbake_core::fabric`).
+#[derive(Args, Debug, Default, Clone, Copy, PartialEq)]
+pub struct MaterialArgs {
+    /// Diffuse albedo rho_d, one value or R,G,B, each in [0, 1].
+    #[arg(long, value_name = "R,G,B|X", value_parser = parse_albedo, allow_hyphen_values = true)]
+    pub albedo: Option<[f64; 3]>,
+
+    /// Specular coefficient rho_s in [0, 1].
+    #[arg(long, value_name = "X", value_parser = parse_specular, allow_hyphen_values = true)]
+    pub specular: Option<f64>,
+
+    /// Specular exponent n >= 0 (cloth: 6 to 15).
+    #[arg(long, value_name = "N", value_parser = parse_exponent, allow_hyphen_values = true)]
+    pub exponent: Option<f64>,
+}
+
+/// How to compute the reflection.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// The thesis's analytic direct-reflection model.
+    Analytic,
+    /// Monte Carlo ray tracing of the explicit micro-geometry (ground truth).
+    Raytrace,
+}
+
+impl Method {
+    /// Name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Analytic => "analytic",
+            Method::Raytrace => "raytrace",
+        }
+    }
+}
+
+/// `--facet` values (mirrors `clothbake_core::FacetModel`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FacetArg {
+    /// Thesis eqs 4.6 and 4.8: I_d = rho_d N.L, I_s = rho_s (N.H)^n.
+    Huo,
+    /// Lewis's reciprocal, energy-conserving modified Phong.
+    Lewis,
+}
+
+impl From<FacetArg> for FacetModel {
+    fn from(f: FacetArg) -> FacetModel {
+        match f {
+            FacetArg::Huo => FacetModel::Huo,
+            FacetArg::Lewis => FacetModel::Lewis,
+        }
+    }
+}
+
+/// A direction given on the command line, in degrees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Direction {
+    /// Polar angle from +Z, in [0, 90].
+    pub theta: f64,
+    /// Azimuth from +X toward +Y, any finite value.
+    pub phi: f64,
+}
+
+impl Direction {
+    /// The unit vector.
+    pub fn unit(self) -> UnitVec3 {
+        UnitVec3::from_degrees(self.theta, self.phi)
+    }
+
+    /// False at the horizon (theta = 90), where nothing is lit or seen.
+    pub fn above_horizon(self) -> bool {
+        self.theta < 90.0
+    }
+}
+
+fn number(s: &str, what: &str) -> Result<f64, String> {
+    let t = s.trim();
+    match t.parse::<f64>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(_) => Err(format!("{what} `{t}` is not a finite number")),
+        Err(_) => Err(format!("{what} `{t}` is not a number")),
+    }
+}
+
+/// Parses `THETA,PHI` in degrees; theta must lie in [0, 90].
+pub fn parse_direction(s: &str) -> Result<Direction, String> {
+    const FIX: &str =
+        "write THETA,PHI in degrees, e.g. 45,90 (theta from +Z, 0 to 90; phi from +X toward +Y)";
+    let parts: Vec<&str> = s.split(',').collect();
+    let [t, p] = parts.as_slice() else {
+        return Err(format!(
+            "expected two numbers separated by a comma, found {}; {FIX}",
+            if parts.len() == 1 {
+                "one".to_string()
+            } else {
+                parts.len().to_string()
+            }
+        ));
+    };
+    let theta = number(t, "theta").map_err(|e| format!("{e}; {FIX}"))?;
+    let phi = number(p, "phi").map_err(|e| format!("{e}; {FIX}"))?;
+    if !(0.0..=90.0).contains(&theta) {
+        return Err(format!(
+            "theta {theta} is outside [0, 90]; give the polar angle from the normal +Z, \
+             0 (overhead) to 90 (horizon): directions below the surface are not supported"
+        ));
+    }
+    Ok(Direction { theta, phi })
+}
+
+/// Parses a positive sample count.
+pub fn parse_samples(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(0) => Err("the sample count must be at least 1; give e.g. --samples 100000".into()),
+        Ok(n) => Ok(n),
+        Err(_) => Err(format!(
+            "`{}` is not a whole number of samples; give e.g. --samples 100000",
+            s.trim()
+        )),
+    }
+}
+
+fn unit_interval(s: &str, what: &str, fix: &str) -> Result<f64, String> {
+    let x = number(s, what).map_err(|e| format!("{e}; {fix}"))?;
+    if !(0.0..=1.0).contains(&x) {
+        return Err(format!("{what} {x} is outside [0, 1]; {fix}"));
+    }
+    Ok(x)
+}
+
+/// Parses a diffuse albedo: one number or `R,G,B`, each in [0, 1].
+pub fn parse_albedo(s: &str) -> Result<[f64; 3], String> {
+    const FIX: &str = "give one number or R,G,B, each between 0 and 1, e.g. 0.4 or 0.5,0.2,0.1";
+    let parts: Vec<&str> = s.split(',').collect();
+    match parts.as_slice() {
+        [x] => Ok([unit_interval(x, "albedo", FIX)?; 3]),
+        [r, g, b] => Ok([
+            unit_interval(r, "albedo R", FIX)?,
+            unit_interval(g, "albedo G", FIX)?,
+            unit_interval(b, "albedo B", FIX)?,
+        ]),
+        _ => Err(format!(
+            "expected 1 or 3 comma-separated values, found {}; {FIX}",
+            parts.len()
+        )),
+    }
+}
+
+/// Parses a specular coefficient rho_s in [0, 1].
+pub fn parse_specular(s: &str) -> Result<f64, String> {
+    unit_interval(
+        s,
+        "specular",
+        "give a specular coefficient rho_s between 0 and 1, e.g. 0.3",
+    )
+}
+
+/// Parses a specular exponent n >= 0.
+pub fn parse_exponent(s: &str) -> Result<f64, String> {
+    const FIX: &str = "give a non-negative specular exponent n (cloth: 6 to 15), e.g. 10";
+    let n = number(s, "exponent").map_err(|e| format!("{e}; {FIX}"))?;
+    if n < 0.0 {
+        return Err(format!("exponent {n} is negative; {FIX}"));
+    }
+    Ok(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn clap_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn directions() {
+        assert_eq!(
+            parse_direction("45,90").unwrap(),
+            Direction {
+                theta: 45.0,
+                phi: 90.0
+            }
+        );
+        assert_eq!(
+            parse_direction(" 0 , -30.5 ").unwrap(),
+            Direction {
+                theta: 0.0,
+                phi: -30.5
+            }
+        );
+        assert!(parse_direction("90,0").unwrap().theta == 90.0);
+        for bad in [
+            "45", "45,", "a,1", "1,2,3", "91,0", "-1,0", "nan,0", "45,inf", "",
+        ] {
+            let e = parse_direction(bad).unwrap_err();
+            assert!(!e.contains('\n'), "{e}");
+        }
+        assert!(parse_direction("91,0")
+            .unwrap_err()
+            .contains("outside [0, 90]"));
+    }
+
+    #[test]
+    fn materials() {
+        assert_eq!(parse_albedo("0.5").unwrap(), [0.5; 3]);
+        assert_eq!(parse_albedo("0.5,0.2,0.1").unwrap(), [0.5, 0.2, 0.1]);
+        assert!(parse_albedo("0.5,1.2,0.1")
+            .unwrap_err()
+            .contains("albedo G 1.2"));
+        assert!(parse_albedo("0.5,0.2").is_err());
+        assert!(parse_albedo("nan").is_err());
+        assert!(parse_specular("1.0").is_ok());
+        assert!(parse_specular("-0.1").is_err());
+        assert_eq!(parse_exponent("0").unwrap(), 0.0);
+        assert!(parse_exponent("-1").is_err());
+        assert!(parse_exponent("inf").is_err());
+        assert!(parse_samples("0").is_err());
+        assert_eq!(parse_samples("10").unwrap(), 10);
+    }
+}

@@ -1,0 +1,132 @@
+//! `clothbake eval`: the reflection of a fabric for one light and one eye direction.
+
+use crate::cli::{EvalArgs, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
+use crate::error::CliError;
+use crate::report::{self, Report};
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, Reflection, UnitVec3};
+
+/// Runs `clothbake eval` and returns the text to print on stdout.
+pub fn run(args: &EvalArgs) -> Result<String, CliError> {
+    if args.method == Method::Analytic && (args.samples.is_some() || args.seed.is_some()) {
+        return Err(CliError::new(
+            "--samples and --seed apply only to the ray tracer",
+            "add --method raytrace or drop them",
+        ));
+    }
+    let fabric = Fabric::from_path(&args.weave)?;
+    let fabric = apply_material(fabric, &args.material);
+    let facet = FacetModel::from(args.facet);
+    let (wi, wo) = (args.wi.unit(), args.wo.unit());
+    let horizon = !(args.wi.above_horizon() && args.wo.above_horizon());
+
+    let (reflection, raytrace) = match args.method {
+        Method::Analytic => {
+            let r = if horizon {
+                Reflection::default()
+            } else {
+                AnalyticModel::new(&fabric, facet).eval(wi, wo)
+            };
+            (r, None)
+        }
+        Method::Raytrace => {
+            let samples = args.samples.unwrap_or(DEFAULT_SAMPLES);
+            let seed = args.seed.unwrap_or(DEFAULT_SEED);
+            let (r, std_err) = if horizon {
+                (Reflection::default(), [0.0; 3])
+            } else {
+                raytrace(&fabric, facet, wi, wo, samples, seed)
+            };
+            (r, Some(report::Raytrace { std_err, samples }))
+        }
+    };
+    let brdf = if horizon {
+        [0.0; 3]
+    } else {
+        reflection.brdf(wi)
+    };
+    let rep = Report {
+        fabric_name: &fabric.name,
+        file: &args.weave,
+        method: args.method,
+        facet,
+        wi: args.wi,
+        wo: args.wo,
+        horizon,
+        reflection,
+        brdf,
+        raytrace,
+    };
+    Ok(if args.json { rep.json() } else { rep.table() })
+}
+
+/// Replaces the facet-material fields given on the command line, in both yarn groups; fields not
+/// given keep each group's value from the file. (The values were range-checked by the parsers.)
+pub fn apply_material(mut fabric: Fabric, m: &MaterialArgs) -> Fabric {
+    for g in [&mut fabric.warp, &mut fabric.weft] {
+        if let Some(a) = m.albedo {
+            g.material.albedo = a;
+        }
+        if let Some(s) = m.specular {
+            g.material.specular = s;
+        }
+        if let Some(n) = m.exponent {
+            g.material.exponent = n;
+        }
+    }
+    fabric
+}
+
+/// The ray-traced estimate and its standard error (of the total I, per channel; infinite when
+/// too few samples to estimate it).
+fn raytrace(
+    fabric: &Fabric,
+    facet: FacetModel,
+    wi: UnitVec3,
+    wo: UnitVec3,
+    samples: usize,
+    seed: u64,
+) -> (Reflection, [f64; 3]) {
+    let est = RayTracer::new(fabric, facet).render(wi, wo, samples, seed);
+    (est.reflection, est.std_err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::Direction;
+
+    #[test]
+    fn material_overrides_keep_unset_fields() {
+        let f = Fabric::from_json_str(
+            r#"{"pattern": [[1,0],[0,1]],
+                "warp": {"radius": 1.5, "spacing": 3.1, "material": {"specular": 0.1}},
+                "weft": {"radius": 1.5, "spacing": 3.1, "material": {"specular": 0.2}}}"#,
+            "t",
+        )
+        .unwrap();
+        let m = MaterialArgs {
+            albedo: Some([0.1, 0.2, 0.3]),
+            specular: None,
+            exponent: Some(4.0),
+        };
+        let f = apply_material(f, &m);
+        assert_eq!(f.warp.material.albedo, [0.1, 0.2, 0.3]);
+        assert_eq!(f.weft.material.exponent, 4.0);
+        assert_eq!(f.warp.material.specular, 0.1);
+        assert_eq!(f.weft.material.specular, 0.2);
+    }
+
+    #[test]
+    fn horizon_direction() {
+        assert!(!Direction {
+            theta: 90.0,
+            phi: 0.0
+        }
+        .above_horizon());
+        assert!(Direction {
+            theta: 89.9,
+            phi: 0.0
+        }
+        .above_horizon());
+    }
+}

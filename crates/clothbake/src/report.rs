@@ -1,0 +1,111 @@
+//! Output of `clothbake eval`: one JSON object (`--json`) or a short table.
+
+use crate::cli::{Direction, Method};
+use clothbake_core::{FacetModel, Reflection};
+use serde_json::json;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Ray-tracer extras.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Raytrace {
+    /// Standard error of the estimate of I, per channel (infinite, printed as JSON `null`, when
+    /// too few samples to estimate it).
+    pub std_err: [f64; 3],
+    /// Number of samples asked for.
+    pub samples: usize,
+}
+
+/// Everything one evaluation prints.
+#[derive(Debug)]
+pub struct Report<'a> {
+    /// Fabric display name.
+    pub fabric_name: &'a str,
+    /// Fabric file.
+    pub file: &'a Path,
+    /// Method used.
+    pub method: Method,
+    /// Facet model used.
+    pub facet: FacetModel,
+    /// Toward the light.
+    pub wi: Direction,
+    /// Toward the eye.
+    pub wo: Direction,
+    /// True when wi or wo lies at the horizon (the result is zero by definition).
+    pub horizon: bool,
+    /// I_d and I_s.
+    pub reflection: Reflection,
+    /// f_r in 1/sr.
+    pub brdf: [f64; 3],
+    /// Present for `--method raytrace`.
+    pub raytrace: Option<Raytrace>,
+}
+
+impl Report<'_> {
+    /// One JSON object: `I_d`, `I_s`, `I`, `brdf`, and for the ray tracer `std_err`, `samples`.
+    pub fn json(&self) -> String {
+        let mut v = json!({
+            "I_d": self.reflection.i_d,
+            "I_s": self.reflection.i_s,
+            "I": self.reflection.total(),
+            "brdf": self.brdf,
+        });
+        if let Some(rt) = &self.raytrace {
+            v["std_err"] = json!(rt.std_err);
+            v["samples"] = json!(rt.samples);
+        }
+        let mut s = v.to_string();
+        s.push('\n');
+        s
+    }
+
+    /// A short human-readable table.
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "fabric  {} ({})\nmethod  {}, {} facets",
+            self.fabric_name,
+            self.file.display(),
+            self.method.name(),
+            self.facet.name()
+        );
+        let _ = writeln!(
+            s,
+            "wi      theta {:6.2}  phi {:7.2}  (toward the light, degrees)",
+            self.wi.theta, self.wi.phi
+        );
+        let _ = writeln!(
+            s,
+            "wo      theta {:6.2}  phi {:7.2}  (toward the eye, degrees)",
+            self.wo.theta, self.wo.phi
+        );
+        if self.horizon {
+            let _ = writeln!(
+                s,
+                "note    a direction lies at the horizon: nothing is reflected"
+            );
+        }
+        let _ = writeln!(s, "{:8}{:>12} {:>12} {:>12}", "", "R", "G", "B");
+        let row = |s: &mut String, name: &str, v: [f64; 3], unit: &str| {
+            let _ = writeln!(
+                s,
+                "{name:8}{:>12.6} {:>12.6} {:>12.6}{unit}",
+                v[0], v[1], v[2]
+            );
+        };
+        row(&mut s, "I_d", self.reflection.i_d, "");
+        row(&mut s, "I_s", self.reflection.i_s, "");
+        row(&mut s, "I", self.reflection.total(), "");
+        row(&mut s, "brdf", self.brdf, "  1/sr");
+        if let Some(rt) = &self.raytrace {
+            row(
+                &mut s,
+                "std_err",
+                rt.std_err,
+                &format!("  (of I, {} samples)", rt.samples),
+            );
+        }
+        s
+    }
+}

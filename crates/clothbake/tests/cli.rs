@@ -1,0 +1,333 @@
+//! The command-line contract of `clothbake`, driving the built binary.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const TABLES: [&str; 6] = ["plain", "basket", "twill", "twill31", "satin5", "parallel"];
+
+fn table(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tables")
+        .join(format!("{name}.json"))
+}
+
+fn clothbake(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_clothbake"))
+        .args(args)
+        .output()
+        .expect("run the clothbake binary")
+}
+
+fn eval(weave: &Path, rest: &[&str]) -> Output {
+    let w = weave.to_str().unwrap();
+    let mut args = vec!["eval", "--weave", w];
+    args.extend_from_slice(rest);
+    clothbake(args.as_slice())
+}
+
+/// A fabric file in the target's temporary folder.
+fn temp_fabric(name: &str, text: &str) -> PathBuf {
+    let p = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-{name}.json"));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Asserts a failure: exit status 2, nothing on stdout, one line `clothbake: ...` on stderr
+/// containing every needle. Returns that line.
+fn fails(out: &Output, needles: &[&str]) -> String {
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert!(
+        out.stdout.is_empty(),
+        "stdout: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(
+        err.ends_with('\n') && err.lines().count() == 1,
+        "not one line: {err:?}"
+    );
+    assert!(err.starts_with("clothbake: "), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} does not contain {n:?}");
+    }
+    err
+}
+
+fn rgb(v: &Value, key: &str) -> [f64; 3] {
+    let a = v[key]
+        .as_array()
+        .unwrap_or_else(|| panic!("`{key}` is not an array: {v}"));
+    assert_eq!(a.len(), 3, "{key}: {v}");
+    std::array::from_fn(|k| {
+        let x = a[k]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{key}[{k}] not a number: {v}"));
+        assert!(x.is_finite() && x >= 0.0, "{key}[{k}] = {x}");
+        x
+    })
+}
+
+/// Runs an evaluation that must succeed and returns its one JSON object.
+fn eval_json(weave: &Path, rest: &[&str]) -> Value {
+    let mut args = rest.to_vec();
+    args.push("--json");
+    let out = eval(weave, &args);
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        out.status.success(),
+        "{:?} failed: {}",
+        args,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(stdout.trim().lines().count(), 1, "{stdout}");
+    serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("not JSON ({e}): {stdout}"))
+}
+
+fn keys(v: &Value) -> Vec<&str> {
+    let mut k: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+    k.sort_unstable();
+    k
+}
+
+#[test]
+fn json_output_has_the_documented_keys_and_is_consistent() {
+    for name in TABLES {
+        for facet in ["huo", "lewis"] {
+            let theta_i: f64 = 40.0;
+            let v = eval_json(
+                &table(name),
+                &["--wi", "40,90", "--wo", "30,250", "--facet", facet],
+            );
+            assert_eq!(keys(&v), ["I", "I_d", "I_s", "brdf"], "{v}");
+            let (d, s, i, f) = (
+                rgb(&v, "I_d"),
+                rgb(&v, "I_s"),
+                rgb(&v, "I"),
+                rgb(&v, "brdf"),
+            );
+            for k in 0..3 {
+                assert!(
+                    (i[k] - d[k] - s[k]).abs() <= 1e-12 * (1.0 + i[k]),
+                    "{name}: {v}"
+                );
+                let want = i[k] / (std::f64::consts::PI * theta_i.to_radians().cos());
+                assert!((f[k] - want).abs() <= 1e-9 * (1.0 + want), "{name}: {v}");
+            }
+        }
+    }
+}
+
+#[test]
+fn material_overrides_reach_the_model() {
+    let t = table("twill");
+    let dirs = ["--wi", "30,45", "--wo", "20,200"];
+    let v = eval_json(&t, &[&dirs[..], &["--albedo", "0"]].concat());
+    assert_eq!(rgb(&v, "I_d"), [0.0; 3], "{v}");
+    let v = eval_json(&t, &[&dirs[..], &["--specular", "0"]].concat());
+    assert_eq!(rgb(&v, "I_s"), [0.0; 3], "{v}");
+    let v = eval_json(
+        &t,
+        &[&dirs[..], &["--albedo", "0.5,0.2,0.1", "--exponent", "6"]].concat(),
+    );
+    let d = rgb(&v, "I_d");
+    assert!(d[0] > d[1] && d[1] > d[2], "{v}");
+}
+
+#[test]
+fn horizon_directions_give_zeros() {
+    for name in TABLES {
+        for (wi, wo) in [("45,0", "90,180"), ("90,0", "30,180"), ("90,10", "90,70")] {
+            let v = eval_json(&table(name), &["--wi", wi, "--wo", wo]);
+            for key in ["I_d", "I_s", "I", "brdf"] {
+                assert_eq!(rgb(&v, key), [0.0; 3], "{name} {wi} {wo}: {v}");
+            }
+        }
+    }
+    // The ray tracer's output shape, with its extra keys.
+    let v = eval_json(
+        &table("twill"),
+        &[
+            "--wi",
+            "45,0",
+            "--wo",
+            "90,0",
+            "--method",
+            "raytrace",
+            "--samples",
+            "1000",
+        ],
+    );
+    assert_eq!(
+        keys(&v),
+        ["I", "I_d", "I_s", "brdf", "samples", "std_err"],
+        "{v}"
+    );
+    assert_eq!(rgb(&v, "std_err"), [0.0; 3]);
+    assert_eq!(v["samples"], 1000);
+}
+
+#[test]
+fn raytrace_output() {
+    let args = [
+        "--wi", "40,90", "--wo", "30,250", "--method", "raytrace", "--seed", "7",
+    ];
+    let v = eval_json(
+        &table("twill"),
+        &[&args[..], &["--samples", "20000"]].concat(),
+    );
+    assert_eq!(
+        keys(&v),
+        ["I", "I_d", "I_s", "brdf", "samples", "std_err"],
+        "{v}"
+    );
+    assert_eq!(v["samples"], 20000);
+    let (i, e) = (rgb(&v, "I"), rgb(&v, "std_err"));
+    assert!(i[0] > 0.0 && e[0] > 0.0 && e[0] < 0.1 * i[0], "{v}");
+    // Same seed, same answer.
+    let again = eval_json(
+        &table("twill"),
+        &[&args[..], &["--samples", "20000"]].concat(),
+    );
+    assert_eq!(v, again);
+    // Too few samples to estimate the error: JSON has no infinity, so it is null.
+    let v = eval_json(&table("twill"), &[&args[..], &["--samples", "1"]].concat());
+    assert_eq!(v["std_err"], serde_json::json!([null, null, null]), "{v}");
+}
+
+#[test]
+fn table_output_is_readable() {
+    let out = eval(&table("plain"), &["--wi", "45,90", "--wo", "30,270"]);
+    assert!(out.status.success());
+    let s = String::from_utf8(out.stdout).unwrap();
+    for w in [
+        "plain", "analytic", "huo", "I_d", "I_s", "brdf", "1/sr", "45.00", "270.00",
+    ] {
+        assert!(s.contains(w), "{w} missing in\n{s}");
+    }
+    assert!(serde_json::from_str::<Value>(&s).is_err());
+}
+
+#[test]
+fn invalid_fabric_names_the_field() {
+    let p = temp_fabric(
+        "radius",
+        r#"{"pattern": [[1,0],[0,1]], "warp": {"radius": -1, "spacing": 3.1},
+            "weft": {"radius": 1.5, "spacing": 3.1}}"#,
+    );
+    fails(
+        &eval(&p, &["--wi", "30,0", "--wo", "30,180"]),
+        &["warp.radius", "cli-radius.json", "> 0"],
+    );
+
+    let p = temp_fabric(
+        "albedo",
+        r#"{"pattern": [[1]], "warp": {"radius": 1, "spacing": 2},
+            "weft": {"radius": 1, "spacing": 2, "material": {"albedo": [0.1, 2, 0.1]}}}"#,
+    );
+    fails(
+        &eval(&p, &["--wi", "30,0", "--wo", "30,180"]),
+        &["weft.material.albedo[1]"],
+    );
+
+    let p = temp_fabric(
+        "unknown",
+        r#"{"pattern": [[1]], "warp": {"radius": 1, "spacing": 2, "colour": 1}, "weft": {"radius": 1, "spacing": 2}}"#,
+    );
+    fails(
+        &eval(&p, &["--wi", "30,0", "--wo", "30,180"]),
+        &["warp.colour", "docs/fabric-format.md"],
+    );
+
+    let p = temp_fabric("syntax", "{\"pattern\": [[1]],\n");
+    fails(
+        &eval(&p, &["--wi", "30,0", "--wo", "30,180"]),
+        &["cli-syntax.json", "JSON"],
+    );
+}
+
+#[test]
+fn missing_file() {
+    let p = Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-such-fabric.json");
+    fails(
+        &eval(&p, &["--wi", "30,0", "--wo", "30,180"]),
+        &["no-such-fabric.json", "check the path"],
+    );
+}
+
+#[test]
+fn bad_angles() {
+    let t = table("twill");
+    for (wi, needle) in [
+        ("45", "THETA,PHI"),
+        ("45;90", "THETA,PHI"),
+        ("a,90", "theta `a` is not a number"),
+        ("45,b", "phi `b` is not a number"),
+        ("1,2,3", "THETA,PHI"),
+        ("95,0", "outside [0, 90]"),
+        ("-10,0", "outside [0, 90]"),
+        ("nan,0", "not a finite number"),
+    ] {
+        fails(
+            &eval(&t, &["--wi", wi, "--wo", "30,180"]),
+            &["--wi", needle],
+        );
+        fails(
+            &eval(&t, &["--wi", "30,180", "--wo", wi]),
+            &["--wo", needle],
+        );
+    }
+}
+
+#[test]
+fn bad_options() {
+    let t = table("twill");
+    let d = ["--wi", "30,0", "--wo", "30,180"];
+    let with = |extra: &[&str]| eval(&t, &[&d[..], extra].concat());
+    fails(&with(&["--albedo", "1.5"]), &["--albedo", "[0, 1]"]);
+    fails(&with(&["--albedo", "0.1,0.2"]), &["--albedo", "R,G,B"]);
+    fails(&with(&["--specular", "-0.1"]), &["--specular", "[0, 1]"]);
+    fails(
+        &with(&["--exponent", "-2"]),
+        &["--exponent", "non-negative"],
+    );
+    fails(&with(&["--facet", "phong"]), &["--facet", "huo", "lewis"]);
+    fails(
+        &with(&["--method", "exact"]),
+        &["--method", "analytic", "raytrace"],
+    );
+    fails(
+        &with(&["--samples", "10"]),
+        &["--samples", "--method raytrace"],
+    );
+    fails(
+        &with(&["--method", "raytrace", "--samples", "0"]),
+        &["--samples", "at least 1"],
+    );
+    fails(&with(&["--weav", "x"]), &["--weav", "--weave", "--help"]);
+    fails(
+        &eval(&t, &["--wo", "30,180"]),
+        &["--wi", "clothbake eval --help"],
+    );
+    fails(
+        &clothbake(&["frobnicate"]),
+        &["frobnicate", "clothbake --help"],
+    );
+}
+
+#[test]
+fn default_mode_is_not_yet_available() {
+    let w = table("twill");
+    let out = clothbake(&["--weave", w.to_str().unwrap()]);
+    fails(&out, &["not yet available", "clothbake eval"]);
+    fails(&clothbake(&[]), &["no command", "clothbake eval"]);
+}
+
+#[test]
+fn help_and_version_succeed() {
+    for args in [&["--help"][..], &["eval", "--help"], &["--version"]] {
+        let out = clothbake(args);
+        assert!(out.status.success(), "{args:?}");
+        assert!(!out.stdout.is_empty());
+    }
+}
