@@ -6,7 +6,7 @@
 //! there and a handler in `main`.
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use clothbake_core::{FacetModel, UnitVec3};
+use clothbake_core::{Caps, FacetModel, UnitVec3, Variant};
 use std::path::PathBuf;
 
 /// Default number of samples (rays) of `--method raytrace`.
@@ -80,6 +80,16 @@ pub struct EvalArgs {
     #[arg(long, value_enum, default_value_t = FacetArg::Huo)]
     pub facet: FacetArg,
 
+    /// Analytic variant: eq. 3.6 on the rectangle top as printed (thesis) or averaged over the
+    /// arc's true heights (refined, the default; see docs/model.md).
+    #[arg(long, value_enum, default_value_t = VariantArg::Refined)]
+    pub variant: VariantArg,
+
+    /// Ray tracer: whether rays ending on a segment's flat end cap are averaged (shaded) or, like
+    /// floor hits, left out (excluded, the default: the analytic model has no caps).
+    #[arg(long, value_enum, default_value_t = CapsArg::Excluded)]
+    pub caps: CapsArg,
+
     /// Material overrides, applied to both yarn groups.
     #[command(flatten)]
     pub material: MaterialArgs,
@@ -140,6 +150,42 @@ impl From<FacetArg> for FacetModel {
         match f {
             FacetArg::Huo => FacetModel::Huo,
             FacetArg::Lewis => FacetModel::Lewis,
+        }
+    }
+}
+
+/// `--variant` values (mirrors `clothbake_core::Variant`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VariantArg {
+    /// Eq. 3.6 as printed, on the equal-area rectangle's top.
+    Thesis,
+    /// Eq. 3.6 averaged over the arc (default).
+    Refined,
+}
+
+impl From<VariantArg> for Variant {
+    fn from(v: VariantArg) -> Variant {
+        match v {
+            VariantArg::Thesis => Variant::Thesis,
+            VariantArg::Refined => Variant::Refined,
+        }
+    }
+}
+
+/// `--caps` values (mirrors `clothbake_core::Caps`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CapsArg {
+    /// Caps occlude but are not averaged (default).
+    Excluded,
+    /// Caps are shaded and averaged like the cylinder sides.
+    Shaded,
+}
+
+impl From<CapsArg> for Caps {
+    fn from(c: CapsArg) -> Caps {
+        match c {
+            CapsArg::Excluded => Caps::Excluded,
+            CapsArg::Shaded => Caps::Shaded,
         }
     }
 }

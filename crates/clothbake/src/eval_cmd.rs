@@ -3,7 +3,7 @@
 use crate::cli::{EvalArgs, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
 use crate::report::{self, Report};
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, Reflection, UnitVec3};
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, Reflection};
 
 /// Runs `clothbake eval` and returns the text to print on stdout.
 pub fn run(args: &EvalArgs) -> Result<String, CliError> {
@@ -24,7 +24,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
             let r = if horizon {
                 Reflection::default()
             } else {
-                AnalyticModel::new(&fabric, facet).eval(wi, wo)
+                AnalyticModel::with_variant(&fabric, facet, args.variant.into()).eval(wi, wo)
             };
             (r, None)
         }
@@ -34,7 +34,9 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
             let (r, std_err) = if horizon {
                 (Reflection::default(), [0.0; 3])
             } else {
-                raytrace(&fabric, facet, wi, wo, samples, seed)
+                let tracer = RayTracer::new(&fabric, facet).with_caps(args.caps.into());
+                let est = tracer.render(wi, wo, samples, seed);
+                (est.reflection, est.std_err)
             };
             (r, Some(report::Raytrace { std_err, samples }))
         }
@@ -74,20 +76,6 @@ pub fn apply_material(mut fabric: Fabric, m: &MaterialArgs) -> Fabric {
         }
     }
     fabric
-}
-
-/// The ray-traced estimate and its standard error (of the total I, per channel; infinite when
-/// too few samples to estimate it).
-fn raytrace(
-    fabric: &Fabric,
-    facet: FacetModel,
-    wi: UnitVec3,
-    wo: UnitVec3,
-    samples: usize,
-    seed: u64,
-) -> (Reflection, [f64; 3]) {
-    let est = RayTracer::new(fabric, facet).render(wi, wo, samples, seed);
-    (est.reflection, est.std_err)
 }
 
 #[cfg(test)]
