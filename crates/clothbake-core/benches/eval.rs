@@ -1,7 +1,7 @@
 //! Criterion benchmarks of the direct model: the analytic path per (wi, wo) pair.
 //! The ray tracer's cost at 1% error is reported beside it by the `raytrace_1pct` group.
 
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3};
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, UnitVec3};
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::path::Path;
@@ -45,5 +45,23 @@ fn analytic(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, analytic);
+/// The ground truth's cost for a 1% standard error on the total intensity, same pairs.
+fn raytrace_1pct(c: &mut Criterion) {
+    let fabric = twill();
+    let rt = RayTracer::new(&fabric, FacetModel::Huo);
+    let dirs = directions(8);
+    let mut g = c.benchmark_group("raytrace_1pct");
+    g.sample_size(10);
+    g.bench_function("twill/huo/per_pair", |b| {
+        let mut k = 0;
+        b.iter(|| {
+            let (wi, wo) = dirs[k % dirs.len()];
+            k += 1;
+            black_box(rt.render_to_error(wi, wo, 0.01, 1 << 22, k as u64))
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, analytic, raytrace_1pct);
 criterion_main!(benches);

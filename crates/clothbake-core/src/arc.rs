@@ -118,10 +118,15 @@ pub fn huo_specular_integral(arc: Arc, h: Projected, e: Projected, n: f64) -> Op
 
 /// C_m(u) = integral of cos^m from 0 to u, by C_m = cos^{m-1} sin / m + (m - 1)/m C_{m-2}.
 fn cos_power_integral(m: u32, su: f64, cu: f64, u: f64) -> f64 {
-    let mut acc = if m.is_multiple_of(2) { u } else { su };
-    let mut k = if m.is_multiple_of(2) { 2 } else { 3 };
+    let even = m.is_multiple_of(2);
+    let mut acc = if even { u } else { su };
+    let mut k = if even { 2 } else { 3 };
+    // cos^{k-1}, advanced by cos^2 per step.
+    let mut cp = if even { cu } else { cu * cu };
+    let c2 = cu * cu;
     while k <= m {
-        acc = cu.powi(k as i32 - 1) * su / k as f64 + (k as f64 - 1.0) / k as f64 * acc;
+        acc = cp * su / k as f64 + (k as f64 - 1.0) / k as f64 * acc;
+        cp *= c2;
         k += 2;
     }
     acc

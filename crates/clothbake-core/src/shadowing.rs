@@ -183,20 +183,25 @@ pub fn mean_occluded_length(
     let a = (o.support(sp, cp) - h * cp) / sp;
     let b = r * cp / sp;
     // Break points: sin(theta) = a / b (l = 0) and (a - max_len) / b (l = max_len).
-    let mut cuts = vec![arc.lo, arc.hi];
+    let mut cuts = [0.0f64; 8];
+    cuts[0] = arc.lo;
+    let mut n = 1;
     if b > 0.0 {
         for x in [a / b, (a - max_len) / b] {
             if x.abs() < 1.0 {
                 let t = x.asin();
                 for c in [t, std::f64::consts::PI - t, t - 2.0 * std::f64::consts::PI] {
                     if c > arc.lo && c < arc.hi {
-                        cuts.push(c);
+                        cuts[n] = c;
+                        n += 1;
                     }
                 }
             }
         }
     }
-    cuts.sort_by(f64::total_cmp);
+    cuts[n] = arc.hi;
+    let cuts = &mut cuts[..=n];
+    cuts.sort_unstable_by(f64::total_cmp);
     // Primitives of w = e.c cos + e.z sin and of sin * w.
     let pw = |t: f64| e.c * t.sin() - e.z * t.cos();
     let psw = |t: f64| e.c * 0.5 * t.sin().powi(2) + e.z * (0.5 * t - 0.25 * (2.0 * t).sin());
