@@ -561,6 +561,58 @@ mod tests {
     }
 
     #[test]
+    fn lone_cylinder_matches_brute_force_arc_average() {
+        // One endless half cylinder, neighbours 1000 radii away: only self-shadowing and
+        // self-blocking act. Reference: a plain Riemann sum over the half circle with
+        // indicator functions, independent of the arc code.
+        let f = fabric(
+            r#"{"pattern": [[1]], "warp": {"radius": 1, "spacing": 1000},
+                "weft": {"radius": 0.5, "spacing": 1}}"#,
+        );
+        let m = AnalyticModel::new(&f, FacetModel::Huo);
+        for (ti, pi, to, po) in [
+            (30.0, 0.0, 50.0, 180.0),
+            (70.0, 180.0, 20.0, 180.0),
+            (45.0, 30.0, 60.0, 250.0),
+        ] {
+            let (wi, wo) = (
+                UnitVec3::from_degrees(ti, pi),
+                UnitVec3::from_degrees(to, po),
+            );
+            let (l, e) = (wi.get(), wo.get());
+            let (mut num_d, mut num_s, mut den) = (0.0, 0.0, 0.0);
+            let steps = 200_000;
+            for k in 0..steps {
+                let t = (k as f64 + 0.5) / steps as f64 * PI;
+                let n = Vec3::new(t.cos(), 0.0, t.sin());
+                let (nl, ne) = (n.dot(l), n.dot(e));
+                if ne <= 0.0 {
+                    continue;
+                }
+                den += ne;
+                if nl > 0.0 {
+                    let h = l + e;
+                    num_d += nl * ne;
+                    num_s += (n.dot(h) / h.length()).powi(10) * ne;
+                }
+            }
+            let r = m.eval(wi, wo);
+            assert!(
+                (r.i_d[0] - 0.4 * num_d / den).abs() < 1e-6,
+                "{:?} vs {}",
+                r.i_d,
+                0.4 * num_d / den
+            );
+            assert!(
+                (r.i_s[0] - 0.3 * num_s / den).abs() < 1e-6,
+                "{:?} vs {}",
+                r.i_s,
+                0.3 * num_s / den
+            );
+        }
+    }
+
+    #[test]
     fn quadrature_path_matches_closed_form() {
         let f = fabric(TWILL);
         let m = AnalyticModel::new(&f, FacetModel::Huo);

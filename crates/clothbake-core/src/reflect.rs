@@ -32,3 +32,23 @@ pub fn intensity_to_brdf(i: [f64; 3], wi: UnitVec3) -> [f64; 3] {
     let c = wi.cos_theta();
     std::array::from_fn(|k| i[k] / (PI * c))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flat_lambertian_facet_gives_rho_over_pi() {
+        // A flat facet reflects I = rho N.L for unit light (thesis units).
+        for theta in [0.0, 30.0, 75.0] {
+            let wi = UnitVec3::from_degrees(theta, 40.0);
+            let i = 0.4 * wi.cos_theta();
+            let f = intensity_to_brdf([i; 3], wi);
+            assert!((f[0] - 0.4 / PI).abs() < 1e-15);
+        }
+        assert_eq!(
+            intensity_to_brdf([1.0; 3], UnitVec3::from_degrees(90.0, 0.0)),
+            [0.0; 3]
+        );
+    }
+}
