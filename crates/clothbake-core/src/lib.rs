@@ -17,6 +17,7 @@ pub mod raytrace;
 pub mod reflect;
 pub mod rng;
 pub mod shadowing;
+pub mod symmetry;
 pub mod validate;
 pub mod vec3;
 pub mod weave;
