@@ -20,6 +20,10 @@ use crate::arc::{diffuse_integral, huo_specular_integral, projected_width, Arc, 
 use crate::fabric::{Fabric, Material};
 use crate::facet::{Facet, FacetModel};
 use crate::geometry::{equal_area_height, Geometry, Segment};
+use crate::interreflection::{
+    analytic as secondary_analytic, two_level_sampling, Kernel, Orders, Pair, Ranges, Sampling,
+    Secondary, Setting,
+};
 use crate::quad::integrate;
 use crate::reflect::Reflection;
 use crate::shadowing::{
@@ -57,8 +61,58 @@ struct Unit {
     /// Occluders on the +c side and on the -c side of the cross-section.
     side_plus: ActiveTable,
     side_minus: ActiveTable,
+    /// The parallel neighbours on the +c and -c sides, for secondary reflection (sec. 5.4).
+    neighbours: [Option<Neighbour>; 2],
     /// Number of identical pieces in the period (D_i).
     count: u32,
+}
+
+/// A parallel cylinder next to a piece, in the piece's crossing row (thesis sec. 5.4: cloth's
+/// inter-reflection approximated by that between adjacent parallel segments).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Neighbour {
+    /// Axis-to-axis distance.
+    d: f64,
+    radius: f64,
+    height: f64,
+    /// Its extent along the axis relative to the piece's middle (infinite when endless).
+    axial: (f64, f64),
+    material: Material,
+}
+
+/// How the secondary reflection (thesis ch. 5) is computed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SecondaryMethod {
+    /// The analytical solution (sec. 5.3).
+    Analytic {
+        /// Integration ranges.
+        ranges: Ranges,
+        /// Quadrature orders.
+        orders: Orders,
+    },
+    /// The two-level ray-traced sampling (sec. 5.2).
+    Sampling(Sampling),
+}
+
+/// Options of the secondary reflection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SecondaryOptions {
+    /// Solution method.
+    pub method: SecondaryMethod,
+    /// Second-bounce weight.
+    pub kernel: Kernel,
+}
+
+impl Default for SecondaryOptions {
+    fn default() -> Self {
+        SecondaryOptions {
+            method: SecondaryMethod::Analytic {
+                ranges: Ranges::Full,
+                orders: Orders::default(),
+            },
+            kernel: Kernel::default(),
+        }
+    }
 }
 
 /// Inventory of the preprocessing, for reports and tests.
@@ -284,9 +338,34 @@ impl AnalyticModel {
                     Some((_, y1)) if m == f - 1 => y1,
                     _ => mid(k + 1),
                 };
+                let neighbour = |dir: isize| {
+                    let (o, id) = occluder_at(&geo, seg, 1, k, dir);
+                    if id.is_some() {
+                        return None;
+                    }
+                    let t = seg.thread as isize + dir;
+                    let nt = rem(t, geo.fabric.weave.n(g));
+                    let yarn = geo.fabric.group(g).threads[nt];
+                    let mid = 0.5 * (lo + hi);
+                    let axial = match geo.segment_at(g, nt, k).map(|i| &geo.segments[i]) {
+                        Some(s) if s.extent.is_some() => {
+                            let (e0, e1) = extent_near(s, geo.position(c, k), geo.period_along(g));
+                            (e0 - mid, e1 - mid)
+                        }
+                        _ => (f64::NEG_INFINITY, f64::INFINITY),
+                    };
+                    Some(Neighbour {
+                        d: o.u,
+                        radius: yarn.radius,
+                        height: yarn.height,
+                        axial,
+                        material: data.material,
+                    })
+                };
                 let unit = Unit {
                     seg: data.clone(),
                     range: (lo, hi),
+                    neighbours: [neighbour(1), neighbour(-1)],
                     side_plus: ActiveTable::scan(&side_profile(&geo, seg, k, 1)),
                     side_minus: ActiveTable::scan(&side_profile(&geo, seg, k, -1)),
                     count: 1,
@@ -361,13 +440,29 @@ impl AnalyticModel {
     /// visible-area-weighted average over the units of the period. Zero when either direction
     /// is at or below the horizon.
     pub fn eval(&self, wi: UnitVec3, wo: UnitVec3) -> Reflection {
+        self.eval_with(wi, wo, None)
+    }
+
+    /// As [`AnalyticModel::eval`], adding the secondary reflection I_2 between adjacent
+    /// parallel cylinders (thesis ch. 5; for cloth, sec. 5.4's approximation) when `secondary`
+    /// is given. I_2 is averaged over the same visible projected area as I_1.
+    pub fn eval_with(
+        &self,
+        wi: UnitVec3,
+        wo: UnitVec3,
+        secondary: Option<&SecondaryOptions>,
+    ) -> Reflection {
         if !(wi.above_horizon() && wo.above_horizon()) {
-            return Reflection::default();
+            return Reflection {
+                secondary: secondary.map(|_| Secondary::default()),
+                ..Reflection::default()
+            };
         }
         let (l, e) = (wi.get(), wo.get());
         let mut s_total = 0.0;
         let mut i_d = [0.0; 3];
         let mut i_s = 0.0;
+        let mut i_2 = Secondary::default();
         for u in &self.units {
             let seg = &u.seg;
             let (c, a) = frame(seg.group);
@@ -391,6 +486,9 @@ impl AnalyticModel {
             }
             let d = u.count as f64;
             s_total += d * l_v * projected_width(seg.radius, vis, ep);
+            if let Some(opts) = secondary {
+                i_2.add_scaled(&self.secondary(u, opts, l, e, vis, lit), d * l_v);
+            }
             let l_vi = overlap(u.range, meet(vis_len, lit_len));
             if vi.is_empty() || l_vi <= 0.0 {
                 continue;
@@ -403,12 +501,72 @@ impl AnalyticModel {
             i_s += w * ks;
         }
         if s_total <= 0.0 {
-            return Reflection::default();
+            return Reflection {
+                secondary: secondary.map(|_| Secondary::default()),
+                ..Reflection::default()
+            };
         }
         Reflection {
             i_d: i_d.map(|x| x / s_total),
             i_s: [i_s / s_total; 3],
+            secondary: secondary.map(|_| i_2.scaled(1.0 / s_total)),
         }
+    }
+
+    /// Secondary reflection reaching the eye from the visible arc of unit `u`, per unit length,
+    /// from both parallel neighbours. The neighbour's lit arc is taken equal to the unit's own
+    /// (exact for the parallel-cylinder surface, where all cylinders are alike).
+    fn secondary(
+        &self,
+        u: &Unit,
+        opts: &SecondaryOptions,
+        l: Vec3,
+        e: Vec3,
+        vis: Arc,
+        lit: Arc,
+    ) -> Secondary {
+        let (c, a) = frame(u.seg.group);
+        let mut out = Secondary::default();
+        for (side, nb) in [(1.0, &u.neighbours[0]), (-1.0, &u.neighbours[1])] {
+            let Some(nb) = nb else { continue };
+            let local = |v: Vec3| Vec3::new(side * v.dot(c), v.dot(a), v.z);
+            let mirror = |arc: Arc| {
+                if side > 0.0 {
+                    arc
+                } else {
+                    Arc {
+                        lo: PI - arc.hi,
+                        hi: PI - arc.lo,
+                    }
+                }
+            };
+            let pair = Pair {
+                r1: u.seg.radius,
+                h1: u.seg.height,
+                r2: nb.radius,
+                h2: nb.height,
+                d: nb.d,
+                m1: u.seg.material,
+                m2: nb.material,
+                facet: self.facet,
+                kernel: opts.kernel,
+            };
+            let setting = Setting {
+                l: local(l),
+                e: local(e),
+                vis1: mirror(vis),
+                lit2: mirror(lit),
+                axial: nb.axial,
+            };
+            let part = match opts.method {
+                SecondaryMethod::Analytic { ranges, orders } => {
+                    secondary_analytic(&pair, &setting, ranges, orders)
+                }
+                SecondaryMethod::Sampling(p) => two_level_sampling(&pair, &setting, p),
+            };
+            out.add_scaled(&part, 1.0);
+        }
+        out
     }
 
     /// Arc of the unit's cross-section that faces `v` and is not hidden by a neighbour on the

@@ -1,21 +1,30 @@
 //! The output quantity: reflected intensity split into diffuse and specular parts, and the BRDF.
 
+use crate::interreflection::Secondary;
 use crate::vec3::UnitVec3;
 use std::f64::consts::PI;
 
 /// Reflected intensity for unit incident intensity (thesis units: pi times radiance), RGB.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Reflection {
-    /// Diffuse part I_d.
+    /// Diffuse part I_d of the direct reflection.
     pub i_d: [f64; 3],
-    /// Specular part I_s.
+    /// Specular part I_s of the direct reflection.
     pub i_s: [f64; 3],
+    /// Secondary reflection I_2 and its components (thesis ch. 5), when computed.
+    pub secondary: Option<Secondary>,
 }
 
 impl Reflection {
-    /// Total intensity I = I_d + I_s.
-    pub fn total(&self) -> [f64; 3] {
+    /// Direct reflection I_1 = I_d + I_s.
+    pub fn direct(&self) -> [f64; 3] {
         std::array::from_fn(|k| self.i_d[k] + self.i_s[k])
+    }
+
+    /// Total intensity I = I_1 (+ I_2 when the secondary reflection was computed).
+    pub fn total(&self) -> [f64; 3] {
+        let i2 = self.secondary.map_or([0.0; 3], |s| s.total());
+        std::array::from_fn(|k| self.i_d[k] + self.i_s[k] + i2[k])
     }
 
     /// The BRDF f_r = I / (pi cos theta_i) in 1/sr (zero for light at or below the horizon).

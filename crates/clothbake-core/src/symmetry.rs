@@ -56,7 +56,10 @@ fn reversed(threads: &[Yarn]) -> Vec<Yarn> {
             let old = n - 1 - k;
             // The gap after new thread k is the gap before old thread `old`.
             let spacing = threads[(old + n - 1) % n].spacing;
-            Yarn { spacing, ..threads[old] }
+            Yarn {
+                spacing,
+                ..threads[old]
+            }
         })
         .collect()
 }
@@ -86,7 +89,10 @@ pub fn symmetries(fabric: &Fabric) -> Vec<Symmetry> {
             Symmetry::MirrorY => (false, true),
             Symmetry::Rotate180 => (true, true),
         };
-        let (wx, wy) = (if fx { &rwarp } else { warp }, if fy { &rweft } else { weft });
+        let (wx, wy) = (
+            if fx { &rwarp } else { warp },
+            if fy { &rweft } else { weft },
+        );
         // Transformed weave: cell (i, j) of the image comes from (i', j') of the original.
         let image = |i: usize, j: usize| {
             let i0 = if fx { nx - 1 - i } else { i };
@@ -94,7 +100,8 @@ pub fn symmetries(fabric: &Fabric) -> Vec<Symmetry> {
             w.warp_over(i0, j0)
         };
         let found = (0..nx).any(|sx| {
-            shifted_equal(wx, warp, sx) && (0..ny).any(|sy| shifted_equal(wy, weft, sy) && weave_equal(w, image, sx, sy))
+            shifted_equal(wx, warp, sx)
+                && (0..ny).any(|sy| shifted_equal(wy, weft, sy) && weave_equal(w, image, sx, sy))
         });
         if found {
             out.push(sym);
@@ -123,7 +130,10 @@ mod tests {
     #[test]
     fn known_weaves() {
         let plain = fabric("[[1,0],[0,1]]", "1.5");
-        assert_eq!(symmetries(&plain), vec![Symmetry::MirrorX, Symmetry::MirrorY, Symmetry::Rotate180]);
+        assert_eq!(
+            symmetries(&plain),
+            vec![Symmetry::MirrorX, Symmetry::MirrorY, Symmetry::Rotate180]
+        );
         let twill = fabric("[[1,1,0],[0,1,1],[1,0,1]]", "1.5");
         assert_eq!(symmetries(&twill), vec![Symmetry::Rotate180]);
         // Unequal warp radii in a non-palindromic order break the mirror in x.
@@ -135,7 +145,10 @@ mod tests {
     fn detected_symmetries_hold_for_the_model() {
         let twill = fabric("[[1,1,0],[0,1,1],[1,0,1]]", "1.5");
         let m = AnalyticModel::new(&twill, FacetModel::Huo);
-        let (wi, wo) = (UnitVec3::from_degrees(50.0, 20.0), UnitVec3::from_degrees(35.0, 200.0));
+        let (wi, wo) = (
+            UnitVec3::from_degrees(50.0, 20.0),
+            UnitVec3::from_degrees(35.0, 200.0),
+        );
         let a = m.eval(wi, wo).total();
         let s = Symmetry::Rotate180;
         let b = m.eval(s.apply(wi), s.apply(wo)).total();
@@ -161,7 +174,8 @@ mod tests {
                 let phi = (k as f64 + 0.5) * 360.0 / n as f64;
                 let v = s.apply(UnitVec3::from_degrees(45.0, phi));
                 let (_, p) = v.to_spherical();
-                let want = (p.to_degrees().rem_euclid(360.0) / (360.0 / n as f64) - 0.5).round() as usize;
+                let want =
+                    (p.to_degrees().rem_euclid(360.0) / (360.0 / n as f64) - 0.5).round() as usize;
                 assert_eq!(s.phi_index(k, n), Some(want % n), "{s:?} {k}");
             }
         }

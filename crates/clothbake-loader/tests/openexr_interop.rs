@@ -1,0 +1,158 @@
+//! Cross-check with the reference OpenEXR library: tables written by the `exr` crate are read
+//! by the PyPI `OpenEXR` package (tests/python/read_exr.py) and must give the same dimensions,
+//! metadata and every value.
+//!
+//! Skipped with a message when `python3` cannot import OpenEXR and numpy, except when the `CI`
+//! environment variable is set: CI installs them (see .ci/run), so there it must run.
+
+use std::path::Path;
+use std::process::Command;
+
+use clothbake_loader::{write_exr, Grid, Metadata, Precision, Table};
+use serde_json::Value;
+
+const SCRIPT: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../tests/python/read_exr.py"
+);
+
+/// True when running under CI (`CI` set to anything but empty, "0" or "false").
+fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
+}
+
+/// Whether the Python side can run; panics under CI when it cannot.
+fn openexr_available() -> bool {
+    let probe = Command::new("python3")
+        .args(["-c", "import OpenEXR, numpy"])
+        .output();
+    let why = match probe {
+        Ok(out) if out.status.success() => return true,
+        Ok(out) => {
+            let err = String::from_utf8_lossy(&out.stderr);
+            err.trim()
+                .lines()
+                .last()
+                .unwrap_or("import failed")
+                .to_string()
+        }
+        Err(e) => format!("cannot run python3: {e}"),
+    };
+    if in_ci() {
+        panic!(
+            "CI is set, but the OpenEXR Python package is not usable ({why}); \
+             install it with: python3 -m pip install OpenEXR numpy"
+        );
+    }
+    eprintln!("skipped: OpenEXR Python package not installed (pip install OpenEXR numpy): {why}");
+    false
+}
+
+fn sample_table() -> Table {
+    let grid = Grid {
+        n_theta_i: 2,
+        n_phi_i: 3,
+        n_theta_o: 4,
+        n_phi_o: 5,
+    };
+    let meta = Metadata::new(
+        "clothbake 0.1.0",
+        grid,
+        "{\"name\": \"Köper – twill 🧵\", \"spacing\": [1.5, 2.0]}",
+        "{\"samples\": 64, \"precision\": \"f16\"}",
+        "mirror x, mirror y",
+    );
+    let values = (0..grid.len() * 3)
+        .map(|i| {
+            let x = i as f32;
+            (x * 0.731).cos().abs() * 10f32.powi((i % 9) as i32 - 5) + x * 0.01
+        })
+        .collect();
+    Table::new(meta, values).unwrap()
+}
+
+fn run_script(path: &Path) -> Value {
+    let out = Command::new("python3")
+        .arg(SCRIPT)
+        .arg(path)
+        .output()
+        .expect("run python3");
+    assert!(
+        out.status.success(),
+        "{SCRIPT} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("the script prints JSON")
+}
+
+fn check(precision: Precision) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("interop.exr");
+    let table = sample_table();
+    write_exr(&path, &table, precision, false).unwrap();
+    let got = run_script(&path);
+    let grid = table.meta.grid;
+
+    let (width, height) = (15u64, 8u64);
+    assert_eq!(got["width"], width, "{got}");
+    assert_eq!(got["height"], height);
+    let kind = match precision {
+        Precision::F16 => "half",
+        Precision::F32 => "float",
+    };
+    for c in ["R", "G", "B"] {
+        assert_eq!(got["channels"][c], kind, "channel {c}");
+    }
+    assert_eq!(got["channels"].as_object().unwrap().len(), 3);
+
+    let attrs = &got["attributes"];
+    assert_eq!(attrs["clothbake.format_version"], "1");
+    assert_eq!(
+        attrs["clothbake.grid"],
+        "theta_i 2 phi_i 3 theta_o 4 phi_o 5, cell-centred, degrees"
+    );
+    assert_eq!(attrs["clothbake.units"], "1/sr");
+    assert_eq!(attrs["clothbake.tool"], "clothbake 0.1.0");
+    assert_eq!(got["crc32"]["ok"], true, "{}", got["crc32"]);
+    let meta: Metadata = serde_json::from_value(got["metadata"].clone()).unwrap();
+    assert_eq!(meta, table.meta);
+    let meta: Metadata =
+        serde_json::from_str(attrs["clothbake.metadata"].as_str().unwrap()).unwrap();
+    assert_eq!(meta, table.meta);
+
+    for (k, c) in ["R", "G", "B"].into_iter().enumerate() {
+        let plane = got["values"][c].as_array().unwrap();
+        assert_eq!(plane.len() as u64, width * height);
+        for ti in 0..grid.n_theta_i {
+            for pi in 0..grid.n_phi_i {
+                for to in 0..grid.n_theta_o {
+                    for po in 0..grid.n_phi_o {
+                        let (x, y) = (pi * grid.n_phi_o + po, ti * grid.n_theta_o + to);
+                        let v = table.values[3 * grid.index(ti, pi, to, po) + k];
+                        let expected = match precision {
+                            Precision::F16 => half::f16::from_f32(v).to_f32(),
+                            Precision::F32 => v,
+                        };
+                        let seen = plane[(y as u64 * width + x as u64) as usize]
+                            .as_f64()
+                            .unwrap();
+                        assert_eq!(
+                            seen,
+                            f64::from(expected),
+                            "{c} at pixel ({x}, {y}) = cell ({ti}, {pi}, {to}, {po})"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn openexr_reads_what_we_write() {
+    if !openexr_available() {
+        return;
+    }
+    check(Precision::F32);
+    check(Precision::F16);
+}
