@@ -327,7 +327,6 @@ pub enum Ranges {
     },
 }
 
-
 /// Quadrature orders of the analytic solution (Gauss-Legendre nodes per panel).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Orders {

@@ -274,9 +274,9 @@ impl Iterator for CellWalk {
 
 /// One copy of a segment of the period, placed so that it overlaps the period's base cell.
 #[derive(Clone, Copy, Debug)]
-struct Prim {
+pub(crate) struct Prim {
     /// Index of the segment in `geometry.segments`.
-    seg: u32,
+    pub(crate) seg: u32,
     /// Warp (axis along y; u = x, v = y) or weft (axis along x; u = y, v = x).
     warp: bool,
     /// The solid, in coordinates of the base period.
@@ -301,7 +301,7 @@ impl Prim {
     }
 
     /// Outward normal at the point `p` (base-period coordinates) of the given surface.
-    fn normal(&self, p: Vec3, surface: Surface) -> Vec3 {
+    pub(crate) fn normal(&self, p: Vec3, surface: Surface) -> Vec3 {
         let s = &self.shape;
         let (u, z) = if self.warp { (p.x, p.z) } else { (p.y, p.z) };
         let (nu, nv, nz) = match surface {
@@ -321,7 +321,7 @@ impl Prim {
     }
 
     /// Identity of the physical segment copy when this prim is seen from period copy (tx, ty).
-    fn copy_key(&self, tx: i64, ty: i64) -> (u32, i64, i64) {
+    pub(crate) fn copy_key(&self, tx: i64, ty: i64) -> (u32, i64, i64) {
         let endless = self.shape.extent.is_none();
         let kx = if endless && !self.warp {
             0
@@ -339,12 +339,12 @@ impl Prim {
 
 /// Uniform grid over one period: for each cell the prims whose bounding boxes overlap it.
 #[derive(Clone, Debug)]
-struct Grid {
+pub(crate) struct Grid {
     nx: i64,
     ny: i64,
     cx: f64,
     cy: f64,
-    prims: Vec<Prim>,
+    pub(crate) prims: Vec<Prim>,
     /// `items[starts[c]..starts[c + 1]]` are the prims of cell c = ly * nx + lx.
     starts: Vec<u32>,
     items: Vec<u32>,
@@ -457,11 +457,11 @@ impl Grid {
 
 /// A ray's first yarn hit.
 #[derive(Clone, Copy, Debug)]
-struct Hit {
-    t: f64,
-    prim: u32,
-    tile: (i64, i64),
-    surface: Surface,
+pub(crate) struct Hit {
+    pub(crate) t: f64,
+    pub(crate) prim: u32,
+    pub(crate) tile: (i64, i64),
+    pub(crate) surface: Surface,
 }
 
 /// Per-batch sums of the estimator.
@@ -533,14 +533,14 @@ pub enum Caps {
 /// The exact orthographic ray caster of a fabric's micro-geometry (the ground truth).
 #[derive(Clone, Debug)]
 pub struct RayTracer {
-    geometry: Geometry,
-    facet: FacetModel,
-    caps: Caps,
-    grid: Grid,
+    pub(crate) geometry: Geometry,
+    pub(crate) facet: FacetModel,
+    pub(crate) caps: Caps,
+    pub(crate) grid: Grid,
     /// Facet material of each segment.
-    materials: Vec<Material>,
+    pub(crate) materials: Vec<Material>,
     /// Height of the plane the primary rays start from, just above the highest yarn.
-    z_top: f64,
+    pub(crate) z_top: f64,
 }
 
 impl RayTracer {
@@ -593,7 +593,7 @@ impl RayTracer {
 
     /// The first yarn surface the ray `o + t d` enters with `t_min < t < t_max`; with `any`, the
     /// first one found (for shadow rays). `skip` excludes one physical segment copy.
-    fn trace(
+    pub(crate) fn trace(
         &self,
         o: Vec3,
         d: Vec3,
@@ -677,14 +677,15 @@ impl RayTracer {
     }
 
     /// Traces `m` stratified primary rays over one period into `sums`.
-    fn batch(&self, wi: UnitVec3, wo: UnitVec3, m: usize, rng: &mut Rng, sums: &mut BatchSums) {
+    /// The origins of `m` stratified primary rays over one period (jittered with `rng`).
+    pub(crate) fn origins(&self, m: usize, rng: &mut Rng) -> impl Iterator<Item = Vec3> + '_ {
         let (px, py) = self.geometry.period;
         // sx * sy <= m strata of aspect ~ Px:Py, the remaining (< sx) samples uniform.
         let sx = ((m as f64 * px / py).sqrt().round() as usize).clamp(1, m.max(1));
         let sy = (m / sx).max(1);
         let strata = (sx * sy).min(m);
-        for k in 0..m {
-            let (u, v) = (rng.next_f64(), rng.next_f64());
+        let jitter: Vec<(f64, f64)> = (0..m).map(|_| (rng.next_f64(), rng.next_f64())).collect();
+        jitter.into_iter().enumerate().map(move |(k, (u, v))| {
             let (x, y) = if k < strata {
                 (
                     ((k % sx) as f64 + u) / sx as f64,
@@ -693,7 +694,12 @@ impl RayTracer {
             } else {
                 (u, v)
             };
-            let o = Vec3::new(x * px, y * py, self.z_top);
+            Vec3::new(x * px, y * py, self.z_top)
+        })
+    }
+
+    fn batch(&self, wi: UnitVec3, wo: UnitVec3, m: usize, rng: &mut Rng, sums: &mut BatchSums) {
+        for o in self.origins(m, rng) {
             sums.rays += 1;
             if let Some((diffuse, specular, seg)) = self.shade(o, wi, wo) {
                 sums.hits += 1;
