@@ -1,7 +1,7 @@
 //! Criterion benchmarks of the direct model: the analytic path per (wi, wo) pair.
 //! The ray tracer's cost at 1% error is reported beside it by the `raytrace_1pct` group.
 
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, UnitVec3};
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, SecondaryOptions, UnitVec3};
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::path::Path;
@@ -63,5 +63,26 @@ fn raytrace_1pct(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, analytic, raytrace_1pct);
+/// Secondary reflection on the parallel-cylinder surface (thesis ch. 5) and on the twill.
+fn secondary(c: &mut Criterion) {
+    let dirs = directions(64);
+    let pf = Fabric::from_path(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/parallel.json"),
+    )
+    .unwrap();
+    for (name, fabric) in [("parallel", pf), ("twill", twill())] {
+        let m = AnalyticModel::new(&fabric, FacetModel::Huo);
+        let opts = SecondaryOptions::default();
+        c.bench_function(&format!("secondary_analytic/{name}/per_pair"), |b| {
+            let mut k = 0;
+            b.iter(|| {
+                let (wi, wo) = dirs[k % dirs.len()];
+                k += 1;
+                black_box(m.eval_with(black_box(wi), black_box(wo), Some(&opts)))
+            })
+        });
+    }
+}
+
+criterion_group!(benches, analytic, raytrace_1pct, secondary);
 criterion_main!(benches);

@@ -65,7 +65,7 @@ impl Facet for FacetModel {
                 };
                 FacetIntensity {
                     diffuse: nl,
-                    specular: m.specular * nh.powf(m.exponent),
+                    specular: m.specular * pow(nh, m.exponent),
                 }
             }
             FacetModel::Lewis => {
@@ -73,10 +73,30 @@ impl Facet for FacetModel {
                 let re = (2.0 * nl * ne - l.dot(e)).max(0.0);
                 FacetIntensity {
                     diffuse: nl,
-                    specular: m.specular * 0.5 * (m.exponent + 2.0) * re.powf(m.exponent) * nl,
+                    specular: m.specular * 0.5 * (m.exponent + 2.0) * pow(re, m.exponent) * nl,
                 }
             }
         }
+    }
+}
+
+/// x^n for x >= 0: repeated multiplication for small integer n (several times faster than
+/// `powf`, which the hot loops of the secondary reflection feel), `powf` otherwise.
+#[inline]
+fn pow(x: f64, n: f64) -> f64 {
+    if n.fract() == 0.0 && (0.0..=64.0).contains(&n) {
+        // Square-and-multiply, inlined (the `powi` intrinsic is an out-of-line call).
+        let (mut acc, mut base, mut k) = (1.0, x, n as u32);
+        while k > 0 {
+            if k & 1 == 1 {
+                acc *= base;
+            }
+            base *= base;
+            k >>= 1;
+        }
+        acc
+    } else {
+        x.powf(n)
     }
 }
 
