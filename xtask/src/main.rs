@@ -1,25 +1,42 @@
 //! Project chores: `cargo xtask <task>`.
 //!
+//! * `ch5`: the comparisons of thesis sec. 5.4 (sphere, disk, convergence) into
+//!   `docs/interreflection-results.md`.
 //! * `validate`: holds the analytic model against the ray-traced ground truth for every shipped
 //!   fabric and writes the error tables to `docs/validation.md`.
+//! * `golden`: bakes every shipped fabric (`tables/*.json`) at the golden grid into
+//!   `tables/golden/<name>.bin` (see `clothbake::golden` and `docs/baking.md`).
+//! * `bench-bake [--bounces-2]`: times the default-grid bake of the twill with 1 and 2 threads
+//!   (and, with `--bounces-2`, once with the secondary reflection).
+
+use clothbake::bake::{bake, BakeOptions};
+use clothbake::golden::{bake_golden, golden_path, shipped_fabrics};
+mod ch5;
 
 use clothbake_core::validate::{compare_with, direction_set, Report};
 use clothbake_core::{Caps, Fabric, FacetModel, Variant};
+use clothbake_loader::write_binary;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
 
 const TABLES: [&str; 6] = ["plain", "basket", "twill", "twill31", "satin5", "parallel"];
 
 fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    p.canonicalize().unwrap_or(p)
 }
 
 fn main() {
     let task = std::env::args().nth(1).unwrap_or_default();
     match task.as_str() {
         "validate" => validate(),
+        "ch5" => ch5::run(&root()),
+        "golden" => golden(),
+        "bench-bake" => bench_bake(std::env::args().skip(2).any(|a| a == "--bounces-2")),
         _ => {
-            eprintln!("usage: cargo xtask validate");
+            eprintln!("usage: cargo xtask validate | golden | ch5 | bench-bake [--bounces-2]");
             std::process::exit(2);
         }
     }
@@ -142,4 +159,88 @@ fn validate() {
     let path = root().join("docs/validation.md");
     std::fs::write(&path, out).unwrap();
     eprintln!("wrote {}", path.display());
+}
+
+/// Bakes the golden table of every shipped fabric.
+fn golden() {
+    let tables = root().join("tables");
+    let dir = tables.join("golden");
+    std::fs::create_dir_all(&dir).unwrap();
+    let fabrics = shipped_fabrics(&tables).unwrap();
+    // Remove golden tables whose fabric is gone.
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        let stem = p.file_stem().unwrap().to_string_lossy().into_owned();
+        if p.extension().is_some_and(|x| x == "bin") && !fabrics.iter().any(|(n, _)| *n == stem) {
+            std::fs::remove_file(&p).unwrap();
+            eprintln!("removed {} (no tables/{stem}.json)", p.display());
+        }
+    }
+    for (name, path) in fabrics {
+        let f = Fabric::from_path(&path).unwrap_or_else(|e| panic!("{e}"));
+        let t = bake_golden(&f).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let out = golden_path(&tables, &name);
+        write_binary(&out, &t, true).unwrap_or_else(|e| panic!("{e}"));
+        eprintln!("wrote {} ({})", out.display(), t.meta.grid);
+    }
+}
+
+/// Bakes `opts` for `f` on a pool of `threads`, returning (seconds, cells evaluated).
+fn timed_bake(f: &Fabric, opts: &BakeOptions, threads: usize) -> (f64, usize) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let start = Instant::now();
+    let b = pool
+        .install(|| bake(f, opts, &|_| {}, &AtomicBool::new(false)))
+        .unwrap();
+    (start.elapsed().as_secs_f64(), b.evaluated)
+}
+
+/// Times the default-grid bake of the twill, direct reflection, with 1 and 2 threads (best of
+/// 3 each), and optionally once with two bounces on all cores.
+fn bench_bake(bounces_2: bool) {
+    let f = Fabric::from_path(&root().join("tables/twill.json")).unwrap();
+    let opts = BakeOptions::default();
+    let cells = opts.grid.len() as f64;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    println!(
+        "twill, grid {} ({} cells), analytic, refined, huo, bounces 1; {cores} cores",
+        opts.grid, cells
+    );
+    println!("| threads | wall time (best of 3) | table entries/s | evaluations/s |");
+    println!("|---|---|---|---|");
+    let mut best = Vec::new();
+    for threads in [1, 2] {
+        let runs: Vec<(f64, usize)> = (0..3).map(|_| timed_bake(&f, &opts, threads)).collect();
+        let (t, evaluated) = runs
+            .iter()
+            .copied()
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .unwrap();
+        println!(
+            "| {threads} | {t:.2} s | {:.0} | {:.0} |",
+            cells / t,
+            evaluated as f64 / t
+        );
+        best.push(t);
+    }
+    println!(
+        "parallel efficiency t1 / (2 t2) = {:.2}",
+        best[0] / (2.0 * best[1])
+    );
+    if bounces_2 {
+        let opts = BakeOptions {
+            bounces: 2,
+            ..BakeOptions::default()
+        };
+        let (t, evaluated) = timed_bake(&f, &opts, cores);
+        println!(
+            "bounces 2 (secondary analytic, radiometric kernel), {cores} threads: {t:.1} s, {:.0} \
+             table entries/s, {:.0} evaluations/s",
+            cells / t,
+            evaluated as f64 / t
+        );
+    }
 }

@@ -1,7 +1,8 @@
 //! The bake: evaluate f_r on every cell of a (theta_i, phi_i, theta_o, phi_o) grid.
 //!
 //! * Cell-centred grid (see `clothbake_loader::Grid`); values are f_r = I / (pi cos theta_i) in
-//!   1/sr, RGB, from the analytic model (or the ray tracer, for small ground-truth tables).
+//!   1/sr, RGB, from the analytic model (or the ray tracer, for small ground-truth tables). With
+//!   `bounces: 2` the analytic model adds the secondary reflection I_2 (thesis ch. 5).
 //! * Symmetry: where the fabric's micro-geometry is invariant under mirror x, mirror y or a
 //!   rotation by 180 degrees ([`clothbake_core::symmetry`]), so is its BRDF, exactly. Only one
 //!   cell of each orbit of the symmetry group on the (phi_i, phi_o) indices is evaluated; the
@@ -9,11 +10,15 @@
 //! * Deterministic: every cell is a pure function of the inputs; the parallel sweep collects in
 //!   cell order, so the table is bit-identical for any number of threads.
 
+use clothbake_core::interreflection::{Orders, Ranges, Sampling};
 use clothbake_core::symmetry::{symmetries, Symmetry};
-use clothbake_core::{AnalyticModel, Caps, Fabric, FacetModel, RayTracer, UnitVec3, Variant};
+use clothbake_core::{
+    AnalyticModel, Caps, Fabric, FacetModel, Kernel, RayTracer, SecondaryMethod, SecondaryOptions,
+    UnitVec3, Variant,
+};
 use clothbake_loader::{Grid, Metadata, Table, FORMAT_VERSION};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// The default grid: 32 x 64 x 32 x 64 cells (2.8 degrees in theta, 5.6 in phi).
@@ -25,38 +30,38 @@ pub const DEFAULT_GRID: Grid = Grid {
 };
 
 /// How each cell is evaluated.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-#[serde(rename_all = "lowercase", tag = "method")]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Method {
-    /// The analytic model (thesis ch. 3-4).
+    /// The analytic model (thesis ch. 3-4, and ch. 5 with two bounces).
     Analytic {
         /// Analytic variant.
         variant: Variant,
     },
-    /// The ray-traced ground truth, `samples` rays per cell, seeded per cell.
+    /// The ray-traced ground truth of the direct reflection, `samples` rays per cell, seeded
+    /// per cell.
     Raytrace {
         /// Primary rays per cell.
         samples: usize,
         /// Base seed; cell c uses seed + c.
         seed: u64,
         /// End-cap convention.
-        #[serde(skip)]
         caps: Caps,
     },
 }
 
 /// Everything that determines a table besides the fabric.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BakeOptions {
     /// The grid.
     pub grid: Grid,
     /// Facet model.
     pub facet: FacetModel,
     /// Evaluation method.
-    #[serde(flatten)]
     pub method: Method,
-    /// Bounces (1: direct reflection only).
+    /// Bounces: 1 (direct reflection I_1 only) or 2 (I_1 + the secondary reflection I_2).
     pub bounces: u32,
+    /// How I_2 is computed; used only when `bounces == 2`.
+    pub secondary: SecondaryOptions,
 }
 
 impl Default for BakeOptions {
@@ -68,7 +73,86 @@ impl Default for BakeOptions {
                 variant: Variant::default(),
             },
             bounces: 1,
+            secondary: SecondaryOptions::default(),
         }
+    }
+}
+
+fn caps_name(c: Caps) -> &'static str {
+    match c {
+        Caps::Excluded => "excluded",
+        Caps::Shaded => "shaded",
+    }
+}
+
+fn kernel_name(k: Kernel) -> &'static str {
+    match k {
+        Kernel::Thesis => "thesis",
+        Kernel::Radiometric => "radiometric",
+    }
+}
+
+fn orders_json(o: Orders) -> Value {
+    json!({"theta": o.theta, "beta": o.beta, "axial": o.axial})
+}
+
+fn sampling_json(s: Sampling) -> Value {
+    json!({
+        "first_level": s.first_level,
+        "d_alpha": s.d_alpha,
+        "d_l": s.d_l,
+        "l0": s.l0,
+        "exact_solid_angle": s.exact_solid_angle,
+    })
+}
+
+fn ranges_json(r: Ranges) -> Value {
+    serde_json::to_value(r).unwrap_or_else(|_| Value::String(format!("{r:?}")))
+}
+
+impl BakeOptions {
+    /// The options as stored in the table's `options_json`: the grid, the facet model, the
+    /// method with its parameters, the bounces and, with two bounces, the secondary reflection's
+    /// method, parameters and kernel. Not the thread count: it does not change the table.
+    pub fn to_json(&self) -> Value {
+        let mut v = json!({
+            "grid": self.grid,
+            "facet": self.facet,
+        });
+        match self.method {
+            Method::Analytic { variant } => {
+                v["method"] = json!("analytic");
+                v["variant"] = json!(variant);
+            }
+            Method::Raytrace {
+                samples,
+                seed,
+                caps,
+            } => {
+                v["method"] = json!("raytrace");
+                v["samples"] = json!(samples);
+                v["seed"] = json!(seed);
+                v["caps"] = json!(caps_name(caps));
+            }
+        }
+        v["bounces"] = json!(self.bounces);
+        if self.bounces == 2 {
+            let s = self.secondary;
+            let mut sec = match s.method {
+                SecondaryMethod::Analytic { ranges, orders } => json!({
+                    "method": "analytic",
+                    "ranges": ranges_json(ranges),
+                    "orders": orders_json(orders),
+                }),
+                SecondaryMethod::Sampling(p) => json!({
+                    "method": "sampling",
+                    "sampling": sampling_json(p),
+                }),
+            };
+            sec["kernel"] = json!(kernel_name(s.kernel));
+            v["secondary"] = sec;
+        }
+        v
     }
 }
 
@@ -81,6 +165,17 @@ pub enum BakeError {
     Invalid(String),
 }
 
+impl std::fmt::Display for BakeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BakeError::Cancelled => f.write_str("the bake was cancelled"),
+            BakeError::Invalid(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for BakeError {}
+
 /// A finished bake.
 #[derive(Debug, Clone)]
 pub struct Baked {
@@ -92,15 +187,17 @@ pub struct Baked {
     pub evaluated: usize,
 }
 
-/// The grid's direction for polar index `k` of `n` and azimuth index `m` of `nm`.
-fn direction(k: u32, n: u32, m: u32, nm: u32) -> UnitVec3 {
+/// The grid's direction for polar index `k` of `n` and azimuth index `m` of `nm`: the centre
+/// of the cell.
+pub fn direction(k: u32, n: u32, m: u32, nm: u32) -> UnitVec3 {
     let theta = (k as f64 + 0.5) * 90.0 / n as f64;
     let phi = (m as f64 + 0.5) * 360.0 / nm as f64;
     UnitVec3::from_degrees(theta, phi)
 }
 
-/// The symmetries usable on this grid: those of the fabric that map azimuth cells onto cells.
-fn usable(fabric: &Fabric, g: &Grid) -> Vec<Symmetry> {
+/// The symmetries usable on this grid: those of the fabric that map azimuth cells onto cells
+/// (mirror x and the rotation need an even number of azimuth cells).
+pub fn usable_symmetries(fabric: &Fabric, g: &Grid) -> Vec<Symmetry> {
     symmetries(fabric)
         .into_iter()
         .filter(|s| {
@@ -111,47 +208,82 @@ fn usable(fabric: &Fabric, g: &Grid) -> Vec<Symmetry> {
 }
 
 /// The representative of (pi, po)'s orbit: the smallest pair reachable by the group the
-/// symmetries generate (here at most {1, Mx, My, R}, closed under composition).
-fn representative(pi: usize, po: usize, syms: &[Symmetry], g: &Grid) -> (usize, usize) {
+/// symmetries generate. The group is generated by commuting involutions (mirror x, mirror y,
+/// their product the rotation), so an orbit has at most 4 elements.
+pub fn representative(pi: usize, po: usize, syms: &[Symmetry], g: &Grid) -> (usize, usize) {
     let (ni, no) = (g.n_phi_i as usize, g.n_phi_o as usize);
-    let mut orbit = vec![(pi, po)];
+    let mut orbit = [(pi, po); 8];
+    let mut len = 1;
     let mut k = 0;
-    while k < orbit.len() {
+    while k < len {
         let (a, b) = orbit[k];
         for s in syms {
-            let img = (s.phi_index(a, ni).unwrap(), s.phi_index(b, no).unwrap());
-            if !orbit.contains(&img) {
-                orbit.push(img);
+            let img = (
+                s.phi_index(a, ni).expect("usable symmetry"),
+                s.phi_index(b, no).expect("usable symmetry"),
+            );
+            if !orbit[..len].contains(&img) {
+                assert!(len < orbit.len(), "orbit larger than the symmetry group");
+                orbit[len] = img;
+                len += 1;
             }
         }
         k += 1;
     }
-    orbit.into_iter().min().unwrap()
+    orbit[..len].iter().copied().min().expect("non-empty orbit")
 }
 
-/// Bakes `fabric` on `opts.grid`. `progress` receives the number of cells finished so far (it
-/// is called from worker threads); raising `cancel` stops the sweep with [`BakeError::Cancelled`].
-/// Runs on the current rayon pool (use `ThreadPool::install` to choose the thread count).
+/// Checks that `opts` can be baked: a valid grid, one or two bounces, two bounces only with the
+/// analytic model.
+pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
+    opts.grid
+        .validate()
+        .map_err(|e| BakeError::Invalid(e.to_string()))?;
+    match (opts.bounces, opts.method) {
+        (1, _) | (2, Method::Analytic { .. }) => Ok(()),
+        (2, Method::Raytrace { .. }) => Err(BakeError::Invalid(
+            "the ray tracer bakes the direct reflection only; use --bounces 1 with --method \
+             raytrace, or --method analytic with --bounces 2"
+                .into(),
+        )),
+        (n, _) => Err(BakeError::Invalid(format!(
+            "{n} bounces is not supported; use --bounces 1 (direct reflection) or 2 (direct and \
+             secondary reflection, thesis ch. 5)"
+        ))),
+    }
+}
+
+/// The number of cells [`bake`] evaluates on grid `g` (the others are copies): the total its
+/// `progress` counts up to.
+pub fn evaluations(fabric: &Fabric, g: &Grid) -> usize {
+    let syms = usable_symmetries(fabric, g);
+    let pairs = (0..g.n_phi_i as usize)
+        .flat_map(|pi| (0..g.n_phi_o as usize).map(move |po| (pi, po)))
+        .filter(|&(pi, po)| representative(pi, po, &syms, g) == (pi, po))
+        .count();
+    pairs * (g.n_theta_i as usize) * (g.n_theta_o as usize)
+}
+
+/// Bakes `fabric` on `opts.grid`. `progress` receives the number of cells evaluated so far, up
+/// to [`evaluations`] (copied cells do not count: they cost nothing; it is called from worker
+/// threads, once per (theta_i, phi_i) row, not necessarily in increasing order); raising
+/// `cancel` stops the sweep with [`BakeError::Cancelled`]. Runs on the current rayon pool (use
+/// `ThreadPool::install` to choose the thread count); the result does not depend on the number
+/// of threads.
 pub fn bake(
     fabric: &Fabric,
     opts: &BakeOptions,
     progress: &(dyn Fn(u64) + Sync),
     cancel: &AtomicBool,
 ) -> Result<Baked, BakeError> {
+    check_options(opts)?;
     let g = opts.grid;
-    g.validate()
-        .map_err(|e| BakeError::Invalid(e.to_string()))?;
-    if opts.bounces != 1 {
-        return Err(BakeError::Invalid(format!(
-            "--bounces {} is not available yet (inter-reflection, thesis ch. 5, is not built); use --bounces 1",
-            opts.bounces
-        )));
-    }
-    let syms = usable(fabric, &g);
+    let syms = usable_symmetries(fabric, &g);
+    let secondary = (opts.bounces == 2).then_some(opts.secondary);
     let eval: Box<dyn Fn(usize, UnitVec3, UnitVec3) -> [f64; 3] + Sync> = match opts.method {
         Method::Analytic { variant } => {
             let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
-            Box::new(move |_, wi, wo| m.eval(wi, wo).brdf(wi))
+            Box::new(move |_, wi, wo| m.eval_with(wi, wo, secondary.as_ref()).brdf(wi))
         }
         Method::Raytrace {
             samples,
@@ -167,23 +299,26 @@ pub fn bake(
         }
     };
     let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
-    let row_len = (nto * npo) as usize;
+    // Which (pi, po) pairs are evaluated, and where the others copy from.
+    let reps: Vec<(usize, usize)> = (0..npi as usize)
+        .flat_map(|pi| (0..npo as usize).map(move |po| (pi, po)))
+        .map(|(pi, po)| representative(pi, po, &syms, &g))
+        .collect();
+    let rep = |pi: usize, po: usize| reps[pi * npo as usize + po];
     let done = AtomicU64::new(0);
     // One row per (theta_i, phi_i): its canonical cells' values, in cell order.
     let rows: Vec<Vec<[f32; 3]>> = (0..(nti * npi) as usize)
         .into_par_iter()
         .map(|row| {
-            if cancel.load(Ordering::Relaxed) {
-                return Vec::new();
-            }
             let (ti, pi) = ((row / npi as usize) as u32, (row % npi as usize) as u32);
             let wi = direction(ti, nti, pi, npi);
             let mut out = Vec::new();
             for to in 0..nto {
+                if cancel.load(Ordering::Relaxed) {
+                    return Vec::new();
+                }
                 for po in 0..npo {
-                    if representative(pi as usize, po as usize, &syms, &g)
-                        != (pi as usize, po as usize)
-                    {
+                    if rep(pi as usize, po as usize) != (pi as usize, po as usize) {
                         continue;
                     }
                     let c = g.index(ti, pi, to, po);
@@ -191,7 +326,8 @@ pub fn bake(
                     out.push(v.map(|x| x as f32));
                 }
             }
-            progress(done.fetch_add(row_len as u64, Ordering::Relaxed) + row_len as u64);
+            let n = out.len() as u64;
+            progress(done.fetch_add(n, Ordering::Relaxed) + n);
             out
         })
         .collect();
@@ -202,29 +338,29 @@ pub fn bake(
     let mut values = vec![f32::NAN; g.len() * 3];
     let mut evaluated = 0;
     for (row, vals) in rows.iter().enumerate() {
-        let (ti, pi) = (row / npi as usize, row % npi as usize);
+        let (ti, pi) = ((row / npi as usize) as u32, (row % npi as usize) as u32);
         let mut it = vals.iter();
-        for to in 0..nto as usize {
-            for po in 0..npo as usize {
-                if representative(pi, po, &syms, &g) == (pi, po) {
+        for to in 0..nto {
+            for po in 0..npo {
+                if rep(pi as usize, po as usize) == (pi as usize, po as usize) {
                     let v = it.next().expect("one value per canonical cell");
-                    values[3 * g.index(ti as u32, pi as u32, to as u32, po as u32)..][..3]
-                        .copy_from_slice(v);
+                    values[3 * g.index(ti, pi, to, po)..][..3].copy_from_slice(v);
                     evaluated += 1;
                 }
             }
         }
     }
-    for ti in 0..nti as usize {
-        for pi in 0..npi as usize {
-            for to in 0..nto as usize {
-                for po in 0..npo as usize {
-                    let (ri, ro) = representative(pi, po, &syms, &g);
-                    if (ri, ro) != (pi, po) {
-                        let src = 3 * g.index(ti as u32, ri as u32, to as u32, ro as u32);
-                        let dst = 3 * g.index(ti as u32, pi as u32, to as u32, po as u32);
-                        values.copy_within(src..src + 3, dst);
-                    }
+    for ti in 0..nti {
+        for pi in 0..npi {
+            for po in 0..npo {
+                let (ri, ro) = rep(pi as usize, po as usize);
+                if (ri, ro) == (pi as usize, po as usize) {
+                    continue;
+                }
+                for to in 0..nto {
+                    let src = 3 * g.index(ti, ri as u32, to, ro as u32);
+                    let dst = 3 * g.index(ti, pi, to, po);
+                    values.copy_within(src..src + 3, dst);
                 }
             }
         }
@@ -242,7 +378,7 @@ pub fn bake(
         quantity: "f_r".into(),
         units: "1/sr".into(),
         fabric_json: fabric.to_json().to_string(),
-        options_json: serde_json::to_string(opts).expect("options serialise"),
+        options_json: opts.to_json().to_string(),
         symmetry,
     };
     let table = Table::new(meta, values).map_err(|e| BakeError::Invalid(e.to_string()))?;
@@ -251,4 +387,130 @@ pub fn bake(
         symmetries: syms,
         evaluated,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn twill() -> Fabric {
+        Fabric::from_path(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/twill.json"),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn options_json_names_everything_that_changes_the_table() {
+        let o = BakeOptions::default();
+        let v = o.to_json();
+        assert_eq!(v["method"], "analytic");
+        assert_eq!(v["variant"], "refined");
+        assert_eq!(v["facet"], "huo");
+        assert_eq!(v["bounces"], 1);
+        assert_eq!(v["grid"]["n_phi_o"], 64);
+        assert!(v.get("secondary").is_none());
+        let o = BakeOptions {
+            bounces: 2,
+            ..BakeOptions::default()
+        };
+        let v = o.to_json();
+        assert_eq!(v["secondary"]["method"], "analytic");
+        assert_eq!(v["secondary"]["kernel"], "radiometric");
+        assert_eq!(v["secondary"]["ranges"], "full");
+        assert_eq!(v["secondary"]["orders"]["theta"], 8);
+        let o = BakeOptions {
+            bounces: 2,
+            secondary: SecondaryOptions {
+                method: SecondaryMethod::Sampling(Sampling::default()),
+                kernel: Kernel::Thesis,
+            },
+            ..BakeOptions::default()
+        };
+        let v = o.to_json();
+        assert_eq!(v["secondary"]["method"], "sampling");
+        assert_eq!(v["secondary"]["kernel"], "thesis");
+        assert_eq!(v["secondary"]["sampling"]["first_level"], 32);
+        let o = BakeOptions {
+            method: Method::Raytrace {
+                samples: 10,
+                seed: 3,
+                caps: Caps::Shaded,
+            },
+            ..BakeOptions::default()
+        };
+        let v = o.to_json();
+        assert_eq!(
+            (&v["method"], &v["samples"], &v["seed"], &v["caps"]),
+            (&json!("raytrace"), &json!(10), &json!(3), &json!("shaded"))
+        );
+    }
+
+    #[test]
+    fn invalid_options_are_refused() {
+        let f = twill();
+        let none = AtomicBool::new(false);
+        for (o, needle) in [
+            (
+                BakeOptions {
+                    bounces: 3,
+                    ..BakeOptions::default()
+                },
+                "--bounces 1",
+            ),
+            (
+                BakeOptions {
+                    bounces: 2,
+                    method: Method::Raytrace {
+                        samples: 1,
+                        seed: 1,
+                        caps: Caps::Excluded,
+                    },
+                    ..BakeOptions::default()
+                },
+                "--method analytic",
+            ),
+            (
+                BakeOptions {
+                    grid: Grid {
+                        n_theta_i: 0,
+                        ..DEFAULT_GRID
+                    },
+                    ..BakeOptions::default()
+                },
+                "n_theta_i is 0",
+            ),
+        ] {
+            match bake(&f, &o, &|_| {}, &none) {
+                Err(BakeError::Invalid(m)) => assert!(m.contains(needle), "{m}"),
+                other => panic!("{other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn cancel_stops_the_bake() {
+        let cancel = AtomicBool::new(true);
+        let r = bake(&twill(), &BakeOptions::default(), &|_| {}, &cancel);
+        assert_eq!(r.unwrap_err(), BakeError::Cancelled);
+    }
+
+    #[test]
+    fn orbits() {
+        let g = Grid {
+            n_theta_i: 1,
+            n_phi_i: 8,
+            n_theta_o: 1,
+            n_phi_o: 8,
+        };
+        let all = [Symmetry::MirrorX, Symmetry::MirrorY, Symmetry::Rotate180];
+        // Each orbit of the full group has 4 elements (no cell centre is on a mirror line).
+        let canonical = (0..8)
+            .flat_map(|a| (0..8).map(move |b| (a, b)))
+            .filter(|&(a, b)| representative(a, b, &all, &g) == (a, b))
+            .count();
+        assert_eq!(canonical, 16);
+        assert_eq!(representative(5, 3, &[], &g), (5, 3));
+        assert_eq!(representative(5, 3, &[Symmetry::Rotate180], &g), (1, 7));
+    }
 }

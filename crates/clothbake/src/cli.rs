@@ -1,12 +1,13 @@
 //! The command line: clap definitions and the value parsers behind them.
 //!
-//! Layout: `clothbake [--weave FILE]` (default mode: bake a table; reserved, not yet available)
-//! and `clothbake eval --weave FILE --wi THETA,PHI --wo THETA,PHI [...]`. The default mode's
-//! options live in [`BakeArgs`], flattened into [`Cli`], so the bake issue only has to add fields
-//! there and a handler in `main`.
+//! Layout: `clothbake --weave FILE [options]` (default mode: bake a table, the same as
+//! `clothbake bake --weave FILE [options]`), `clothbake eval --weave FILE --wi THETA,PHI
+//! --wo THETA,PHI [...]`, `clothbake info TABLE` and `clothbake diff A B`. The bake options live
+//! in [`BakeOpts`], flattened into both [`Cli`] (default mode) and [`BakeCmd`] (the subcommand).
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use clothbake_core::{Caps, FacetModel, UnitVec3, Variant};
+use clothbake_core::{Caps, FacetModel, Kernel, UnitVec3, Variant};
+use clothbake_loader::Grid;
 use std::path::PathBuf;
 
 /// Default number of samples (rays) of `--method raytrace`.
@@ -20,33 +21,154 @@ pub const DEFAULT_SEED: u64 = 1;
     name = "clothbake",
     version,
     args_conflicts_with_subcommands = true,
-    after_help = "Angles are in degrees: theta from the macro normal +Z (0 to 90), phi from +X (the weft \
-                  direction) toward +Y (the warp direction). Fabric files: see docs/fabric-format.md \
-                  and tables/*.json."
+    after_help = "Without a subcommand, `clothbake --weave FILE [options]` bakes a table (the options of \
+                  `clothbake bake`). Angles are in degrees: theta from the macro normal +Z (0 to 90), phi \
+                  from +X (the weft direction) toward +Y (the warp direction). Fabric files: see \
+                  docs/fabric-format.md and tables/*.json; baking: docs/baking.md."
 )]
 pub struct Cli {
-    /// What to do; without a subcommand clothbake bakes a table (not yet available).
+    /// What to do; without a subcommand clothbake bakes the fabric given with --weave.
     #[command(subcommand)]
     pub command: Option<Command>,
 
-    /// Options of the default mode (baking a table).
-    #[command(flatten)]
-    pub bake: BakeArgs,
-}
-
-/// Options of the default mode, `clothbake --weave FILE` (baking; reserved for a later release).
-#[derive(Args, Debug, Default)]
-pub struct BakeArgs {
-    /// Fabric description to bake into a BRDF table (baking is not yet available; use `eval`).
+    /// Fabric description to bake into a BRDF table (JSON, see docs/fabric-format.md).
     #[arg(long, value_name = "FILE")]
     pub weave: Option<PathBuf>,
+
+    /// Options of the default mode (baking a table).
+    #[command(flatten)]
+    pub bake: BakeOpts,
 }
 
 /// The subcommands.
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// Bake a fabric's BRDF into a table (the default mode, spelled out).
+    Bake(BakeCmd),
     /// Evaluate the reflection of a fabric for one light and one eye direction.
     Eval(EvalArgs),
+    /// Describe a baked table: metadata, value range, directional albedo.
+    Info(InfoArgs),
+    /// Compare two baked tables of the same grid; exit 1 when they differ beyond the tolerance.
+    Diff(DiffArgs),
+}
+
+/// `clothbake bake`.
+#[derive(Args, Debug)]
+pub struct BakeCmd {
+    /// Fabric description to bake (JSON, see docs/fabric-format.md), e.g. tables/twill.json.
+    #[arg(long, value_name = "FILE")]
+    pub weave: PathBuf,
+
+    /// The bake options.
+    #[command(flatten)]
+    pub opts: BakeOpts,
+}
+
+/// Options of a bake (default mode and `clothbake bake`).
+#[derive(Args, Debug, Clone)]
+pub struct BakeOpts {
+    /// Output table [default: <fabric file stem>.exr (or .bin with --format bin) in the current
+    /// folder].
+    #[arg(short = 'o', long, value_name = "PATH")]
+    pub output: Option<PathBuf>,
+
+    /// Grid: cells of theta_i, phi_i, theta_o, phi_o (cell-centred; see docs/table-format.md).
+    #[arg(long, value_name = "NTI,NPI,NTO,NPO", value_parser = parse_res, default_value = "32,64,32,64")]
+    pub res: Option<Grid>,
+
+    /// Table format [default: from the output's extension, .exr or .bin; otherwise exr].
+    #[arg(long, value_enum)]
+    pub format: Option<FormatArg>,
+
+    /// Sample precision of an EXR table (f16: about 3 digits, at most 65504) [default: f16].
+    #[arg(long, value_enum)]
+    pub precision: Option<PrecisionArg>,
+
+    /// Worker threads [default: all cores]; the table does not depend on it.
+    #[arg(long, value_name = "N", value_parser = parse_threads)]
+    pub threads: Option<usize>,
+
+    /// Print nothing but errors (no progress bar, no summary line).
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+
+    /// Overwrite an existing output file.
+    #[arg(long)]
+    pub force: bool,
+
+    /// Facet reflection model: the thesis's Phong-like terms or Lewis's modified Phong.
+    #[arg(long, value_enum, default_value_t = FacetArg::Huo)]
+    pub facet: FacetArg,
+
+    /// Analytic variant: eq. 3.6 on the rectangle top as printed (thesis) or averaged over the
+    /// arc's true heights (see docs/model.md) [default: refined].
+    #[arg(long, value_enum)]
+    pub variant: Option<VariantArg>,
+
+    /// Analytic model (thesis ch. 3-5) or the ray-traced ground truth of the direct reflection
+    /// (slow: for small grids).
+    #[arg(long, value_enum, default_value_t = Method::Analytic)]
+    pub method: Method,
+
+    /// Rays per cell for --method raytrace [default: 100000].
+    #[arg(long, value_name = "N", value_parser = parse_samples)]
+    pub samples: Option<usize>,
+
+    /// Random seed for --method raytrace (cell c uses seed + c) [default: 1].
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
+
+    /// End caps for --method raytrace: excluded from the average (default) or shaded.
+    #[arg(long, value_enum)]
+    pub caps: Option<CapsArg>,
+
+    /// 1: direct reflection; 2: adds the secondary reflection between neighbouring parallel
+    /// threads (thesis ch. 5; analytic model only; much slower).
+    #[arg(long, value_name = "1|2", value_parser = parse_bounces, default_value = "1")]
+    pub bounces: u32,
+
+    /// With --bounces 2: the secondary reflection's analytic solution (sec. 5.3) or the
+    /// thesis's two-level ray-traced sampling (sec. 5.2) [default: analytic].
+    #[arg(long, value_enum)]
+    pub secondary: Option<SecondaryArg>,
+
+    /// With --bounces 2: weight of the second bounce, the rendering equation's (radiometric)
+    /// or the thesis's as printed (larger by pi N.w) [default: radiometric].
+    #[arg(long, value_enum)]
+    pub kernel: Option<KernelArg>,
+
+    /// Material overrides, applied to both yarn groups.
+    #[command(flatten)]
+    pub material: MaterialArgs,
+}
+
+/// `clothbake info`.
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// A baked table (.exr or .bin).
+    #[arg(value_name = "TABLE")]
+    pub table: PathBuf,
+}
+
+/// `clothbake diff`.
+#[derive(Args, Debug)]
+pub struct DiffArgs {
+    /// The reference table.
+    #[arg(value_name = "A")]
+    pub a: PathBuf,
+
+    /// The table compared with A (same grid).
+    #[arg(value_name = "B")]
+    pub b: PathBuf,
+
+    /// Relative tolerance: a value passes when |a - b| <= ABS + REL |a| [default: 1e-6].
+    #[arg(long, value_name = "REL", value_parser = parse_tolerance, allow_hyphen_values = true)]
+    pub tol: Option<f64>,
+
+    /// Absolute tolerance, 1/sr [default: 1e-7].
+    #[arg(long = "abs", value_name = "ABS", value_parser = parse_tolerance, allow_hyphen_values = true)]
+    pub abs_tol: Option<f64>,
 }
 
 /// `clothbake eval`.
@@ -90,13 +212,29 @@ pub struct EvalArgs {
     #[arg(long, value_enum, default_value_t = CapsArg::Excluded)]
     pub caps: CapsArg,
 
+    /// 1: direct reflection; 2: adds the secondary reflection I_2 (thesis ch. 5). With
+    /// --method raytrace and --bounces 2 the path tracer estimates I_2 (ground truth).
+    #[arg(long, value_name = "1|2", value_parser = parse_bounces, default_value = "1")]
+    pub bounces: u32,
+
+    /// With --bounces 2 and --method analytic: the analytical solution (sec. 5.3, default) or
+    /// the thesis's two-level ray-traced sampling (sec. 5.2).
+    #[arg(long, value_enum)]
+    pub secondary: Option<SecondaryArg>,
+
+    /// With --bounces 2: weight of the second bounce, radiometric (the rendering equation,
+    /// default) or thesis (as printed, larger by pi N.w).
+    #[arg(long, value_enum)]
+    pub kernel: Option<KernelArg>,
+
     /// Material overrides, applied to both yarn groups.
     #[command(flatten)]
     pub material: MaterialArgs,
 
     /// Print one JSON object instead of a table: keys I_d, I_s, I (reflected intensity for unit
-    /// incident intensity) and brdf (1/sr), each [r, g, b]; raytrace adds std_err ([r, g, b],
-    /// null when too few samples to estimate it) and samples.
+    /// incident intensity) and brdf (1/sr), each [r, g, b]; with --bounces 2 also I_ss, I_sd,
+    /// I_ds, I_dd and I_2 (I is then I_1 + I_2); raytrace adds std_err ([r, g, b], null when
+    /// too few samples to estimate it) and samples.
     #[arg(long)]
     pub json: bool,
 }
@@ -186,6 +324,61 @@ impl From<CapsArg> for Caps {
         match c {
             CapsArg::Excluded => Caps::Excluded,
             CapsArg::Shaded => Caps::Shaded,
+        }
+    }
+}
+
+/// `--format` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FormatArg {
+    /// OpenEXR image (docs/table-format.md).
+    Exr,
+    /// The checksummed binary file, f32 (docs/table-format.md).
+    Bin,
+}
+
+impl FormatArg {
+    /// The file extension (and command-line name).
+    pub fn ext(self) -> &'static str {
+        match self {
+            FormatArg::Exr => "exr",
+            FormatArg::Bin => "bin",
+        }
+    }
+}
+
+/// `--precision` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PrecisionArg {
+    /// 16-bit half floats.
+    F16,
+    /// 32-bit floats.
+    F32,
+}
+
+/// `--secondary` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SecondaryArg {
+    /// The analytical solution (thesis sec. 5.3).
+    Analytic,
+    /// The thesis's two-level ray-traced sampling (sec. 5.2).
+    Raytrace,
+}
+
+/// `--kernel` values (mirrors `clothbake_core::Kernel`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KernelArg {
+    /// As printed in the thesis: facet intensities times the projected solid angle.
+    Thesis,
+    /// The rendering equation: facet intensities times d omega / pi.
+    Radiometric,
+}
+
+impl From<KernelArg> for Kernel {
+    fn from(k: KernelArg) -> Kernel {
+        match k {
+            KernelArg::Thesis => Kernel::Thesis,
+            KernelArg::Radiometric => Kernel::Radiometric,
         }
     }
 }
@@ -303,6 +496,87 @@ pub fn parse_exponent(s: &str) -> Result<f64, String> {
     Ok(n)
 }
 
+/// Parses `--res NTI,NPI,NTO,NPO`: four whole numbers of cells, each at least 1, at most
+/// 2^31 cells in all.
+pub fn parse_res(s: &str) -> Result<Grid, String> {
+    const FIX: &str = "give four whole numbers of cells NTI,NPI,NTO,NPO (theta_i, phi_i, theta_o, \
+                       phi_o), e.g. 32,64,32,64";
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 4 {
+        return Err(format!(
+            "expected 4 comma-separated numbers, found {}; {FIX}",
+            parts.len()
+        ));
+    }
+    let mut n = [0u32; 4];
+    for (k, (p, name)) in parts.iter().zip(["NTI", "NPI", "NTO", "NPO"]).enumerate() {
+        n[k] = match p.parse::<u32>() {
+            Ok(0) => {
+                return Err(format!(
+                    "{name} is 0; every axis needs at least 1 cell; {FIX}"
+                ))
+            }
+            Ok(x) => x,
+            Err(_) => {
+                return Err(format!(
+                    "{name} `{p}` is not a whole number of cells; {FIX}"
+                ))
+            }
+        };
+    }
+    let g = Grid {
+        n_theta_i: n[0],
+        n_phi_i: n[1],
+        n_theta_o: n[2],
+        n_phi_o: n[3],
+    };
+    let cells: u64 = n.iter().map(|&x| u64::from(x)).product();
+    if cells > clothbake_loader::format::MAX_CELLS {
+        return Err(format!(
+            "{cells} cells is more than the limit of 2^31; use a coarser grid, e.g. 32,64,32,64"
+        ));
+    }
+    Ok(g)
+}
+
+/// Parses `--threads N`, N >= 1.
+pub fn parse_threads(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(0) => Err(
+            "the thread count must be at least 1; give e.g. --threads 2 (or leave it \
+                      out to use all cores)"
+                .into(),
+        ),
+        Ok(n) => Ok(n),
+        Err(_) => Err(format!(
+            "`{}` is not a whole number of threads; give e.g. --threads 2",
+            s.trim()
+        )),
+    }
+}
+
+/// Parses `--bounces 1|2`.
+pub fn parse_bounces(s: &str) -> Result<u32, String> {
+    match s.trim() {
+        "1" => Ok(1),
+        "2" => Ok(2),
+        t => Err(format!(
+            "`{t}` bounces is not supported; give 1 (direct reflection) or 2 (direct and \
+             secondary reflection, thesis ch. 5)"
+        )),
+    }
+}
+
+/// Parses a non-negative finite tolerance.
+pub fn parse_tolerance(s: &str) -> Result<f64, String> {
+    const FIX: &str = "give a non-negative number, e.g. 1e-6";
+    let x = number(s, "tolerance").map_err(|e| format!("{e}; {FIX}"))?;
+    if x < 0.0 {
+        return Err(format!("tolerance {x} is negative; {FIX}"));
+    }
+    Ok(x)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -357,5 +631,33 @@ mod tests {
         assert!(parse_exponent("inf").is_err());
         assert!(parse_samples("0").is_err());
         assert_eq!(parse_samples("10").unwrap(), 10);
+    }
+
+    #[test]
+    fn grids() {
+        assert_eq!(
+            parse_res("32,64,32,64").unwrap(),
+            clothbake::bake::DEFAULT_GRID
+        );
+        assert_eq!(parse_res(" 1, 2 ,3,4").unwrap().n_phi_o, 4);
+        for (bad, needle) in [
+            ("32,64,32", "found 3"),
+            ("32,64,32,64,1", "found 5"),
+            ("0,64,32,64", "NTI is 0"),
+            ("32,x,32,64", "NPI `x`"),
+            ("32,64,-1,64", "NTO `-1`"),
+            ("32,64,32,6.5", "NPO `6.5`"),
+            ("2048,2048,2048,2048", "2^31"),
+        ] {
+            let e = parse_res(bad).unwrap_err();
+            assert!(e.contains(needle) && !e.contains('\n'), "{bad}: {e}");
+        }
+        assert!(parse_threads("0").is_err());
+        assert_eq!(parse_threads("3").unwrap(), 3);
+        assert!(parse_bounces("3").unwrap_err().contains("give 1"));
+        assert_eq!(parse_bounces("2").unwrap(), 2);
+        assert!(parse_tolerance("-1").is_err());
+        assert!(parse_tolerance("inf").is_err());
+        assert_eq!(parse_tolerance("1e-3").unwrap(), 1e-3);
     }
 }

@@ -1,6 +1,7 @@
 //! The one error type of the binary: a single line naming the cause and the fix.
 //!
-//! `main` prints it as `clothbake: <message>` on stderr and exits with status 2.
+//! `main` prints it as `clothbake: <message>` on stderr and exits with its status: 2 for every
+//! failure, 130 for an interrupted bake.
 
 use std::fmt;
 
@@ -8,6 +9,7 @@ use std::fmt;
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CliError {
     message: String,
+    code: u8,
 }
 
 impl CliError {
@@ -20,7 +22,18 @@ impl CliError {
     pub fn line(message: impl Into<String>) -> Self {
         let message: String = message.into();
         let message = message.split_whitespace().collect::<Vec<_>>().join(" ");
-        CliError { message }
+        CliError { message, code: 2 }
+    }
+
+    /// The same message with another exit status.
+    pub fn with_code(mut self, code: u8) -> Self {
+        self.code = code;
+        self
+    }
+
+    /// The exit status (2 unless set otherwise).
+    pub fn code(&self) -> u8 {
+        self.code
     }
 }
 
@@ -35,6 +48,68 @@ impl std::error::Error for CliError {}
 impl From<clothbake_core::FabricError> for CliError {
     fn from(e: clothbake_core::FabricError) -> Self {
         CliError::line(e.to_string())
+    }
+}
+
+impl From<clothbake_loader::TableError> for CliError {
+    fn from(e: clothbake_loader::TableError) -> Self {
+        table_error(&e)
+    }
+}
+
+/// A table error as one line. The loader's messages name the file, the cause and the fix,
+/// except for operating-system errors, which get a fix chosen by their cause here.
+pub fn table_error(e: &clothbake_loader::TableError) -> CliError {
+    use clothbake_loader::TableError;
+    match e {
+        TableError::Io {
+            path,
+            action,
+            source,
+        } => {
+            let reading = action.contains("read") || action.starts_with("open the table");
+            CliError::new(
+                format!("{}: cannot {action}: {}", path.display(), os_cause(source)),
+                io_fix(source, reading),
+            )
+        }
+        other => CliError::line(other.to_string()),
+    }
+}
+
+/// The cause of an I/O error in words (the OS message without its error number).
+fn os_cause(e: &std::io::Error) -> String {
+    let s = e.to_string();
+    match s.find(" (os error") {
+        Some(i) => s[..i].to_string(),
+        None => s,
+    }
+}
+
+/// What to do about an I/O error while reading or writing a table.
+fn io_fix(e: &std::io::Error, reading: bool) -> String {
+    use std::io::ErrorKind;
+    // ENOSPC, EDQUOT (Linux 122, macOS 69), EROFS: the numbers of Linux and macOS.
+    let raw = e.raw_os_error();
+    if reading {
+        return match e.kind() {
+            ErrorKind::NotFound => "check the path".into(),
+            ErrorKind::PermissionDenied => "check the file's permissions".into(),
+            _ => "check the path and the file".into(),
+        };
+    }
+    let nothing = "nothing was written";
+    if raw == Some(28) || (cfg!(target_os = "linux") && raw == Some(122)) {
+        format!("the disk is full: free some space or write the table elsewhere with -o PATH ({nothing})")
+    } else if raw == Some(30) {
+        format!("the file system is read-only: write the table elsewhere with -o PATH ({nothing})")
+    } else if e.kind() == ErrorKind::PermissionDenied {
+        format!(
+            "you may not write there: write the table into a folder you own with -o PATH, or \
+             change the folder's permissions ({nothing})"
+        )
+    } else {
+        format!("check the output path and the disk ({nothing})")
     }
 }
 

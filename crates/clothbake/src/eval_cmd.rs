@@ -1,9 +1,12 @@
 //! `clothbake eval`: the reflection of a fabric for one light and one eye direction.
 
-use crate::cli::{EvalArgs, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
+use crate::cli::{EvalArgs, MaterialArgs, Method, SecondaryArg, DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
 use crate::report::{self, Report};
+use clothbake_core::interreflection::{Orders, Ranges, Sampling};
+use clothbake_core::pathtrace::PathOptions;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, Reflection};
+use clothbake_core::{Kernel, Secondary, SecondaryMethod, SecondaryOptions};
 
 /// Runs `clothbake eval` and returns the text to print on stdout.
 pub fn run(args: &EvalArgs) -> Result<String, CliError> {
@@ -13,6 +16,29 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
             "add --method raytrace or drop them",
         ));
     }
+    if args.bounces == 1 && (args.secondary.is_some() || args.kernel.is_some()) {
+        return Err(CliError::new(
+            "--secondary and --kernel apply only to the secondary reflection",
+            "add --bounces 2 or drop them",
+        ));
+    }
+    if args.method == Method::Raytrace && args.secondary.is_some() {
+        return Err(CliError::new(
+            "--secondary chooses the analytic model's solution; with --method raytrace the path tracer computes I_2",
+            "drop --secondary or use --method analytic",
+        ));
+    }
+    let kernel: Kernel = args.kernel.map_or(Kernel::default(), Kernel::from);
+    let secondary = (args.bounces == 2).then(|| SecondaryOptions {
+        method: match args.secondary {
+            Some(SecondaryArg::Raytrace) => SecondaryMethod::Sampling(Sampling::default()),
+            _ => SecondaryMethod::Analytic {
+                ranges: Ranges::Full,
+                orders: Orders::default(),
+            },
+        },
+        kernel,
+    });
     let fabric = Fabric::from_path(&args.weave)?;
     let fabric = apply_material(fabric, &args.material);
     let facet = FacetModel::from(args.facet);
@@ -22,19 +48,45 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     let (reflection, raytrace) = match args.method {
         Method::Analytic => {
             let r = if horizon {
-                Reflection::default()
+                Reflection {
+                    secondary: secondary.map(|_| Secondary::default()),
+                    ..Reflection::default()
+                }
             } else {
-                AnalyticModel::with_variant(&fabric, facet, args.variant.into()).eval(wi, wo)
+                AnalyticModel::with_variant(&fabric, facet, args.variant.into()).eval_with(
+                    wi,
+                    wo,
+                    secondary.as_ref(),
+                )
             };
             (r, None)
         }
         Method::Raytrace => {
             let samples = args.samples.unwrap_or(DEFAULT_SAMPLES);
             let seed = args.seed.unwrap_or(DEFAULT_SEED);
+            let tracer = RayTracer::new(&fabric, facet).with_caps(args.caps.into());
             let (r, std_err) = if horizon {
-                (Reflection::default(), [0.0; 3])
+                (
+                    Reflection {
+                        secondary: secondary.map(|_| Secondary::default()),
+                        ..Reflection::default()
+                    },
+                    [0.0; 3],
+                )
+            } else if args.bounces == 2 {
+                // The path tracer: orders 1 and 2, I_2 split into its four components.
+                let opts = PathOptions {
+                    max_bounces: 2,
+                    kernel,
+                    roulette_from: 9,
+                };
+                let p = tracer.render_paths(wi, wo, samples, seed, opts);
+                let direct = tracer.render(wi, wo, samples, seed);
+                let mut r = direct.reflection;
+                r.secondary = Some(p.secondary);
+                let err = std::array::from_fn(|c| direct.std_err[c].hypot(p.std_err[1][c]));
+                (r, err)
             } else {
-                let tracer = RayTracer::new(&fabric, facet).with_caps(args.caps.into());
                 let est = tracer.render(wi, wo, samples, seed);
                 (est.reflection, est.std_err)
             };

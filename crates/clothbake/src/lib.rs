@@ -1,7 +1,13 @@
 //! clothbake: bake the BRDF of woven cloth into tables renderers load.
 //!
 //! The library half of the `clothbake` binary: [`bake::bake`] sweeps the (theta_i, phi_i,
-//! theta_o, phi_o) grid of a fabric in parallel and returns the table; the file formats live in
-//! `clothbake-loader`.
+//! theta_o, phi_o) grid of a fabric in parallel and returns the table; [`compare`] holds two
+//! tables against each other (`clothbake diff`, the golden tables of [`golden`]); [`albedo`]
+//! integrates a table's directional albedo (`clothbake info`); [`output`] writes tables with
+//! reproducible bytes. The file formats live in `clothbake-loader`.
 
+pub mod albedo;
 pub mod bake;
+pub mod compare;
+pub mod golden;
+pub mod output;

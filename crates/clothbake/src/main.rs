@@ -1,15 +1,19 @@
 //! `clothbake`: the command-line front end of clothbake-core.
 //!
-//! Every failure is one line `clothbake: <cause>; <fix>` on stderr with exit status 2.
+//! Every failure is one line `clothbake: <cause>; <fix>` on stderr with exit status 2 (130 for
+//! an interrupted bake). `clothbake diff` exits 1 when the tables differ beyond its tolerance.
 
+mod bake_cmd;
 mod cli;
+mod diff_cmd;
 mod error;
 mod eval_cmd;
+mod info_cmd;
 mod report;
 
 use clap::error::ErrorKind;
 use clap::Parser;
-use cli::{BakeArgs, Cli, Command};
+use cli::{Cli, Command};
 use error::CliError;
 use std::io::Write;
 use std::process::ExitCode;
@@ -33,39 +37,45 @@ fn main() -> ExitCode {
         eprintln!("clothbake: {e}");
     }));
     match std::panic::catch_unwind(run) {
-        Ok(Ok(())) => ExitCode::SUCCESS,
+        Ok(Ok(code)) => ExitCode::from(code),
         Ok(Err(e)) => {
             eprintln!("clothbake: {e}");
-            ExitCode::from(2)
+            ExitCode::from(e.code())
         }
         Err(_) => ExitCode::from(2), // the panic hook has printed the message
     }
 }
 
-fn run() -> Result<(), CliError> {
+/// Runs the command line; returns the exit status of a successful run (0, or 1 for `diff`
+/// beyond its tolerance).
+fn run() -> Result<u8, CliError> {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) => {
             let _ = e.print();
-            return Ok(());
+            return Ok(0);
         }
         Err(e) => {
-            let sub = if std::env::args()
-                .skip(1)
-                .find(|a| !a.starts_with('-'))
-                .as_deref()
-                == Some("eval")
-            {
-                "clothbake eval"
-            } else {
-                "clothbake"
+            let first = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+            let sub = match first.as_deref() {
+                Some("eval") => "clothbake eval",
+                Some("bake") => "clothbake bake",
+                Some("info") => "clothbake info",
+                Some("diff") => "clothbake diff",
+                _ => "clothbake",
             };
             return Err(error::from_clap(&e, sub));
         }
     };
-    let out = match cli.command {
-        Some(Command::Eval(args)) => eval_cmd::run(&args)?,
-        None => return Err(default_mode(&cli.bake)),
+    let (out, code) = match cli.command {
+        Some(Command::Eval(args)) => (eval_cmd::run(&args)?, 0),
+        Some(Command::Bake(args)) => (bake_cmd::run(&args.weave, &args.opts)?, 0),
+        Some(Command::Info(args)) => (info_cmd::run(&args)?, 0),
+        Some(Command::Diff(args)) => diff_cmd::run(&args)?,
+        None => match &cli.weave {
+            Some(w) => (bake_cmd::run(w, &cli.bake)?, 0),
+            None => return Err(no_command()),
+        },
     };
     let mut stdout = std::io::stdout().lock();
     match stdout
@@ -73,28 +83,18 @@ fn run() -> Result<(), CliError> {
         .and_then(|()| stdout.flush())
     {
         // The reader went away (e.g. `| head`): nothing left to tell anyone.
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        r => r.map_err(|e| CliError::new(format!("cannot write the output: {e}"), "check stdout")),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(code),
+        r => r
+            .map(|()| code)
+            .map_err(|e| CliError::new(format!("cannot write the output: {e}"), "check stdout")),
     }
 }
 
-/// The default mode, `clothbake --weave FILE`, will bake a table; not yet available.
-fn default_mode(bake: &BakeArgs) -> CliError {
-    match &bake.weave {
-        Some(w) => CliError::new(
-            format!(
-                "baking a BRDF table (`clothbake --weave {}`) is not yet available",
-                w.display()
-            ),
-            format!(
-                "evaluate single directions with `clothbake eval --weave {} --wi THETA,PHI --wo THETA,PHI`",
-                w.display()
-            ),
-        ),
-        None => CliError::new(
-            "no command given",
-            "evaluate a fabric with `clothbake eval --weave FILE --wi THETA,PHI --wo THETA,PHI` \
-             (see `clothbake --help`)",
-        ),
-    }
+/// `clothbake` alone.
+fn no_command() -> CliError {
+    CliError::new(
+        "no command given",
+        "bake a table with `clothbake --weave FILE` (e.g. tables/twill.json), or see \
+         `clothbake --help` for eval, info and diff",
+    )
 }

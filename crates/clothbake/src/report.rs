@@ -50,6 +50,13 @@ impl Report<'_> {
             "I": self.reflection.total(),
             "brdf": self.brdf,
         });
+        if let Some(s2) = &self.reflection.secondary {
+            v["I_ss"] = json!(s2.ss);
+            v["I_sd"] = json!(s2.sd);
+            v["I_ds"] = json!(s2.ds);
+            v["I_dd"] = json!(s2.dd);
+            v["I_2"] = json!(s2.total());
+        }
         if let Some(rt) = &self.raytrace {
             v["std_err"] = json!(rt.std_err);
             v["samples"] = json!(rt.samples);
@@ -96,6 +103,13 @@ impl Report<'_> {
         };
         row(&mut s, "I_d", self.reflection.i_d, "");
         row(&mut s, "I_s", self.reflection.i_s, "");
+        if let Some(s2) = &self.reflection.secondary {
+            row(&mut s, "I_ss", s2.ss, "");
+            row(&mut s, "I_sd", s2.sd, "");
+            row(&mut s, "I_ds", s2.ds, "");
+            row(&mut s, "I_dd", s2.dd, "");
+            row(&mut s, "I_2", s2.total(), "");
+        }
         row(&mut s, "I", self.reflection.total(), "");
         row(&mut s, "brdf", self.brdf, "  1/sr");
         if let Some(rt) = &self.raytrace {

@@ -316,18 +316,62 @@ fn bad_options() {
 }
 
 #[test]
-fn default_mode_is_not_yet_available() {
-    let w = table("twill");
-    let out = clothbake(&["--weave", w.to_str().unwrap()]);
-    fails(&out, &["not yet available", "clothbake eval"]);
-    fails(&clothbake(&[]), &["no command", "clothbake eval"]);
+fn no_command() {
+    fails(&clothbake(&[]), &["no command", "clothbake --weave FILE"]);
 }
 
 #[test]
 fn help_and_version_succeed() {
-    for args in [&["--help"][..], &["eval", "--help"], &["--version"]] {
+    for args in [
+        &["--help"][..],
+        &["eval", "--help"],
+        &["bake", "--help"],
+        &["info", "--help"],
+        &["diff", "--help"],
+        &["--version"],
+    ] {
         let out = clothbake(args);
         assert!(out.status.success(), "{args:?}");
         assert!(!out.stdout.is_empty());
     }
+}
+
+#[test]
+fn bounces_2_reports_the_four_components() {
+    for method in ["analytic", "raytrace"] {
+        let mut rest = vec![
+            "--wi",
+            "30,180",
+            "--wo",
+            "40,0",
+            "--bounces",
+            "2",
+            "--method",
+            method,
+        ];
+        if method == "raytrace" {
+            rest.extend(["--samples", "20000"]);
+        }
+        let v = eval_json(&table("parallel"), &rest);
+        let comps: Vec<[f64; 3]> = ["I_ss", "I_sd", "I_ds", "I_dd"]
+            .iter()
+            .map(|k| rgb(&v, k))
+            .collect();
+        let i2 = rgb(&v, "I_2");
+        let (id, is, i) = (rgb(&v, "I_d"), rgb(&v, "I_s"), rgb(&v, "I"));
+        for c in 0..3 {
+            let sum: f64 = comps.iter().map(|x| x[c]).sum();
+            assert!((sum - i2[c]).abs() < 1e-12 && i2[c] > 0.0, "{method}: {v}");
+            assert!(
+                (id[c] + is[c] + i2[c] - i[c]).abs() < 1e-12,
+                "{method}: {v}"
+            );
+        }
+    }
+    // The kernel and solution flags need --bounces 2.
+    let out = eval(
+        &table("parallel"),
+        &["--wi", "30,180", "--wo", "40,0", "--kernel", "thesis"],
+    );
+    fails(&out, &["--bounces 2"]);
 }

@@ -1,0 +1,90 @@
+//! Directional albedo of a baked table: how much of the light arriving from one incident cell
+//! the fabric reflects, `integral over the hemisphere of f_r cos(theta_o) d omega_o`.
+//!
+//! The integral is the sum over the outgoing cells of the cell's value times the exact integral
+//! of `cos(theta_o)` over the cell's solid angle,
+//! `delta_phi * (sin^2 theta_hi - sin^2 theta_lo) / 2` (midpoint rule in f_r, exact in the
+//! weight). The weights of a whole hemisphere add up to pi exactly, so a constant
+//! `f_r = rho / pi` has albedo rho at any resolution.
+
+use clothbake_loader::{Grid, Table};
+use std::f64::consts::PI;
+
+/// The polar cell (of `n`) whose centre is nearest to `deg` degrees: the one containing it (on
+/// a cell edge, the upper one).
+pub fn nearest_polar(n: u32, deg: f64) -> u32 {
+    let k = (deg * f64::from(n) / 90.0).floor();
+    (k.max(0.0) as u32).min(n - 1)
+}
+
+/// The azimuth cell (of `n`) whose centre is nearest to `deg` degrees: the one containing it
+/// (on a cell edge, the upper one: cell 0, centred on 180 / n degrees, for 0 degrees).
+pub fn nearest_azimuth(n: u32, deg: f64) -> u32 {
+    let k = (deg.rem_euclid(360.0) * f64::from(n) / 360.0).floor();
+    (k.max(0.0) as u32).min(n - 1)
+}
+
+/// `integral of cos(theta) d omega` over outgoing polar cell `to` and one azimuth cell.
+pub fn cell_weight(g: &Grid, to: u32) -> f64 {
+    let dt = PI / 2.0 / f64::from(g.n_theta_o);
+    let (lo, hi) = (f64::from(to) * dt, f64::from(to + 1) * dt);
+    let dphi = 2.0 * PI / f64::from(g.n_phi_o);
+    dphi * (hi.sin().powi(2) - lo.sin().powi(2)) / 2.0
+}
+
+/// Directional albedo, per RGB channel, for the incident cell (ti, pi).
+pub fn directional_albedo(t: &Table, ti: u32, pi: u32) -> [f64; 3] {
+    let g = t.meta.grid;
+    let mut out = [0.0; 3];
+    for to in 0..g.n_theta_o {
+        let w = cell_weight(&g, to);
+        for po in 0..g.n_phi_o {
+            let v = t.rgb(ti, pi, to, po);
+            for k in 0..3 {
+                out[k] += w * f64::from(v[k]);
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clothbake_loader::Metadata;
+
+    #[test]
+    fn lambertian_table_has_its_albedo() {
+        let g = Grid {
+            n_theta_i: 3,
+            n_phi_i: 4,
+            n_theta_o: 7,
+            n_phi_o: 5,
+        };
+        let rho = [0.4f32, 0.2, 0.1];
+        let values = (0..g.len())
+            .flat_map(|_| rho.map(|r| r / std::f32::consts::PI))
+            .collect();
+        let t = Table::new(Metadata::new("t", g, "{}", "{}", "none"), values).unwrap();
+        let a = directional_albedo(&t, 1, 2);
+        for k in 0..3 {
+            assert!((a[k] - f64::from(rho[k])).abs() < 1e-6, "{a:?}");
+        }
+    }
+
+    #[test]
+    fn nearest_cells() {
+        assert_eq!(nearest_polar(32, 0.0), 0);
+        assert_eq!(nearest_polar(32, 30.0), 10); // centre 29.53
+        assert_eq!(nearest_polar(32, 60.0), 21); // centre 60.47
+        assert_eq!(nearest_polar(32, 80.0), 28); // centre 80.16
+        assert_eq!(nearest_polar(32, 90.0), 31);
+        assert_eq!(nearest_polar(8, 80.0), 7);
+        assert_eq!(nearest_azimuth(64, 0.0), 0);
+        assert_eq!(nearest_azimuth(64, 359.0), 63);
+        assert_eq!(nearest_azimuth(8, 90.0), 2); // 67.5 and 112.5 tie: the upper
+        assert_eq!(nearest_azimuth(8, 80.0), 1);
+        assert_eq!(nearest_azimuth(8, -10.0), 7);
+        assert_eq!(nearest_azimuth(1, 200.0), 0);
+    }
+}

@@ -1,0 +1,334 @@
+//! Comparing two tables of the same grid (`clothbake diff`, the golden-table test).
+//!
+//! Every value (cell and channel) of table A is compared with the same value of table B. A value
+//! is within tolerance when `|a - b| <= abs + rel * |a|`.
+
+use clothbake_loader::{Grid, Table};
+
+/// Default relative tolerance of `clothbake diff`: about 8 units in the last place of an f32,
+/// so that two bakes of the same model agree even across platforms whose maths libraries round
+/// differently in the last bit.
+pub const DEFAULT_REL: f64 = 1e-6;
+/// Default absolute tolerance of `clothbake diff`, in 1/sr: a million times below a typical
+/// cloth BRDF (0.1 /sr); it only matters for values that are (nearly) zero.
+pub const DEFAULT_ABS: f64 = 1e-7;
+/// The tolerance that covers the rounding of an f32 table to half floats (EXR `--precision
+/// f16`): relative 2^-11 (half floats' rounding error, 4.88e-4) and, for the half subnormals
+/// below 6.1e-5, absolute 2^-25 (3.0e-8).
+pub const F16_TOLERANCE: Tolerance = Tolerance {
+    rel: 4.9e-4,
+    abs: 3e-8,
+};
+
+/// `|a - b| <= abs + rel * |a|`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    /// Relative part, times |a|.
+    pub rel: f64,
+    /// Absolute part, 1/sr.
+    pub abs: f64,
+}
+
+impl Default for Tolerance {
+    fn default() -> Self {
+        Tolerance {
+            rel: DEFAULT_REL,
+            abs: DEFAULT_ABS,
+        }
+    }
+}
+
+/// A cell of a grid with its direction in degrees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cell {
+    /// Cell number ([`Grid::index`]).
+    pub index: usize,
+    /// Indices (ti, pi, to, po).
+    pub indices: [u32; 4],
+    /// Cell centre (theta_i, phi_i, theta_o, phi_o), degrees.
+    pub degrees: [f64; 4],
+}
+
+impl Cell {
+    /// The cell numbered `index` of `g`.
+    pub fn of(g: &Grid, index: usize) -> Cell {
+        let po = (index % g.n_phi_o as usize) as u32;
+        let rest = index / g.n_phi_o as usize;
+        let to = (rest % g.n_theta_o as usize) as u32;
+        let rest = rest / g.n_theta_o as usize;
+        let pi = (rest % g.n_phi_i as usize) as u32;
+        let ti = (rest / g.n_phi_i as usize) as u32;
+        Cell {
+            index,
+            indices: [ti, pi, to, po],
+            degrees: [
+                g.theta_i_deg(ti),
+                g.phi_i_deg(pi),
+                g.theta_o_deg(to),
+                g.phi_o_deg(po),
+            ],
+        }
+    }
+}
+
+impl std::fmt::Display for Cell {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [ti, pi, to, po] = self.degrees;
+        write!(
+            f,
+            "theta_i {ti:.2} phi_i {pi:.2} theta_o {to:.2} phi_o {po:.2} (cell {})",
+            self.index
+        )
+    }
+}
+
+/// The value that is furthest beyond (or closest to) the tolerance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Worst {
+    /// Where.
+    pub cell: Cell,
+    /// Channel (0 R, 1 G, 2 B).
+    pub channel: usize,
+    /// Value of A.
+    pub a: f32,
+    /// Value of B.
+    pub b: f32,
+    /// `|a - b| / (abs + rel |a|)`: above 1 means beyond the tolerance (infinite for a
+    /// difference where the tolerance is 0).
+    pub ratio: f64,
+}
+
+/// What `clothbake diff` reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    /// Number of values compared (3 per cell).
+    pub values: usize,
+    /// Largest |a - b|.
+    pub max_abs: f64,
+    /// Mean |a - b|.
+    pub mean_abs: f64,
+    /// Largest |a - b| / |a| over the values with a != 0 (0 if there are none).
+    pub max_rel: f64,
+    /// Mean |a - b| / |a| over the values with a != 0.
+    pub mean_rel: f64,
+    /// Largest value of A (the PSNR's peak).
+    pub peak: f64,
+    /// Mean squared difference.
+    pub mse: f64,
+    /// Number of values beyond the tolerance.
+    pub beyond: usize,
+    /// The value furthest beyond the tolerance (the largest `ratio`, ties to the largest
+    /// difference); `None` when the tables are identical.
+    pub worst: Option<Worst>,
+    /// The tolerance used.
+    pub tolerance: Tolerance,
+}
+
+impl Comparison {
+    /// Peak signal-to-noise ratio in dB, peak = max of A: infinite for identical tables, `None`
+    /// when A has no positive value.
+    pub fn psnr(&self) -> Option<f64> {
+        if self.peak <= 0.0 {
+            None
+        } else if self.mse == 0.0 {
+            Some(f64::INFINITY)
+        } else {
+            Some(10.0 * (self.peak * self.peak / self.mse).log10())
+        }
+    }
+
+    /// True when every value is within the tolerance.
+    pub fn within(&self) -> bool {
+        self.beyond == 0
+    }
+}
+
+/// The two grids differ.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridMismatch {
+    /// Grid of A.
+    pub a: Grid,
+    /// Grid of B.
+    pub b: Grid,
+}
+
+impl std::fmt::Display for GridMismatch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (a, b) = (self.a, self.b);
+        let differ: Vec<String> = [
+            ("n_theta_i", a.n_theta_i, b.n_theta_i),
+            ("n_phi_i", a.n_phi_i, b.n_phi_i),
+            ("n_theta_o", a.n_theta_o, b.n_theta_o),
+            ("n_phi_o", a.n_phi_o, b.n_phi_o),
+        ]
+        .iter()
+        .filter(|(_, x, y)| x != y)
+        .map(|(n, x, y)| format!("{n} {x} vs {y}"))
+        .collect();
+        write!(
+            f,
+            "different grids ({}): A is {a}, B is {b}",
+            differ.join(", ")
+        )
+    }
+}
+
+/// Compares every value of `a` with the same value of `b`.
+pub fn compare(a: &Table, b: &Table, tol: Tolerance) -> Result<Comparison, GridMismatch> {
+    if a.meta.grid != b.meta.grid {
+        return Err(GridMismatch {
+            a: a.meta.grid,
+            b: b.meta.grid,
+        });
+    }
+    let g = a.meta.grid;
+    let n = a.values.len();
+    let (mut sum_abs, mut sum_sq, mut sum_rel, mut n_rel) = (0.0, 0.0, 0.0, 0usize);
+    let (mut max_abs, mut max_rel, mut peak) = (0.0f64, 0.0f64, f64::NEG_INFINITY);
+    let mut beyond = 0;
+    let mut worst: Option<(f64, f64, usize)> = None; // (ratio, diff, value index)
+    for (k, (&x, &y)) in a.values.iter().zip(&b.values).enumerate() {
+        let (x64, y64) = (f64::from(x), f64::from(y));
+        let d = (x64 - y64).abs();
+        peak = peak.max(x64);
+        sum_abs += d;
+        sum_sq += d * d;
+        max_abs = max_abs.max(d);
+        if x != 0.0 {
+            let r = d / x64.abs();
+            sum_rel += r;
+            n_rel += 1;
+            max_rel = max_rel.max(r);
+        }
+        let t = tol.abs + tol.rel * x64.abs();
+        if d > t {
+            beyond += 1;
+        }
+        if d > 0.0 {
+            let ratio = if t > 0.0 { d / t } else { f64::INFINITY };
+            let better = match worst {
+                None => true,
+                Some((wr, wd, _)) => (ratio, d) > (wr, wd),
+            };
+            if better {
+                worst = Some((ratio, d, k));
+            }
+        }
+    }
+    let nf = n.max(1) as f64;
+    Ok(Comparison {
+        values: n,
+        max_abs,
+        mean_abs: sum_abs / nf,
+        max_rel,
+        mean_rel: if n_rel > 0 {
+            sum_rel / n_rel as f64
+        } else {
+            0.0
+        },
+        peak: if n > 0 { peak } else { 0.0 },
+        mse: sum_sq / nf,
+        beyond,
+        worst: worst.map(|(ratio, _, k)| Worst {
+            cell: Cell::of(&g, k / 3),
+            channel: k % 3,
+            a: a.values[k],
+            b: b.values[k],
+            ratio,
+        }),
+        tolerance: tol,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clothbake_loader::Metadata;
+
+    fn table(g: Grid, f: impl Fn(usize) -> f32) -> Table {
+        let meta = Metadata::new("t", g, "{}", "{}", "none");
+        Table::new(meta, (0..3 * g.len()).map(f).collect()).unwrap()
+    }
+
+    const G: Grid = Grid {
+        n_theta_i: 2,
+        n_phi_i: 3,
+        n_theta_o: 4,
+        n_phi_o: 5,
+    };
+
+    #[test]
+    fn identical_tables() {
+        let a = table(G, |k| k as f32 * 0.1);
+        let c = compare(&a, &a, Tolerance { rel: 0.0, abs: 0.0 }).unwrap();
+        assert!(c.within());
+        assert_eq!((c.max_abs, c.mean_abs, c.max_rel), (0.0, 0.0, 0.0));
+        assert_eq!(c.worst, None);
+        assert_eq!(c.psnr(), Some(f64::INFINITY));
+        assert_eq!(c.values, 360);
+    }
+
+    #[test]
+    fn one_value_differs() {
+        let a = table(G, |k| 1.0 + k as f32);
+        let b = table(G, |k| {
+            if k == 100 {
+                101.0 + 0.5
+            } else {
+                1.0 + k as f32
+            }
+        });
+        let c = compare(&a, &b, Tolerance::default()).unwrap();
+        assert!(!c.within());
+        assert_eq!(c.beyond, 1);
+        assert_eq!(c.max_abs, 0.5);
+        assert!((c.max_rel - 0.5 / 101.0).abs() < 1e-12);
+        let w = c.worst.unwrap();
+        assert_eq!((w.cell.index, w.channel, w.a, w.b), (33, 1, 101.0, 101.5));
+        assert_eq!(Cell::of(&G, 33).indices, [0, 1, 2, 3]);
+        assert_eq!(G.index(0, 1, 2, 3), 33);
+        let psnr = c.psnr().unwrap();
+        let want = 10.0 * (360.0f64 * 360.0 / (0.25 / 360.0)).log10();
+        assert!((psnr - want).abs() < 1e-9, "{psnr} {want}");
+        // A loose tolerance accepts it.
+        let c = compare(
+            &a,
+            &b,
+            Tolerance {
+                rel: 0.01,
+                abs: 0.0,
+            },
+        )
+        .unwrap();
+        assert!(c.within());
+        assert!(c.worst.unwrap().ratio < 1.0);
+    }
+
+    #[test]
+    fn zeros_use_the_absolute_tolerance() {
+        let a = table(G, |_| 0.0);
+        let b = table(G, |k| if k == 7 { 5e-8 } else { 0.0 });
+        assert!(compare(&a, &b, Tolerance::default()).unwrap().within());
+        let c = compare(&a, &b, Tolerance { rel: 1.0, abs: 0.0 }).unwrap();
+        assert!(!c.within());
+        assert_eq!(c.worst.unwrap().ratio, f64::INFINITY);
+        assert_eq!(c.max_rel, 0.0);
+        assert_eq!(c.psnr(), None);
+    }
+
+    #[test]
+    fn grids_must_match() {
+        let a = table(G, |_| 1.0);
+        let b = table(
+            Grid {
+                n_phi_o: 6,
+                n_theta_i: 3,
+                ..G
+            },
+            |_| 1.0,
+        );
+        let e = compare(&a, &b, Tolerance::default()).unwrap_err();
+        let s = e.to_string();
+        assert!(s.contains("n_theta_i 2 vs 3, n_phi_o 5 vs 6"), "{s}");
+    }
+}

@@ -1,0 +1,110 @@
+//! `clothbake info TABLE`: what a baked table holds.
+
+use crate::cli::InfoArgs;
+use crate::error::CliError;
+use clothbake::albedo::{directional_albedo, nearest_azimuth, nearest_polar};
+use clothbake_loader::{read_table, Table};
+use std::fmt::Write as _;
+use std::io::Read;
+use std::path::Path;
+
+/// The incident polar angles at which the albedo is reported, degrees.
+pub const ALBEDO_THETAS: [f64; 4] = [0.0, 30.0, 60.0, 80.0];
+
+fn format_name(path: &Path) -> &'static str {
+    let mut head = [0u8; 4];
+    let ok = std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok();
+    if ok && head == clothbake_loader::format::EXR_MAGIC {
+        "OpenEXR"
+    } else {
+        "binary"
+    }
+}
+
+/// Minimum, maximum and mean of each channel.
+pub fn channel_stats(t: &Table) -> [[f64; 3]; 3] {
+    let mut min = [f64::INFINITY; 3];
+    let mut max = [f64::NEG_INFINITY; 3];
+    let mut sum = [0.0; 3];
+    for c in t.values.chunks_exact(3) {
+        for k in 0..3 {
+            let v = f64::from(c[k]);
+            min[k] = min[k].min(v);
+            max[k] = max[k].max(v);
+            sum[k] += v;
+        }
+    }
+    let n = (t.values.len() / 3).max(1) as f64;
+    [min, max, sum.map(|s| s / n)]
+}
+
+/// Runs `clothbake info` and returns the text to print.
+pub fn run(args: &InfoArgs) -> Result<String, CliError> {
+    let t = read_table(&args.table)?;
+    let m = &t.meta;
+    let g = m.grid;
+    let mut s = String::new();
+    let fabric_name = serde_json::from_str::<serde_json::Value>(&m.fabric_json)
+        .ok()
+        .and_then(|v| v["name"].as_str().map(str::to_string))
+        .unwrap_or_else(|| "(unnamed)".to_string());
+    let _ = writeln!(
+        s,
+        "table      {} ({} format, version {})",
+        args.table.display(),
+        format_name(&args.table),
+        m.format_version
+    );
+    let _ = writeln!(s, "tool       {}", m.tool);
+    let _ = writeln!(s, "fabric     {fabric_name}");
+    let _ = writeln!(
+        s,
+        "grid       theta_i {} x phi_i {} x theta_o {} x phi_o {} = {} cells, centring {} \
+         (values at cell centres)",
+        g.n_theta_i,
+        g.n_phi_i,
+        g.n_theta_o,
+        g.n_phi_o,
+        g.len(),
+        m.centring
+    );
+    let _ = writeln!(s, "quantity   {} in {}", m.quantity, m.units);
+    let _ = writeln!(s, "symmetry   {}", m.symmetry);
+    let _ = writeln!(s, "options    {}", m.options_json);
+    let [min, max, mean] = channel_stats(&t);
+    let _ = writeln!(s, "values     {:>12} {:>12} {:>12}", "R", "G", "B");
+    for (name, v) in [("min", min), ("max", max), ("mean", mean)] {
+        let _ = writeln!(
+            s,
+            "  {name:<8} {:>12.6e} {:>12.6e} {:>12.6e}",
+            v[0], v[1], v[2]
+        );
+    }
+    let pi = nearest_azimuth(g.n_phi_i, 0.0);
+    let _ = writeln!(
+        s,
+        "directional albedo (sum over the outgoing cells of f_r times the cell's integral of \
+         cos theta_o d omega), phi_i {:.2} (row {pi}, nearest 0):",
+        g.phi_i_deg(pi)
+    );
+    let _ = writeln!(
+        s,
+        "  {:<28} {:>9} {:>9} {:>9}",
+        "theta_i asked -> row used", "R", "G", "B"
+    );
+    for want in ALBEDO_THETAS {
+        let ti = nearest_polar(g.n_theta_i, want);
+        let a = directional_albedo(&t, ti, pi);
+        let _ = writeln!(
+            s,
+            "  {:<28} {:>9.4} {:>9.4} {:>9.4}",
+            format!("{want:>2} -> row {ti} ({:.2} deg)", g.theta_i_deg(ti)),
+            a[0],
+            a[1],
+            a[2]
+        );
+    }
+    Ok(s)
+}
