@@ -417,28 +417,20 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
         Ranges::Thesis { c_max, l0 } => {
             let Some((t1, b2)) = pk else { return out };
             // Stay on one side of the top of each cylinder (fig. 5.7).
-            let side1 = if t1 <= FRAC_PI_2 {
-                Arc {
-                    lo: -PI,
-                    hi: FRAC_PI_2,
-                }
-            } else {
-                Arc {
-                    lo: FRAC_PI_2,
-                    hi: 2.0 * PI,
-                }
-            };
-            let side2 = if b2 <= FRAC_PI_2 {
-                Arc {
-                    lo: -PI,
-                    hi: FRAC_PI_2,
-                }
-            } else {
-                Arc {
-                    lo: FRAC_PI_2,
-                    hi: 2.0 * PI,
+            let side = |a: f64| {
+                if a <= FRAC_PI_2 {
+                    Arc {
+                        lo: -PI,
+                        hi: FRAC_PI_2,
+                    }
+                } else {
+                    Arc {
+                        lo: FRAC_PI_2,
+                        hi: 2.0 * PI,
+                    }
                 }
             };
+            let (side1, side2) = (side(t1), side(b2));
             let ta = Arc {
                 lo: t1 - c_max,
                 hi: t1 + c_max,

@@ -246,3 +246,31 @@ fn thesis_kernel_is_larger_by_pi_times_the_cosine() {
         );
     }
 }
+
+#[test]
+fn thesis_ranges_integrate_a_part_of_the_full_ranges() {
+    // The C_max window around the double-specular peak is a subset of the full domain and the
+    // integrand is non-negative: every component is smaller, I_ss keeps most of its value.
+    let m = AnalyticModel::new(&pf(10.0), FacetModel::Huo);
+    let thesis = SecondaryMethod::Analytic {
+        ranges: Ranges::Thesis {
+            c_max: 0.3,
+            l0: 1.5,
+        },
+        orders: Orders::default(),
+    };
+    let opts = |method| SecondaryOptions {
+        method,
+        kernel: Kernel::Thesis,
+    };
+    let (wi, wo) = pairs()[0];
+    let t = m.eval_with(wi, wo, Some(&opts(thesis))).secondary.unwrap();
+    let f = m
+        .eval_with(wi, wo, Some(&opts(ANALYTIC)))
+        .secondary
+        .unwrap();
+    for (a, b) in [(t.ss, f.ss), (t.sd, f.sd), (t.ds, f.ds), (t.dd, f.dd)] {
+        assert!(a[0] >= 0.0 && a[0] <= b[0] * 1.001, "{a:?} vs {b:?}");
+    }
+    assert!(t.ss[0] > 0.3 * f.ss[0], "{} vs {}", t.ss[0], f.ss[0]);
+}
