@@ -14,7 +14,7 @@
 
 use crate::facet::Facet;
 use crate::interreflection::{Kernel, Secondary};
-use crate::raytrace::{Caps, RayTracer, Surface, BATCHES};
+use crate::raytrace::{batch_ratio, Caps, RayTracer, Surface, BATCHES};
 use crate::rng::Rng;
 use crate::vec3::{UnitVec3, Vec3};
 use std::f64::consts::PI;
@@ -237,19 +237,8 @@ fn summarise(accs: &[Acc], k_max: usize) -> PathEstimate {
         return est;
     }
     let ratio = |f: &dyn Fn(&Acc) -> f64| -> (f64, f64) {
-        let h = hits as f64;
-        let r = accs.iter().map(f).sum::<f64>() / h;
-        let nb = accs.iter().filter(|a| a.rays > 0).count();
-        if nb < 2 {
-            return (r, f64::INFINITY);
-        }
-        let mh = h / nb as f64;
-        let ss: f64 = accs
-            .iter()
-            .filter(|a| a.rays > 0)
-            .map(|a| ((f(a) - r * a.hits as f64) / mh).powi(2))
-            .sum();
-        (r, (ss / (nb * (nb - 1)) as f64).sqrt())
+        let batches: Vec<(f64, u64, u64)> = accs.iter().map(|a| (f(a), a.hits, a.rays)).collect();
+        batch_ratio(&batches)
     };
     for k in 0..k_max {
         for c in 0..3 {

@@ -484,22 +484,31 @@ impl BatchSums {
 
 /// Ratio estimate and its standard error (see [`Estimate`]) of the per-hit mean of `f`.
 fn ratio_and_error(sums: &[BatchSums], f: impl Fn(&[f64; 3], f64) -> f64) -> (f64, f64) {
-    let h: u64 = sums.iter().map(|b| b.hits).sum();
+    let batches: Vec<(f64, u64, u64)> =
+        sums.iter().map(|b| (b.shade(&f), b.hits, b.rays)).collect();
+    batch_ratio(&batches)
+}
+
+/// The ratio estimate (sum of shading) / (yarn hits) over batches given as (sum, hits, rays),
+/// and its standard error from the spread of the batches: the estimator of [`Estimate`],
+/// shared with the path tracer.
+pub(crate) fn batch_ratio(batches: &[(f64, u64, u64)]) -> (f64, f64) {
+    let h: u64 = batches.iter().map(|b| b.1).sum();
     if h == 0 {
         return (0.0, 0.0);
     }
     let h = h as f64;
-    let r = sums.iter().map(|b| b.shade(&f)).sum::<f64>() / h;
-    let nb = sums.iter().filter(|b| b.rays > 0).count();
+    let r = batches.iter().map(|b| b.0).sum::<f64>() / h;
+    let nb = batches.iter().filter(|b| b.2 > 0).count();
     if nb < 2 {
         return (r, f64::INFINITY);
     }
     let mean_h = h / nb as f64;
     // (w_b (R_b - R))^2 = ((S_b - R H_b) / mean(H))^2.
-    let ss: f64 = sums
+    let ss: f64 = batches
         .iter()
-        .filter(|b| b.rays > 0)
-        .map(|b| ((b.shade(&f) - r * b.hits as f64) / mean_h).powi(2))
+        .filter(|b| b.2 > 0)
+        .map(|b| ((b.0 - r * b.1 as f64) / mean_h).powi(2))
         .sum();
     (r, (ss / (nb * (nb - 1)) as f64).sqrt())
 }
