@@ -6,14 +6,13 @@
 //! then write the table atomically through the loader. Ctrl-C raises the cancel flag: the bake
 //! stops and nothing is written (exit 130; a second Ctrl-C exits at once).
 
-use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg, SecondaryArg};
+use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg};
 use crate::cli::{DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
 use crate::eval_cmd::apply_material;
 use clothbake::bake::{self, BakeError, BakeOptions, Method, DEFAULT_GRID};
 use clothbake::output::{write_table, Format};
-use clothbake_core::interreflection::{Orders, Ranges, Sampling};
-use clothbake_core::{Caps, Fabric, Kernel, SecondaryMethod, SecondaryOptions, Variant};
+use clothbake_core::{Caps, Fabric, Variant};
 use clothbake_loader::{Precision, TableError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -67,13 +66,8 @@ pub fn plan(weave: &Path, o: &BakeOpts) -> Result<Plan, CliError> {
             "drop --variant or use --method analytic",
         ));
     }
-    if o.bounces == 1 && (o.secondary.is_some() || o.kernel.is_some()) {
-        return Err(CliError::new(
-            "--secondary and --kernel apply only to the secondary reflection",
-            "add --bounces 2 or drop them",
-        ));
-    }
-    if o.bounces == 2 && raytrace {
+    let secondary = o.bounces.options()?;
+    if o.bounces.bounces == 2 && raytrace {
         return Err(CliError::new(
             "--bounces 2 needs the analytic model: the ray tracer bakes the direct reflection only",
             "use --method analytic with --bounces 2 (--secondary raytrace selects the thesis's \
@@ -146,21 +140,11 @@ pub fn plan(weave: &Path, o: &BakeOpts) -> Result<Plan, CliError> {
             variant: o.variant.map_or(Variant::Refined, Variant::from),
         }
     };
-    let secondary = SecondaryOptions {
-        method: match o.secondary {
-            None | Some(SecondaryArg::Analytic) => SecondaryMethod::Analytic {
-                ranges: Ranges::Full,
-                orders: Orders::default(),
-            },
-            Some(SecondaryArg::Raytrace) => SecondaryMethod::Sampling(Sampling::default()),
-        },
-        kernel: o.kernel.map_or(Kernel::Radiometric, Kernel::from),
-    };
     let options = BakeOptions {
         grid: o.res.unwrap_or(DEFAULT_GRID),
         facet: o.facet.into(),
         method,
-        bounces: o.bounces,
+        bounces: o.bounces.bounces,
         secondary,
     };
     bake::check_options(&options).map_err(|e| CliError::line(e.to_string()))?;

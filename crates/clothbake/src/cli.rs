@@ -5,8 +5,12 @@
 //! --wo THETA,PHI [...]`, `clothbake info TABLE` and `clothbake diff A B`. The bake options live
 //! in [`BakeOpts`], flattened into both [`Cli`] (default mode) and [`BakeCmd`] (the subcommand).
 
+use crate::error::CliError;
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use clothbake_core::{Caps, FacetModel, Kernel, UnitVec3, Variant};
+use clothbake_core::interreflection::{Orders, Ranges, Sampling};
+use clothbake_core::{
+    Caps, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
+};
 use clothbake_loader::Grid;
 use std::path::PathBuf;
 
@@ -123,20 +127,9 @@ pub struct BakeOpts {
     #[arg(long, value_enum)]
     pub caps: Option<CapsArg>,
 
-    /// 1: direct reflection; 2: adds the secondary reflection between neighbouring parallel
-    /// threads (thesis ch. 5; analytic model only; much slower).
-    #[arg(long, value_name = "1|2", value_parser = parse_bounces, default_value = "1")]
-    pub bounces: u32,
-
-    /// With --bounces 2: the secondary reflection's analytic solution (sec. 5.3) or the
-    /// thesis's two-level ray-traced sampling (sec. 5.2) [default: analytic].
-    #[arg(long, value_enum)]
-    pub secondary: Option<SecondaryArg>,
-
-    /// With --bounces 2: weight of the second bounce, the rendering equation's (radiometric)
-    /// or the thesis's as printed (larger by pi N.w) [default: radiometric].
-    #[arg(long, value_enum)]
-    pub kernel: Option<KernelArg>,
+    /// Bounces and the secondary reflection's options.
+    #[command(flatten)]
+    pub bounces: BounceArgs,
 
     /// Material overrides, applied to both yarn groups.
     #[command(flatten)]
@@ -212,20 +205,10 @@ pub struct EvalArgs {
     #[arg(long, value_enum, default_value_t = CapsArg::Excluded)]
     pub caps: CapsArg,
 
-    /// 1: direct reflection; 2: adds the secondary reflection I_2 (thesis ch. 5). With
-    /// --method raytrace and --bounces 2 the path tracer estimates I_2 (ground truth).
-    #[arg(long, value_name = "1|2", value_parser = parse_bounces, default_value = "1")]
-    pub bounces: u32,
-
-    /// With --bounces 2 and --method analytic: the analytical solution (sec. 5.3, default) or
-    /// the thesis's two-level ray-traced sampling (sec. 5.2).
-    #[arg(long, value_enum)]
-    pub secondary: Option<SecondaryArg>,
-
-    /// With --bounces 2: weight of the second bounce, radiometric (the rendering equation,
-    /// default) or thesis (as printed, larger by pi N.w).
-    #[arg(long, value_enum)]
-    pub kernel: Option<KernelArg>,
+    /// Bounces and the secondary reflection's options (with --method raytrace and --bounces 2
+    /// the path tracer estimates I_2).
+    #[command(flatten)]
+    pub bounces: BounceArgs,
 
     /// Material overrides, applied to both yarn groups.
     #[command(flatten)]
@@ -354,6 +337,49 @@ pub enum PrecisionArg {
     F16,
     /// 32-bit floats.
     F32,
+}
+
+/// `--bounces`, `--secondary`, `--kernel`: shared by `eval` and the bake.
+#[derive(Args, Debug, Clone, Copy, PartialEq)]
+pub struct BounceArgs {
+    /// 1: direct reflection; 2: adds the secondary reflection I_2 between neighbouring parallel
+    /// threads (thesis ch. 5; much slower). With `eval --method raytrace` the path tracer
+    /// estimates I_2 (ground truth).
+    #[arg(long, value_name = "1|2", value_parser = parse_bounces, default_value = "1")]
+    pub bounces: u32,
+
+    /// With --bounces 2: the secondary reflection's analytic solution (sec. 5.3) or the
+    /// thesis's two-level ray-traced sampling (sec. 5.2) [default: analytic].
+    #[arg(long, value_enum)]
+    pub secondary: Option<SecondaryArg>,
+
+    /// With --bounces 2: weight of the second bounce, the rendering equation's (radiometric)
+    /// or the thesis's as printed (larger by pi N.w) [default: radiometric].
+    #[arg(long, value_enum)]
+    pub kernel: Option<KernelArg>,
+}
+
+impl BounceArgs {
+    /// The secondary-reflection options (also for --bounces 1, where they are unused); an
+    /// error when --secondary or --kernel is given without --bounces 2.
+    pub fn options(&self) -> Result<SecondaryOptions, CliError> {
+        if self.bounces == 1 && (self.secondary.is_some() || self.kernel.is_some()) {
+            return Err(CliError::new(
+                "--secondary and --kernel apply only to the secondary reflection",
+                "add --bounces 2 or drop them",
+            ));
+        }
+        Ok(SecondaryOptions {
+            method: match self.secondary {
+                None | Some(SecondaryArg::Analytic) => SecondaryMethod::Analytic {
+                    ranges: Ranges::Full,
+                    orders: Orders::default(),
+                },
+                Some(SecondaryArg::Raytrace) => SecondaryMethod::Sampling(Sampling::default()),
+            },
+            kernel: self.kernel.map_or(Kernel::Radiometric, Kernel::from),
+        })
+    }
 }
 
 /// `--secondary` values.

@@ -1,12 +1,11 @@
 //! `clothbake eval`: the reflection of a fabric for one light and one eye direction.
 
-use crate::cli::{EvalArgs, MaterialArgs, Method, SecondaryArg, DEFAULT_SAMPLES, DEFAULT_SEED};
+use crate::cli::{EvalArgs, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
 use crate::report::{self, Report};
-use clothbake_core::interreflection::{Orders, Ranges, Sampling};
 use clothbake_core::pathtrace::PathOptions;
+use clothbake_core::Secondary;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, Reflection};
-use clothbake_core::{Kernel, Secondary, SecondaryMethod, SecondaryOptions};
 
 /// Runs `clothbake eval` and returns the text to print on stdout.
 pub fn run(args: &EvalArgs) -> Result<String, CliError> {
@@ -16,29 +15,15 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
             "add --method raytrace or drop them",
         ));
     }
-    if args.bounces == 1 && (args.secondary.is_some() || args.kernel.is_some()) {
-        return Err(CliError::new(
-            "--secondary and --kernel apply only to the secondary reflection",
-            "add --bounces 2 or drop them",
-        ));
-    }
-    if args.method == Method::Raytrace && args.secondary.is_some() {
+    let opts = args.bounces.options()?;
+    if args.method == Method::Raytrace && args.bounces.secondary.is_some() {
         return Err(CliError::new(
             "--secondary chooses the analytic model's solution; with --method raytrace the path tracer computes I_2",
             "drop --secondary or use --method analytic",
         ));
     }
-    let kernel: Kernel = args.kernel.map_or(Kernel::default(), Kernel::from);
-    let secondary = (args.bounces == 2).then(|| SecondaryOptions {
-        method: match args.secondary {
-            Some(SecondaryArg::Raytrace) => SecondaryMethod::Sampling(Sampling::default()),
-            _ => SecondaryMethod::Analytic {
-                ranges: Ranges::Full,
-                orders: Orders::default(),
-            },
-        },
-        kernel,
-    });
+    let kernel = opts.kernel;
+    let secondary = (args.bounces.bounces == 2).then_some(opts);
     let fabric = Fabric::from_path(&args.weave)?;
     let fabric = apply_material(fabric, &args.material);
     let facet = FacetModel::from(args.facet);
@@ -73,7 +58,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
                     },
                     [0.0; 3],
                 )
-            } else if args.bounces == 2 {
+            } else if args.bounces.bounces == 2 {
                 // The path tracer: orders 1 and 2, I_2 split into its four components.
                 let opts = PathOptions {
                     max_bounces: 2,
