@@ -355,18 +355,8 @@ impl Default for Orders {
     }
 }
 
-/// Composite Gauss-Legendre over [a, b] split at the `cuts` inside it. With `graded`, the
-/// first panel is mapped by x = lo + (hi - lo) s^2, which clusters its nodes at `a` and tames
-/// the logarithmic behaviour of the outer integrand where C1 nearly touches C2 (a point there
-/// sees C2 under almost a hemisphere).
-fn panels(
-    a: f64,
-    b: f64,
-    cuts: &[f64],
-    rule: &[(f64, f64)],
-    graded: bool,
-    mut f: impl FnMut(f64, f64),
-) {
+/// Composite Gauss-Legendre over [a, b] split at the `cuts` inside it.
+fn panels(a: f64, b: f64, cuts: &[f64], rule: &[(f64, f64)], mut f: impl FnMut(f64, f64)) {
     let mut pts = [0.0f64; 6];
     pts[0] = a;
     let mut n = 1;
@@ -379,15 +369,10 @@ fn panels(
     pts[n] = b;
     let pts = &mut pts[..=n];
     pts.sort_unstable_by(f64::total_cmp);
-    for (i, w) in pts.windows(2).enumerate() {
+    for w in pts.windows(2) {
         let (lo, hi) = (w[0], w[1]);
         for &(x, wt) in rule {
-            let s = 0.5 * (x + 1.0);
-            if graded && i == 0 {
-                f(lo + (hi - lo) * s * s, wt * (hi - lo) * s);
-            } else {
-                f(lo + (hi - lo) * s, 0.5 * wt * (hi - lo));
-            }
+            f(lo + (hi - lo) * 0.5 * (x + 1.0), 0.5 * wt * (hi - lo));
         }
     }
 }
@@ -489,7 +474,7 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
             )
             .lo,
         );
-        panels(barc.lo, barc.hi, &bcuts, &gb, false, |b, wb| {
+        panels(barc.lo, barc.hi, &bcuts, &gb, |b, wb| {
             let pj0 = pair.p2(b, 0.0);
             let nj = normal(b);
             let dd = (pj0.x - pi_.x).hypot(pj0.z - pi_.z);
@@ -511,7 +496,7 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
                 }
             };
             let tcut = [tau(ye), tau(yl)];
-            panels(tau(ylo), tau(yhi), &tcut, &gu, false, |x: f64, wx: f64| {
+            panels(tau(ylo), tau(yhi), &tcut, &gu, |x: f64, wx: f64| {
                 let q = 1.0 - x * x;
                 if q <= 0.0 {
                     return;
@@ -571,14 +556,9 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
             out.add_scaled(&part, 1.0);
         }
     } else {
-        panels(
-            theta_range.lo,
-            theta_range.hi,
-            &tcuts,
-            &gt,
-            false,
-            |t, wt| out.add_scaled(&inner(t), wt),
-        );
+        panels(theta_range.lo, theta_range.hi, &tcuts, &gt, |t, wt| {
+            out.add_scaled(&inner(t), wt)
+        });
     }
     out
 }
