@@ -876,6 +876,84 @@ fn hex(bytes: &[u8]) -> String {
 // ---------------------------------------------------------------------------------------------
 // EXR format
 
+/// The `exr` crate keeps an image's custom header attributes in a `HashMap` and writes them in
+/// its (randomly seeded) iteration order; [`write_exr`] sorts them by name (as the OpenEXR
+/// library writes them) so the same table always gives the same bytes. Reordering attributes
+/// keeps the header's length, so the offset table after it stays valid.
+/// Version-field flags of multi-part and deep EXR files (not written by clothbake).
+const EXR_MULTIPART: u32 = 0x1000;
+const EXR_DEEP: u32 = 0x800;
+
+/// Sorts the header attributes of a single-part EXR file by name, in place. Returns false (and
+/// leaves the bytes alone) for anything else than a well-formed single-part header.
+fn sort_exr_attributes(bytes: &mut [u8]) -> bool {
+    if bytes.len() < 8 || bytes[..4] != EXR_MAGIC {
+        return false;
+    }
+    let flags = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
+    if flags & (EXR_MULTIPART | EXR_DEEP) != 0 {
+        return false;
+    }
+    let start = 8;
+    let mut pos = start;
+    let mut attrs: Vec<(usize, usize, usize)> = Vec::new(); // (start, name end, end)
+    let cstr_end = |from: usize| bytes[from..].iter().position(|&b| b == 0).map(|i| from + i);
+    loop {
+        let Some(name_end) = cstr_end(pos) else {
+            return false;
+        };
+        if name_end == pos {
+            break; // the empty name that ends the header
+        }
+        let Some(type_end) = cstr_end(name_end + 1) else {
+            return false;
+        };
+        let size_at = type_end + 1;
+        if size_at + 4 > bytes.len() {
+            return false;
+        }
+        let size = i32::from_le_bytes([
+            bytes[size_at],
+            bytes[size_at + 1],
+            bytes[size_at + 2],
+            bytes[size_at + 3],
+        ]);
+        let Ok(size) = usize::try_from(size) else {
+            return false;
+        };
+        let end = size_at + 4 + size;
+        if end > bytes.len() {
+            return false;
+        }
+        attrs.push((pos, name_end, end));
+        pos = end;
+    }
+    let header_end = pos;
+    let mut sorted: Vec<&(usize, usize, usize)> = attrs.iter().collect();
+    sorted.sort_by(|a, b| bytes[a.0..a.1].cmp(&bytes[b.0..b.1]));
+    let mut out = Vec::with_capacity(header_end - start);
+    for &&(s, _, e) in &sorted {
+        out.extend_from_slice(&bytes[s..e]);
+    }
+    bytes[start..header_end].copy_from_slice(&out);
+    true
+}
+
+#[cfg(test)]
+mod sort_tests {
+    use super::sort_exr_attributes;
+
+    #[test]
+    fn malformed_headers_are_left_alone() {
+        let mut junk = b"not an exr".to_vec();
+        assert!(!sort_exr_attributes(&mut junk));
+        let mut cut = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0, b'a', 0, b'b'];
+        let copy = cut.clone();
+        assert!(!sort_exr_attributes(&mut cut));
+        assert_eq!(cut, copy);
+    }
+}
+
 mod exr_io {
     use super::*;
     use exr::prelude::{
@@ -984,6 +1062,7 @@ mod exr_io {
             .non_parallel()
             .to_buffered(Cursor::new(&mut bytes))
             .map_err(|e| unwritable(format!("OpenEXR encoder: {e}")))?;
+        sort_exr_attributes(&mut bytes);
         write_atomic(path, overwrite, |out| out.write_all(&bytes))
     }
 
