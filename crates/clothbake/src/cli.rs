@@ -55,6 +55,9 @@ pub enum Command {
     Info(InfoArgs),
     /// Compare two baked tables of the same grid; exit 1 when they differ beyond the tolerance.
     Diff(DiffArgs),
+    /// Export a fabric's BRDF for other renderers: the RGL `.bsdf` of Mitsuba 3's `measured`
+    /// BSDF, or the isotropic MERL binary (averaged over rotations about the normal).
+    Export(ExportArgs),
 }
 
 /// `clothbake bake`.
@@ -142,6 +145,105 @@ pub struct InfoArgs {
     /// A baked table (.exr or .bin).
     #[arg(value_name = "TABLE")]
     pub table: PathBuf,
+}
+
+/// `clothbake export`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "The MERL format is isotropic and cloth is not: each MERL cell holds f_r \
+                  averaged over rotations about the normal (--phi-samples angles) and over \
+                  swapping light and eye; the spread lost is printed. The RGL file keeps the \
+                  anisotropy. See docs/export.md."
+)]
+pub struct ExportArgs {
+    /// Fabric description (JSON, see docs/fabric-format.md), e.g. tables/twill.json.
+    #[arg(long, value_name = "FILE")]
+    pub weave: PathBuf,
+
+    /// Write the RGL material-database tensor file (RGB) that Mitsuba 3's `measured` BSDF reads.
+    #[arg(long, value_name = "OUT.bsdf")]
+    pub rgl: Option<PathBuf>,
+
+    /// Write the 90x90x180 MERL binary (isotropic: averaged over rotations about the normal).
+    #[arg(long, value_name = "OUT.binary")]
+    pub merl: Option<PathBuf>,
+
+    /// RGL grid: polar and azimuth steps of the view direction, nodes per side of each slice.
+    #[arg(long, value_name = "NT,NP,NS", value_parser = parse_rgl_res, default_value = "16,24,32")]
+    pub rgl_res: RglResArg,
+
+    /// MERL: rotations about the normal averaged per cell.
+    #[arg(long, value_name = "N", value_parser = parse_phi_samples, default_value = "16")]
+    pub phi_samples: usize,
+
+    /// Facet reflection model: the thesis's Phong-like terms or Lewis's modified Phong.
+    #[arg(long, value_enum, default_value_t = FacetArg::Huo)]
+    pub facet: FacetArg,
+
+    /// Analytic variant (see docs/model.md).
+    #[arg(long, value_enum, default_value_t = VariantArg::Refined)]
+    pub variant: VariantArg,
+
+    /// Bounces and the secondary reflection's options.
+    #[command(flatten)]
+    pub bounces: BounceArgs,
+
+    /// Material overrides, applied to both yarn groups.
+    #[command(flatten)]
+    pub material: MaterialArgs,
+
+    /// Worker threads [default: all cores]; the files do not depend on it.
+    #[arg(long, value_name = "N", value_parser = parse_threads)]
+    pub threads: Option<usize>,
+
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
+
+    /// Print nothing but errors.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
+/// `--rgl-res NT,NP,NS` (see `clothbake::export::rgl::RglGrid`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RglResArg(pub clothbake::export::rgl::RglGrid);
+
+/// Parses `--rgl-res NT,NP,NS`: three whole numbers, each from 2 to 1024.
+pub fn parse_rgl_res(s: &str) -> Result<RglResArg, String> {
+    const FIX: &str = "give three whole numbers NT,NP,NS (polar and azimuth steps of the view \
+                       direction, nodes per slice side), each from 2 to 1024, e.g. 16,24,32";
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected 3 comma-separated numbers, found {}; {FIX}",
+            parts.len()
+        ));
+    }
+    let mut n = [0usize; 3];
+    for (k, p) in parts.iter().enumerate() {
+        n[k] = p
+            .parse::<usize>()
+            .map_err(|_| format!("`{p}` is not a whole number; {FIX}"))?;
+    }
+    let g = clothbake::export::rgl::RglGrid {
+        n_theta: n[0],
+        n_phi: n[1],
+        n_slice: n[2],
+    };
+    g.validate().map_err(|e| format!("{e}; {FIX}"))?;
+    Ok(RglResArg(g))
+}
+
+/// Parses `--phi-samples N`, 1 <= N <= 4096.
+pub fn parse_phi_samples(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if (1..=4096).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "`{}` is not a number of rotations from 1 to 4096; give e.g. --phi-samples 16",
+            s.trim()
+        )),
+    }
 }
 
 /// `clothbake diff`.

@@ -4,10 +4,12 @@
 //! theta_o, phi_o) grid of a fabric in parallel and returns the table; [`compare`] holds two
 //! tables against each other (`clothbake diff`, the golden tables of [`golden`]); [`albedo`]
 //! integrates a table's directional albedo (`clothbake info`); [`output`] writes tables with
-//! reproducible bytes. The file formats live in `clothbake-loader`.
+//! reproducible bytes; [`export`] writes the BRDF for other renderers (RGL `.bsdf`,
+//! MERL binary). The file formats live in `clothbake-loader`.
 
 pub mod albedo;
 pub mod bake;
 pub mod compare;
+pub mod export;
 pub mod golden;
 pub mod output;

@@ -8,6 +8,7 @@ mod cli;
 mod diff_cmd;
 mod error;
 mod eval_cmd;
+mod export_cmd;
 mod info_cmd;
 mod report;
 
@@ -62,6 +63,7 @@ fn run() -> Result<u8, CliError> {
                 Some("bake") => "clothbake bake",
                 Some("info") => "clothbake info",
                 Some("diff") => "clothbake diff",
+                Some("export") => "clothbake export",
                 _ => "clothbake",
             };
             return Err(error::from_clap(&e, sub));
@@ -72,6 +74,7 @@ fn run() -> Result<u8, CliError> {
         Some(Command::Bake(args)) => (bake_cmd::run(&args.weave, &args.opts)?, 0),
         Some(Command::Info(args)) => (info_cmd::run(&args)?, 0),
         Some(Command::Diff(args)) => diff_cmd::run(&args)?,
+        Some(Command::Export(args)) => (export_cmd::run(&args)?, 0),
         None => match &cli.weave {
             Some(w) => (bake_cmd::run(w, &cli.bake)?, 0),
             None => return Err(no_command()),
@@ -95,6 +98,6 @@ fn no_command() -> CliError {
     CliError::new(
         "no command given",
         "bake a table with `clothbake --weave FILE` (e.g. tables/twill.json), or see \
-         `clothbake --help` for eval, info and diff",
+         `clothbake --help` for eval, info, diff and export",
     )
 }
