@@ -5,6 +5,7 @@ use crate::cli::ExportArgs;
 use crate::error::CliError;
 use crate::eval_cmd::apply_material;
 use clothbake::export::{self, merl, rgl};
+use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel};
 use clothbake_loader::TableError;
 use std::fmt::Write as _;
@@ -85,7 +86,9 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
     }
     if let Some(out) = &args.merl {
         let start = Instant::now();
-        let table = pool.install(|| merl::merl_table(&brdf, args.phi_samples));
+        // A fabric unchanged by a half turn has a BRDF unchanged by it: half the rotations.
+        let half_turn = symmetries(&fabric).contains(&Symmetry::Rotate180);
+        let table = pool.install(|| merl::merl_table(&brdf, args.phi_samples, half_turn));
         export::write_file(out, &merl::merl_bytes(&table), args.force)?;
         let a = table.anisotropy;
         let _ = writeln!(

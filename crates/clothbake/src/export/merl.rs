@@ -55,16 +55,29 @@ pub fn half_diff_to_pair(theta_h: f64, phi_h: f64, theta_d: f64, phi_d: f64) -> 
 }
 
 /// The rotation-averaged, reciprocity-symmetrised f_r of one cell, and the relative standard
-/// deviation of the luminance over phi_h (0 where the mean is 0).
-pub fn cell_value(brdf: &Brdf, angles: (f64, f64, f64), phi_samples: usize) -> ([f64; 3], f64) {
+/// deviation of the luminance over phi_h (0 where the mean is 0). The average is over
+/// `phi_samples` angles phi_h = 2 pi s / phi_samples; with `half_turn` (the BRDF is unchanged by
+/// a rotation by pi about the normal, e.g. `Symmetry::Rotate180` of the fabric) and an even
+/// count only the first half is evaluated: the second repeats it.
+pub fn cell_value(
+    brdf: &Brdf,
+    angles: (f64, f64, f64),
+    phi_samples: usize,
+    half_turn: bool,
+) -> ([f64; 3], f64) {
     let (th, td, pd) = angles;
     let (a, b) = half_diff_to_pair(th, 0.0, td, pd);
     if a.z <= clothbake_core::vec3::HORIZON_COS || b.z <= clothbake_core::vec3::HORIZON_COS {
         return ([0.0; 3], 0.0);
     }
+    let evaluated = if half_turn && phi_samples % 2 == 0 {
+        phi_samples / 2
+    } else {
+        phi_samples
+    };
     let mut sum = [0.0; 3];
     let (mut s1, mut s2) = (0.0, 0.0);
-    for s in 0..phi_samples {
+    for s in 0..evaluated {
         let ph = 2.0 * PI * s as f64 / phi_samples as f64;
         let (a, b) = half_diff_to_pair(th, ph, td, pd);
         let (Some(a), Some(b)) = (UnitVec3::new(a), UnitVec3::new(b)) else {
@@ -79,7 +92,7 @@ pub fn cell_value(brdf: &Brdf, angles: (f64, f64, f64), phi_samples: usize) -> (
         s1 += y;
         s2 += y * y;
     }
-    let n = phi_samples as f64;
+    let n = evaluated as f64;
     let mean = s1 / n;
     let rel_std = if mean > 0.0 {
         ((s2 / n - mean * mean).max(0.0)).sqrt() / mean
@@ -110,8 +123,9 @@ pub struct MerlTable {
 }
 
 /// Tabulates `brdf` (rows of theta_h in parallel on the current rayon pool, collected in order:
-/// deterministic). `phi_samples` >= 1 rotations are averaged per cell.
-pub fn merl_table(brdf: &Brdf, phi_samples: usize) -> MerlTable {
+/// deterministic). `phi_samples` >= 1 rotations are averaged per cell; `half_turn` as in
+/// [`cell_value`].
+pub fn merl_table(brdf: &Brdf, phi_samples: usize, half_turn: bool) -> MerlTable {
     assert!(phi_samples >= 1);
     let rows: Vec<Vec<([f64; 3], f64)>> = (0..N_THETA_H)
         .into_par_iter()
@@ -119,7 +133,12 @@ pub fn merl_table(brdf: &Brdf, phi_samples: usize) -> MerlTable {
             let mut row = Vec::with_capacity(N_THETA_D * N_PHI_D);
             for id in 0..N_THETA_D {
                 for ip in 0..N_PHI_D {
-                    row.push(cell_value(brdf, cell_angles(ih, id, ip), phi_samples));
+                    row.push(cell_value(
+                        brdf,
+                        cell_angles(ih, id, ip),
+                        phi_samples,
+                        half_turn,
+                    ));
                 }
             }
             row
@@ -193,7 +212,7 @@ mod tests {
             let c = wi.cos_theta() * wo.cos_theta();
             [c, 2.0 * c, 0.5]
         };
-        let (v, rel) = cell_value(&brdf, cell_angles(30, 20, 50), 12);
+        let (v, rel) = cell_value(&brdf, cell_angles(30, 20, 50), 12, false);
         assert!(rel < 1e-12, "{rel}");
         let (a, b) = half_diff_to_pair(
             cell_angles(30, 20, 50).0,
@@ -202,5 +221,24 @@ mod tests {
             cell_angles(30, 20, 50).2,
         );
         assert!((v[0] - a.z * b.z).abs() < 1e-12);
+    }
+
+    #[test]
+    fn half_turn_symmetry_halves_the_work_not_the_result() {
+        // Invariant under (x, y) -> (-x, -y), anisotropic otherwise.
+        let brdf = |wi: UnitVec3, wo: UnitVec3| {
+            let v = (wi.x + wo.x).powi(2) + 0.3 * wi.x * wo.y;
+            [1.0 + v, 2.0, 0.5 + wi.y * wo.y]
+        };
+        for cell in [(10, 5, 7), (40, 30, 100), (70, 10, 179)] {
+            let a = cell_angles(cell.0, cell.1, cell.2);
+            let (full, rf) = cell_value(&brdf, a, 16, false);
+            let (half, rh) = cell_value(&brdf, a, 16, true);
+            assert!(rf > 1e-3, "{rf}");
+            assert!((rf - rh).abs() < 1e-12);
+            for c in 0..3 {
+                assert!((full[c] - half[c]).abs() < 1e-12 * full[c].abs().max(1.0));
+            }
+        }
     }
 }
