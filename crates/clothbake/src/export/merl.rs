@@ -70,7 +70,7 @@ pub fn cell_value(
     if a.z <= clothbake_core::vec3::HORIZON_COS || b.z <= clothbake_core::vec3::HORIZON_COS {
         return ([0.0; 3], 0.0);
     }
-    let evaluated = if half_turn && phi_samples % 2 == 0 {
+    let evaluated = if half_turn && phi_samples.is_multiple_of(2) {
         phi_samples / 2
     } else {
         phi_samples
