@@ -375,3 +375,42 @@ fn bounces_2_reports_the_four_components() {
     );
     fails(&out, &["--bounces 2"]);
 }
+
+#[test]
+fn export_writes_an_rgl_file_and_refuses_bad_requests() {
+    let w = table("plain");
+    let w = w.to_str().unwrap();
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-export.bsdf");
+    let _ = std::fs::remove_file(&out);
+    let o = out.to_str().unwrap();
+    fails(
+        &clothbake(&["export", "--weave", w]),
+        &["nothing to export", "--rgl"],
+    );
+    fails(
+        &clothbake(&["export", "--weave", w, "--rgl", o, "--rgl-res", "1,4,4"]),
+        &["theta resolution 1", "16,24,32"],
+    );
+    let ok = clothbake(&[
+        "export",
+        "--weave",
+        w,
+        "--rgl",
+        o,
+        "--rgl-res",
+        "3,4,5",
+        "-q",
+    ]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let bytes = std::fs::read(&out).unwrap();
+    assert_eq!(&bytes[..12], b"tensor_file\0");
+    fails(
+        &clothbake(&["export", "--weave", w, "--rgl", o]),
+        &["already exists", "--force"],
+    );
+    std::fs::remove_file(&out).unwrap();
+}

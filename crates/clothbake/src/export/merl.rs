@@ -234,7 +234,9 @@ mod tests {
             let a = cell_angles(cell.0, cell.1, cell.2);
             let (full, rf) = cell_value(&brdf, a, 16, false);
             let (half, rh) = cell_value(&brdf, a, 16, true);
-            assert!(rf > 1e-3, "{rf}");
+            // The test BRDF is anisotropic in every cell (less so near theta_h = 0), so the
+            // comparison below is not between two constants.
+            assert!(rf > 1e-4, "{rf}");
             assert!((rf - rh).abs() < 1e-12);
             for c in 0..3 {
                 assert!((full[c] - half[c]).abs() < 1e-12 * full[c].abs().max(1.0));
