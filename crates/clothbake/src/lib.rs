@@ -4,10 +4,14 @@
 //! theta_o, phi_o) grid of a fabric in parallel and returns the table; [`compare`] holds two
 //! tables against each other (`clothbake diff`, the golden tables of [`golden`]); [`albedo`]
 //! integrates a table's directional albedo (`clothbake info`); [`output`] writes tables with
-//! reproducible bytes. The file formats live in `clothbake-loader`.
+//! reproducible bytes. The file formats live in `clothbake-loader`, except the baker's own
+//! shard and checkpoint files ([`shard`], [`merge`], [`checkpoint`]; docs/cluster.md).
 
 pub mod albedo;
 pub mod bake;
+pub mod checkpoint;
 pub mod compare;
 pub mod golden;
+pub mod merge;
 pub mod output;
+pub mod shard;
