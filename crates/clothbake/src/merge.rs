@@ -147,7 +147,7 @@ pub fn merge(parts: &[(PathBuf, Part)]) -> Result<Table, PartError> {
             return Err(e(
                 p,
                 format!(
-                    "shard {id} again: {} is shard {id} too ({}), so these rows would be covered twice",
+                    "shard {id} is given twice (also as {}): its {} would be covered twice",
                     q.display(),
                     describe_rows(&g, &shard_rows(&orbits, id))
                 ),

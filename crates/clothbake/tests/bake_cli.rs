@@ -430,7 +430,7 @@ fn raytraced_and_two_bounce_tables() {
 /// so far, if any, are saved in the checkpoint (tests/shards.rs resumes one).
 #[cfg(unix)]
 #[test]
-fn interrupt_writes_nothing() {
+fn interrupt_writes_no_table() {
     let d = fresh_dir("interrupt");
     let twill = fabric("twill");
     // A bake of minutes: two bounces on the default grid.
