@@ -20,6 +20,7 @@ use clothbake_loader::{Grid, Metadata, Table, FORMAT_VERSION};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::Mutex;
 
 /// The default grid: 32 x 64 x 32 x 64 cells (2.8 degrees in theta, 5.6 in phi).
 pub const DEFAULT_GRID: Grid = Grid {
@@ -256,12 +257,259 @@ pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
 /// The number of cells [`bake`] evaluates on grid `g` (the others are copies): the total its
 /// `progress` counts up to.
 pub fn evaluations(fabric: &Fabric, g: &Grid) -> usize {
-    let syms = usable_symmetries(fabric, g);
-    let pairs = (0..g.n_phi_i as usize)
-        .flat_map(|pi| (0..g.n_phi_o as usize).map(move |po| (pi, po)))
-        .filter(|&(pi, po)| representative(pi, po, &syms, g) == (pi, po))
-        .count();
-    pairs * (g.n_theta_i as usize) * (g.n_theta_o as usize)
+    Orbits::new(g, &usable_symmetries(fabric, g)).evaluations()
+}
+
+/// The canonical values of one (theta_i, phi_i) row: one RGB triple per evaluated cell, in
+/// cell order (theta_o, then phi_o); the row's other cells are copies (see [`Orbits`]).
+pub type Row = Vec<[f32; 3]>;
+
+/// The rows of a grid are numbered `ti * n_phi_i + pi`, the order of the table's cells.
+pub fn row_cell(g: &Grid, row: usize) -> (u32, u32) {
+    let npi = g.n_phi_i as usize;
+    ((row / npi) as u32, (row % npi) as u32)
+}
+
+/// Which cells of a grid are evaluated and where the others copy from: the orbits of the
+/// symmetry group on the (phi_i, phi_o) cells, shared by every theta_i and theta_o.
+#[derive(Clone, Debug)]
+pub struct Orbits {
+    grid: Grid,
+    reps: Vec<(usize, usize)>,
+    /// Canonical phi_o cells per phi_i cell.
+    per_phi_i: Vec<usize>,
+}
+
+impl Orbits {
+    /// The orbits of `syms` (usable on `g`, see [`usable_symmetries`]).
+    pub fn new(g: &Grid, syms: &[Symmetry]) -> Orbits {
+        let (npi, npo) = (g.n_phi_i as usize, g.n_phi_o as usize);
+        let reps: Vec<(usize, usize)> = (0..npi)
+            .flat_map(|pi| (0..npo).map(move |po| (pi, po)))
+            .map(|(pi, po)| representative(pi, po, syms, g))
+            .collect();
+        let per_phi_i = (0..npi)
+            .map(|pi| {
+                (0..npo)
+                    .filter(|&po| reps[pi * npo + po] == (pi, po))
+                    .count()
+            })
+            .collect();
+        Orbits {
+            grid: *g,
+            reps,
+            per_phi_i,
+        }
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// Number of (theta_i, phi_i) rows.
+    pub fn rows(&self) -> usize {
+        (self.grid.n_theta_i * self.grid.n_phi_i) as usize
+    }
+
+    /// The representative of (pi, po).
+    pub fn rep(&self, pi: usize, po: usize) -> (usize, usize) {
+        self.reps[pi * self.grid.n_phi_o as usize + po]
+    }
+
+    fn canonical(&self, pi: usize, po: usize) -> bool {
+        self.rep(pi, po) == (pi, po)
+    }
+
+    /// Cells evaluated in `row` (the length of its [`Row`]).
+    pub fn row_evaluations(&self, row: usize) -> usize {
+        let (_, pi) = row_cell(&self.grid, row);
+        self.per_phi_i[pi as usize] * self.grid.n_theta_o as usize
+    }
+
+    /// Cells evaluated in the whole grid.
+    pub fn evaluations(&self) -> usize {
+        (0..self.rows()).map(|r| self.row_evaluations(r)).sum()
+    }
+
+    /// The table's values (RGB interleaved, cell order) from every row's canonical values:
+    /// canonical cells first, then the copies from their representatives, which may lie in
+    /// another row. `rows[r]` must hold [`Orbits::row_evaluations`]`(r)` values.
+    pub fn assemble(&self, rows: &[Row]) -> Vec<f32> {
+        let g = self.grid;
+        let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
+        assert_eq!(rows.len(), self.rows(), "one Row per grid row");
+        let mut values = vec![f32::NAN; g.len() * 3];
+        for (row, vals) in rows.iter().enumerate() {
+            assert_eq!(vals.len(), self.row_evaluations(row), "row {row}'s length");
+            let (ti, pi) = row_cell(&g, row);
+            let mut it = vals.iter();
+            for to in 0..nto {
+                for po in 0..npo {
+                    if self.canonical(pi as usize, po as usize) {
+                        let v = it.next().expect("one value per canonical cell");
+                        values[3 * g.index(ti, pi, to, po)..][..3].copy_from_slice(v);
+                    }
+                }
+            }
+        }
+        for ti in 0..nti {
+            for pi in 0..npi {
+                for po in 0..npo {
+                    let (ri, ro) = self.rep(pi as usize, po as usize);
+                    if (ri, ro) == (pi as usize, po as usize) {
+                        continue;
+                    }
+                    for to in 0..nto {
+                        let src = 3 * g.index(ti, ri as u32, to, ro as u32);
+                        let dst = 3 * g.index(ti, pi, to, po);
+                        values.copy_within(src..src + 3, dst);
+                    }
+                }
+            }
+        }
+        values
+    }
+}
+
+/// The symmetry as stored in the table's metadata: the names joined by ", ", or "none".
+pub fn symmetry_name(syms: &[Symmetry]) -> String {
+    if syms.is_empty() {
+        "none".to_string()
+    } else {
+        syms.iter().map(|s| s.name()).collect::<Vec<_>>().join(", ")
+    }
+}
+
+/// The tool name stored in tables and shard files: `clothbake <version>`.
+pub fn tool_name() -> String {
+    format!("clothbake {}", env!("CARGO_PKG_VERSION"))
+}
+
+type CellFn = Box<dyn Fn(usize, UnitVec3, UnitVec3) -> [f64; 3] + Sync + Send>;
+
+/// A prepared bake: the cell evaluator, the orbits and the metadata of the table it makes.
+/// Rows are evaluated independently ([`Baker::eval_row`]), by one process ([`bake`]) or by
+/// several (shards, `clothbake merge`), with the same values.
+pub struct Baker {
+    orbits: Orbits,
+    syms: Vec<Symmetry>,
+    eval: CellFn,
+    meta: Metadata,
+}
+
+impl Baker {
+    /// Checks the options and prepares the model (or the ray tracer).
+    pub fn new(fabric: &Fabric, opts: &BakeOptions) -> Result<Baker, BakeError> {
+        check_options(opts)?;
+        let g = opts.grid;
+        let syms = usable_symmetries(fabric, &g);
+        let secondary = (opts.bounces == 2).then_some(opts.secondary);
+        let eval: CellFn = match opts.method {
+            Method::Analytic { variant } => {
+                let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
+                Box::new(move |_, wi, wo| m.eval_with(wi, wo, secondary.as_ref()).brdf(wi))
+            }
+            Method::Raytrace {
+                samples,
+                seed,
+                caps,
+            } => {
+                let rt = RayTracer::new(fabric, opts.facet).with_caps(caps);
+                Box::new(move |c, wi, wo| {
+                    rt.render(wi, wo, samples, seed.wrapping_add(c as u64))
+                        .reflection
+                        .brdf(wi)
+                })
+            }
+        };
+        let meta = Metadata {
+            format_version: FORMAT_VERSION,
+            tool: tool_name(),
+            grid: g,
+            centring: "cell".into(),
+            quantity: "f_r".into(),
+            units: "1/sr".into(),
+            fabric_json: fabric.to_json().to_string(),
+            options_json: opts.to_json().to_string(),
+            symmetry: symmetry_name(&syms),
+        };
+        Ok(Baker {
+            orbits: Orbits::new(&g, &syms),
+            syms,
+            eval,
+            meta,
+        })
+    }
+
+    /// The orbits (which cells are evaluated).
+    pub fn orbits(&self) -> &Orbits {
+        &self.orbits
+    }
+
+    /// The symmetries used.
+    pub fn symmetries(&self) -> &[Symmetry] {
+        &self.syms
+    }
+
+    /// The metadata of the table this bake makes.
+    pub fn metadata(&self) -> &Metadata {
+        &self.meta
+    }
+
+    /// Evaluates the canonical cells of `row`; `None` when `cancel` was raised meanwhile.
+    pub fn eval_row(&self, row: usize, cancel: &AtomicBool) -> Option<Row> {
+        let g = self.orbits.grid;
+        let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
+        let (ti, pi) = row_cell(&g, row);
+        let wi = direction(ti, nti, pi, npi);
+        let mut out = Vec::with_capacity(self.orbits.row_evaluations(row));
+        for to in 0..nto {
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            for po in 0..npo {
+                if !self.orbits.canonical(pi as usize, po as usize) {
+                    continue;
+                }
+                let c = g.index(ti, pi, to, po);
+                let v = (self.eval)(c, wi, direction(to, nto, po, npo));
+                out.push(v.map(|x| x as f32));
+            }
+        }
+        Some(out)
+    }
+
+    /// Evaluates `rows` in parallel on the current rayon pool, handing each finished row to
+    /// `sink` (from worker threads, in no particular order). `progress` receives the number of
+    /// cells evaluated so far by this call, after each row. Stops with
+    /// [`BakeError::Cancelled`] when `cancel` is raised; rows finished before are delivered.
+    pub fn sweep(
+        &self,
+        rows: &[usize],
+        progress: &(dyn Fn(u64) + Sync),
+        cancel: &AtomicBool,
+        sink: &(dyn Fn(usize, Row) + Sync),
+    ) -> Result<(), BakeError> {
+        let done = AtomicU64::new(0);
+        rows.par_iter().for_each(|&row| {
+            if let Some(vals) = self.eval_row(row, cancel) {
+                let n = vals.len() as u64;
+                sink(row, vals);
+                progress(done.fetch_add(n, Ordering::Relaxed) + n);
+            }
+        });
+        if cancel.load(Ordering::Relaxed) {
+            return Err(BakeError::Cancelled);
+        }
+        Ok(())
+    }
+
+    /// The finished table from every row's canonical values.
+    pub fn table(&self, rows: &[Row]) -> Result<Table, BakeError> {
+        Table::new(self.meta.clone(), self.orbits.assemble(rows))
+            .map_err(|e| BakeError::Invalid(e.to_string()))
+    }
 }
 
 /// Bakes `fabric` on `opts.grid`. `progress` receives the number of cells evaluated so far, up
@@ -276,116 +524,21 @@ pub fn bake(
     progress: &(dyn Fn(u64) + Sync),
     cancel: &AtomicBool,
 ) -> Result<Baked, BakeError> {
-    check_options(opts)?;
-    let g = opts.grid;
-    let syms = usable_symmetries(fabric, &g);
-    let secondary = (opts.bounces == 2).then_some(opts.secondary);
-    let eval: Box<dyn Fn(usize, UnitVec3, UnitVec3) -> [f64; 3] + Sync> = match opts.method {
-        Method::Analytic { variant } => {
-            let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
-            Box::new(move |_, wi, wo| m.eval_with(wi, wo, secondary.as_ref()).brdf(wi))
-        }
-        Method::Raytrace {
-            samples,
-            seed,
-            caps,
-        } => {
-            let rt = RayTracer::new(fabric, opts.facet).with_caps(caps);
-            Box::new(move |c, wi, wo| {
-                rt.render(wi, wo, samples, seed.wrapping_add(c as u64))
-                    .reflection
-                    .brdf(wi)
-            })
-        }
-    };
-    let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
-    // Which (pi, po) pairs are evaluated, and where the others copy from.
-    let reps: Vec<(usize, usize)> = (0..npi as usize)
-        .flat_map(|pi| (0..npo as usize).map(move |po| (pi, po)))
-        .map(|(pi, po)| representative(pi, po, &syms, &g))
+    let baker = Baker::new(fabric, opts)?;
+    let all: Vec<usize> = (0..baker.orbits.rows()).collect();
+    let slots: Vec<Mutex<Row>> = all.iter().map(|_| Mutex::new(Vec::new())).collect();
+    baker.sweep(&all, progress, cancel, &|row, vals| {
+        *slots[row].lock().expect("no panics while held") = vals;
+    })?;
+    let rows: Vec<Row> = slots
+        .into_iter()
+        .map(|m| m.into_inner().expect("no panics while held"))
         .collect();
-    let rep = |pi: usize, po: usize| reps[pi * npo as usize + po];
-    let done = AtomicU64::new(0);
-    // One row per (theta_i, phi_i): its canonical cells' values, in cell order.
-    let rows: Vec<Vec<[f32; 3]>> = (0..(nti * npi) as usize)
-        .into_par_iter()
-        .map(|row| {
-            let (ti, pi) = ((row / npi as usize) as u32, (row % npi as usize) as u32);
-            let wi = direction(ti, nti, pi, npi);
-            let mut out = Vec::new();
-            for to in 0..nto {
-                if cancel.load(Ordering::Relaxed) {
-                    return Vec::new();
-                }
-                for po in 0..npo {
-                    if rep(pi as usize, po as usize) != (pi as usize, po as usize) {
-                        continue;
-                    }
-                    let c = g.index(ti, pi, to, po);
-                    let v = eval(c, wi, direction(to, nto, po, npo));
-                    out.push(v.map(|x| x as f32));
-                }
-            }
-            let n = out.len() as u64;
-            progress(done.fetch_add(n, Ordering::Relaxed) + n);
-            out
-        })
-        .collect();
-    if cancel.load(Ordering::Relaxed) {
-        return Err(BakeError::Cancelled);
-    }
-    // Scatter: canonical cells first, then copies from their representatives.
-    let mut values = vec![f32::NAN; g.len() * 3];
-    let mut evaluated = 0;
-    for (row, vals) in rows.iter().enumerate() {
-        let (ti, pi) = ((row / npi as usize) as u32, (row % npi as usize) as u32);
-        let mut it = vals.iter();
-        for to in 0..nto {
-            for po in 0..npo {
-                if rep(pi as usize, po as usize) == (pi as usize, po as usize) {
-                    let v = it.next().expect("one value per canonical cell");
-                    values[3 * g.index(ti, pi, to, po)..][..3].copy_from_slice(v);
-                    evaluated += 1;
-                }
-            }
-        }
-    }
-    for ti in 0..nti {
-        for pi in 0..npi {
-            for po in 0..npo {
-                let (ri, ro) = rep(pi as usize, po as usize);
-                if (ri, ro) == (pi as usize, po as usize) {
-                    continue;
-                }
-                for to in 0..nto {
-                    let src = 3 * g.index(ti, ri as u32, to, ro as u32);
-                    let dst = 3 * g.index(ti, pi, to, po);
-                    values.copy_within(src..src + 3, dst);
-                }
-            }
-        }
-    }
-    let symmetry = if syms.is_empty() {
-        "none".to_string()
-    } else {
-        syms.iter().map(|s| s.name()).collect::<Vec<_>>().join(", ")
-    };
-    let meta = Metadata {
-        format_version: FORMAT_VERSION,
-        tool: format!("clothbake {}", env!("CARGO_PKG_VERSION")),
-        grid: g,
-        centring: "cell".into(),
-        quantity: "f_r".into(),
-        units: "1/sr".into(),
-        fabric_json: fabric.to_json().to_string(),
-        options_json: opts.to_json().to_string(),
-        symmetry,
-    };
-    let table = Table::new(meta, values).map_err(|e| BakeError::Invalid(e.to_string()))?;
+    let table = baker.table(&rows)?;
     Ok(Baked {
         table,
-        symmetries: syms,
-        evaluated,
+        evaluated: baker.orbits.evaluations(),
+        symmetries: baker.syms,
     })
 }
 

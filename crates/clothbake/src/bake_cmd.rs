@@ -6,19 +6,25 @@
 //! then write the table atomically through the loader. Ctrl-C raises the cancel flag: the bake
 //! stops and nothing is written (exit 130; a second Ctrl-C exits at once).
 
-use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg};
+use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg, ShardArg};
 use crate::cli::{DEFAULT_SAMPLES, DEFAULT_SEED};
-use crate::error::CliError;
+use crate::error::{table_error, CliError};
 use crate::eval_cmd::apply_material;
-use clothbake::bake::{self, BakeError, BakeOptions, Method, DEFAULT_GRID};
+use clothbake::bake::{self, BakeError, BakeOptions, Baker, Method, DEFAULT_GRID};
+use clothbake::checkpoint::{checkpoint_path, Checkpointer, DEFAULT_INTERVAL};
+use clothbake::merge;
 use clothbake::output::{write_table, Format};
+use clothbake::shard::{
+    describe_rows, read_part, shard_from_env, shard_rows, write_part, Kind, Part, ShardId,
+};
 use clothbake_core::{Caps, Fabric, Variant};
 use clothbake_loader::{Precision, TableError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Raised by Ctrl-C.
 static CANCEL: AtomicBool = AtomicBool::new(false);
@@ -41,6 +47,10 @@ pub struct Plan {
     pub threads: usize,
     /// The bake options (the fabric-independent part of the table).
     pub options: BakeOptions,
+    /// The shard to bake (the output is then a shard file), and where `auto` found it.
+    pub shard: Option<(ShardId, Option<String>)>,
+    /// Time between checkpoints.
+    pub checkpoint_every: Duration,
 }
 
 fn ext_format(p: &Path) -> Option<FormatArg> {
@@ -51,8 +61,56 @@ fn ext_format(p: &Path) -> Option<FormatArg> {
     }
 }
 
+/// The table format and EXR precision from `--format`, the output's extension and
+/// `--precision` (shared by `bake` and `merge`).
+pub fn output_format(
+    format: Option<FormatArg>,
+    output: Option<&Path>,
+    precision: Option<PrecisionArg>,
+) -> Result<(FormatArg, Precision), CliError> {
+    let format = match (format, output) {
+        (Some(f), Some(out)) => match ext_format(out) {
+            Some(e) if e != f => {
+                return Err(CliError::new(
+                    format!(
+                        "--format {} but the output {} ends in .{}",
+                        f.ext(),
+                        out.display(),
+                        e.ext()
+                    ),
+                    format!("name the output *.{} or drop --format", f.ext()),
+                ))
+            }
+            _ => f,
+        },
+        (Some(f), None) => f,
+        (None, Some(out)) => ext_format(out).unwrap_or(FormatArg::Exr),
+        (None, None) => FormatArg::Exr,
+    };
+    let precision = match (precision, format) {
+        (Some(_), FormatArg::Bin) => {
+            return Err(CliError::new(
+                "--precision applies only to EXR tables: binary tables always hold f32",
+                "drop --precision or write an EXR table (--format exr)",
+            ))
+        }
+        (Some(PrecisionArg::F32), _) => Precision::F32,
+        _ => Precision::F16,
+    };
+    Ok((format, precision))
+}
+
 /// Checks the option combinations and resolves the defaults; reads no file.
 pub fn plan(weave: &Path, o: &BakeOpts) -> Result<Plan, CliError> {
+    plan_with_env(weave, o, &|k| std::env::var(k).ok())
+}
+
+/// [`plan`] with the environment (for `--shard auto`) given by `env`.
+pub fn plan_with_env(
+    weave: &Path,
+    o: &BakeOpts,
+    env: &dyn Fn(&str) -> Option<String>,
+) -> Result<Plan, CliError> {
     let raytrace = o.method == MethodArg::Raytrace;
     if !raytrace && (o.samples.is_some() || o.seed.is_some() || o.caps.is_some()) {
         return Err(CliError::new(
@@ -74,35 +132,27 @@ pub fn plan(weave: &Path, o: &BakeOpts) -> Result<Plan, CliError> {
              two-level sampling of the secondary reflection)",
         ));
     }
-    let format = match (o.format, &o.output) {
-        (Some(f), Some(out)) => match ext_format(out) {
-            Some(e) if e != f => {
-                return Err(CliError::new(
-                    format!(
-                        "--format {} but the output {} ends in .{}",
-                        f.ext(),
-                        out.display(),
-                        e.ext()
-                    ),
-                    format!("name the output *.{} or drop --format", f.ext()),
-                ))
-            }
-            _ => f,
-        },
-        (Some(f), None) => f,
-        (None, Some(out)) => ext_format(out).unwrap_or(FormatArg::Exr),
-        (None, None) => FormatArg::Exr,
-    };
-    let precision = match (o.precision, format) {
-        (Some(_), FormatArg::Bin) => {
+    let shard = match (o.shard, o.shards) {
+        (None, None) => None,
+        (None, Some(_)) | (Some(ShardArg::Fixed(_)), Some(_)) => {
             return Err(CliError::new(
-                "--precision applies only to EXR tables: binary tables always hold f32",
-                "drop --precision or write an EXR table (--format exr)",
+                "--shards goes with --shard auto (Kubernetes Indexed Jobs)",
+                "give --shard K/N alone, or --shard auto --shards N",
             ))
         }
-        (Some(PrecisionArg::F32), _) => Precision::F32,
-        _ => Precision::F16,
+        (Some(ShardArg::Fixed(id)), None) => Some((id, None)),
+        (Some(ShardArg::Auto), n) => {
+            let (id, how) = shard_from_env(env, n).map_err(CliError::line)?;
+            Some((id, Some(how)))
+        }
     };
+    if shard.is_some() && (o.format.is_some() || o.precision.is_some()) {
+        return Err(CliError::new(
+            "--format and --precision do not apply to a shard: shards have their own file format",
+            "give them to `clothbake merge`, which writes the table",
+        ));
+    }
+    let (format, precision) = output_format(o.format, o.output.as_deref(), o.precision)?;
     let output = match &o.output {
         Some(p) => p.clone(),
         None => {
@@ -113,8 +163,13 @@ pub fn plan(weave: &Path, o: &BakeOpts) -> Result<Plan, CliError> {
                 )
             })?;
             let mut name = stem.to_os_string();
-            name.push(".");
-            name.push(format.ext());
+            match shard {
+                Some((id, _)) => name.push(format!("-{}-of-{}.shard", id.index, id.count)),
+                None => {
+                    name.push(".");
+                    name.push(format.ext());
+                }
+            }
             PathBuf::from(name)
         }
     };
@@ -155,12 +210,16 @@ pub fn plan(weave: &Path, o: &BakeOpts) -> Result<Plan, CliError> {
         precision,
         threads,
         options,
+        shard,
+        checkpoint_every: o
+            .checkpoint_every
+            .map_or(DEFAULT_INTERVAL, Duration::from_secs_f64),
     })
 }
 
 /// Refuses an output that would fail only after the bake: an existing file without --force, a
 /// missing folder, a folder we may not write into.
-fn preflight(out: &Path, force: bool) -> Result<(), CliError> {
+pub fn preflight(out: &Path, force: bool) -> Result<(), CliError> {
     if !force && std::fs::symlink_metadata(out).is_ok() {
         return Err(TableError::AlreadyExists {
             path: out.to_path_buf(),
@@ -263,12 +322,118 @@ pub fn thousands(n: u64) -> String {
     groups.join(",")
 }
 
+/// The rows of an earlier run of this bake, from its checkpoint; `what` names the output.
+fn load_checkpoint(
+    path: &Path,
+    baker: &Baker,
+    shard: Option<ShardId>,
+    rows: &std::ops::Range<usize>,
+) -> Result<BTreeMap<usize, bake::Row>, CliError> {
+    let part = read_part(path, merge::orbits_of).map_err(|e| {
+        CliError::new(
+            e.to_string(),
+            format!("or delete {} to start the bake again", path.display()),
+        )
+    })?;
+    let restart = format!("delete {} to start again", path.display());
+    if part.kind != Kind::Checkpoint {
+        return Err(CliError::new(
+            format!("{}: not a checkpoint", path.display()),
+            restart,
+        ));
+    }
+    let (m, want) = (&part.meta, baker.metadata());
+    let differs = if m.tool != want.tool {
+        Some(format!("was written by {}, this is {}", m.tool, want.tool))
+    } else if m.fabric_json != want.fabric_json {
+        Some("is of another fabric (or other material overrides)".to_string())
+    } else if m.options_json != want.options_json {
+        Some(format!(
+            "is of a bake with other options ({} instead of {})",
+            m.options_json, want.options_json
+        ))
+    } else if m != want {
+        Some("has other metadata".to_string())
+    } else if part.shard != shard {
+        let name =
+            |s: Option<ShardId>| s.map_or("the whole table".into(), |s| format!("shard {s}"));
+        Some(format!(
+            "is of {}, this bake is of {}",
+            name(part.shard),
+            name(shard)
+        ))
+    } else {
+        None
+    };
+    if let Some(d) = differs {
+        return Err(CliError::new(
+            format!("{}: the checkpoint {d}", path.display()),
+            format!("resume with the command that wrote it, or {restart}"),
+        ));
+    }
+    if let Some(r) = part.rows.keys().find(|r| !rows.contains(r)) {
+        return Err(CliError::new(
+            format!(
+                "{}: the checkpoint holds row {r}, outside this bake's rows",
+                path.display()
+            ),
+            restart,
+        ));
+    }
+    Ok(part.rows)
+}
+
 /// Runs a bake and returns the summary line for stdout (empty with --quiet).
 pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     let plan = plan(weave, o)?;
     let fabric = Fabric::from_path(&plan.weave)?;
     let fabric = apply_material(fabric, &o.material);
     preflight(&plan.output, o.force)?;
+    let shard = plan.shard.as_ref().map(|(id, _)| *id);
+    if let Some((_, Some(how))) = &plan.shard {
+        if !o.quiet {
+            eprintln!("clothbake: {how}");
+        }
+    }
+    let baker = Baker::new(&fabric, &plan.options).map_err(|e| CliError::line(e.to_string()))?;
+    let rows = match shard {
+        Some(id) => shard_rows(baker.orbits(), id),
+        None => 0..baker.orbits().rows(),
+    };
+    let ck_path = checkpoint_path(&plan.output);
+    let exists = std::fs::symlink_metadata(&ck_path).is_ok();
+    let resumed = match (exists, o.resume) {
+        (true, true) => load_checkpoint(&ck_path, &baker, shard, &rows)?,
+        (true, false) => {
+            return Err(CliError::new(
+                format!(
+                    "{} exists: the checkpoint of an interrupted bake of {}",
+                    ck_path.display(),
+                    plan.output.display()
+                ),
+                format!(
+                    "continue it with the same command and --resume, or delete {} to start again",
+                    ck_path.display()
+                ),
+            ))
+        }
+        (false, _) => BTreeMap::new(),
+    };
+    if o.resume && !o.quiet {
+        if exists {
+            eprintln!(
+                "clothbake: resuming from {}: {} of {} rows done",
+                ck_path.display(),
+                resumed.len(),
+                rows.len()
+            );
+        } else {
+            eprintln!(
+                "clothbake: no checkpoint {} to resume from: starting at the beginning",
+                ck_path.display()
+            );
+        }
+    }
     install_ctrlc();
 
     let start = Instant::now();
@@ -282,53 +447,117 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
             )
         })?;
     let g = plan.options.grid;
-    let total = g.len() as u64;
-    let bar = progress_bar(bake::evaluations(&fabric, &g) as u64, o.quiet);
+    let orbits = baker.orbits();
+    let todo: Vec<usize> = rows.clone().filter(|r| !resumed.contains_key(r)).collect();
+    let to_evaluate: usize = todo.iter().map(|&r| orbits.row_evaluations(r)).sum();
+    let done_before: usize = resumed.keys().map(|&r| orbits.row_evaluations(r)).sum();
+    let bar = progress_bar((to_evaluate + done_before) as u64, o.quiet);
     let shown = AtomicU64::new(0);
     let progress = |n: u64| {
         if let Some(b) = &bar {
             // Rows finish out of order: show the largest count seen.
             let m = shown.fetch_max(n, Ordering::Relaxed).max(n);
-            b.set_position(m);
+            b.set_position(done_before as u64 + m);
         }
     };
-    let result = pool.install(|| bake::bake(&fabric, &plan.options, &progress, &CANCEL));
+    let ck = Checkpointer::new(
+        ck_path.clone(),
+        plan.checkpoint_every,
+        shard,
+        baker.metadata().clone(),
+        resumed,
+    );
+    let warned = AtomicBool::new(false);
+    let sink = |row: usize, vals: bake::Row| {
+        if let Err(e) = ck.record(row, vals) {
+            if !warned.swap(true, Ordering::Relaxed) {
+                eprintln!(
+                    "clothbake: warning: the checkpoint could not be written ({}); the bake goes on",
+                    table_error(&e)
+                );
+            }
+        }
+    };
+    let result = pool.install(|| baker.sweep(&todo, &progress, &CANCEL, &sink));
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let baked = match result {
-        Ok(b) => b,
-        Err(BakeError::Cancelled) => {
-            return Err(CliError::line("interrupted; nothing was written").with_code(INTERRUPTED))
+    match result {
+        Ok(()) if !CANCEL.load(Ordering::SeqCst) => {}
+        Ok(()) | Err(BakeError::Cancelled) => {
+            let what = if shard.is_some() { "shard" } else { "table" };
+            let msg = match ck.save() {
+                Ok(0) => "interrupted; nothing was written".to_string(),
+                Ok(n) => format!(
+                    "interrupted; no {what} was written, {n} of {} rows are saved in {}; run the \
+                     same command with --resume to continue",
+                    rows.len(),
+                    ck_path.display()
+                ),
+                Err(e) => format!(
+                    "interrupted; nothing was written (the checkpoint could not be saved: {})",
+                    table_error(&e)
+                ),
+            };
+            return Err(CliError::line(msg).with_code(INTERRUPTED));
         }
         Err(BakeError::Invalid(m)) => return Err(CliError::line(m)),
-    };
-    if CANCEL.load(Ordering::SeqCst) {
-        return Err(CliError::line("interrupted; nothing was written").with_code(INTERRUPTED));
     }
-    let format = match plan.format {
-        FormatArg::Exr => Format::Exr(plan.precision),
-        FormatArg::Bin => Format::Binary,
+    let done = ck.into_rows();
+    let evaluated: usize = done.keys().map(|&r| orbits.row_evaluations(r)).sum();
+    let what = match shard {
+        Some(id) => {
+            let part = Part {
+                kind: Kind::Shard,
+                shard: Some(id),
+                meta: baker.metadata().clone(),
+                rows: done,
+            };
+            write_part(&plan.output, &part, o.force)?;
+            format!("shard {id}, {}", describe_rows(&g, &rows))
+        }
+        None => {
+            let all: Vec<bake::Row> = done.into_values().collect();
+            let table = baker
+                .table(&all)
+                .map_err(|e| CliError::line(e.to_string()))?;
+            let format = match plan.format {
+                FormatArg::Exr => Format::Exr(plan.precision),
+                FormatArg::Bin => Format::Binary,
+            };
+            write_table(&plan.output, &table, format, o.force)?;
+            format!(
+                "grid {}x{}x{}x{} (theta_i x phi_i x theta_o x phi_o)",
+                g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o
+            )
+        }
     };
-    write_table(&plan.output, &baked.table, format, o.force)?;
+    // The output is in place: the checkpoint has served.
+    match std::fs::remove_file(&ck_path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => eprintln!(
+            "clothbake: warning: cannot remove the checkpoint {}: {e}",
+            ck_path.display()
+        ),
+        _ => {}
+    }
     let secs = start.elapsed().as_secs_f64();
     if o.quiet {
         return Ok(String::new());
     }
-    let symmetry = if baked.symmetries.is_empty() {
+    let symmetry = if baker.symmetries().is_empty() {
         "no symmetry".to_string()
     } else {
-        format!("symmetry {}", baked.table.meta.symmetry)
+        format!("symmetry {}", baker.metadata().symmetry)
     };
+    let total = match shard {
+        Some(_) => rows.len() * (g.n_theta_o * g.n_phi_o) as usize,
+        None => g.len(),
+    } as u64;
     Ok(format!(
-        "wrote {}: grid {}x{}x{}x{} (theta_i x phi_i x theta_o x phi_o), {} of {} cells evaluated \
-         ({symmetry}), {secs:.2} s, {} cells/s, {} thread{}\n",
+        "wrote {}: {what}, {} of {} cells evaluated ({symmetry}), {secs:.2} s, {} cells/s, {} \
+         thread{}\n",
         plan.output.display(),
-        g.n_theta_i,
-        g.n_phi_i,
-        g.n_theta_o,
-        g.n_phi_o,
-        thousands(baked.evaluated as u64),
+        thousands(evaluated as u64),
         thousands(total),
         thousands((total as f64 / secs.max(1e-9)).round() as u64),
         plan.threads,

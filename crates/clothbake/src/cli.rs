@@ -7,6 +7,7 @@
 
 use crate::error::CliError;
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use clothbake::shard::{parse_shard_id, ShardId};
 use clothbake_core::interreflection::{Orders, Ranges, Sampling};
 use clothbake_core::{
     Caps, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
@@ -58,6 +59,8 @@ pub enum Command {
     /// Export a fabric's BRDF for other renderers: the RGL `.bsdf` of Mitsuba 3's `measured`
     /// BSDF, or the isotropic MERL binary (averaged over rotations about the normal).
     Export(ExportArgs),
+    /// Merge the shard files of a bake (`bake --shard K/N`) into the table (docs/cluster.md).
+    Merge(MergeArgs),
 }
 
 /// `clothbake bake`.
@@ -137,6 +140,90 @@ pub struct BakeOpts {
     /// Material overrides, applied to both yarn groups.
     #[command(flatten)]
     pub material: MaterialArgs,
+
+    /// Bake only shard K of N (K 0-based, 0 to N-1) of the (theta_i, phi_i) rows into a shard
+    /// file [default output: <fabric stem>-K-of-N.shard]; `auto`: K and N from a SLURM job
+    /// array or a Kubernetes Indexed Job (with --shards). Merge with `clothbake merge`.
+    #[arg(long, value_name = "K/N|auto", value_parser = parse_shard)]
+    pub shard: Option<ShardArg>,
+
+    /// With --shard auto: the number of shards (required with Kubernetes' JOB_COMPLETION_INDEX;
+    /// with SLURM it must equal SLURM_ARRAY_TASK_COUNT).
+    #[arg(long, value_name = "N", value_parser = parse_shard_count)]
+    pub shards: Option<u32>,
+
+    /// Continue an interrupted bake from its checkpoint (<output>.checkpoint), if there is one.
+    #[arg(long)]
+    pub resume: bool,
+
+    /// Seconds between checkpoints of the finished rows [default: 60].
+    #[arg(long, value_name = "SECS", value_parser = parse_seconds)]
+    pub checkpoint_every: Option<f64>,
+}
+
+/// `--shard` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShardArg {
+    /// Shard K of N, given.
+    Fixed(ShardId),
+    /// From the scheduler's environment.
+    Auto,
+}
+
+/// `clothbake merge`.
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// The table to write (.exr or .bin).
+    #[arg(short = 'o', long, value_name = "TABLE")]
+    pub output: PathBuf,
+
+    /// Every shard file of the bake (any order).
+    #[arg(value_name = "SHARD", required = true)]
+    pub shards: Vec<PathBuf>,
+
+    /// Table format [default: from the output's extension, .exr or .bin; otherwise exr].
+    #[arg(long, value_enum)]
+    pub format: Option<FormatArg>,
+
+    /// Sample precision of an EXR table [default: f16].
+    #[arg(long, value_enum)]
+    pub precision: Option<PrecisionArg>,
+
+    /// Overwrite an existing table.
+    #[arg(long)]
+    pub force: bool,
+
+    /// Print nothing but errors.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
+/// Parses `--shard K/N` or `auto`.
+pub fn parse_shard(s: &str) -> Result<ShardArg, String> {
+    if s.trim() == "auto" {
+        return Ok(ShardArg::Auto);
+    }
+    parse_shard_id(s).map(ShardArg::Fixed)
+}
+
+/// Parses `--shards N` (N >= 1).
+pub fn parse_shard_count(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "--shards `{s}` is not a whole number of at least 1; give the number of shards, e.g. --shards 4"
+        )),
+    }
+}
+
+/// Parses `--checkpoint-every SECS` (finite, >= 0; 0 saves after every row).
+pub fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && (0.0..=1e9).contains(&x) => Ok(x),
+        _ => Err(format!(
+            "--checkpoint-every `{s}` is not a number of seconds; give e.g. --checkpoint-every 300"
+        )),
+    }
 }
 
 /// `clothbake info`.

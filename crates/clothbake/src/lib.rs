@@ -5,11 +5,15 @@
 //! tables against each other (`clothbake diff`, the golden tables of [`golden`]); [`albedo`]
 //! integrates a table's directional albedo (`clothbake info`); [`output`] writes tables with
 //! reproducible bytes; [`export`] writes the BRDF for other renderers (RGL `.bsdf`,
-//! MERL binary). The file formats live in `clothbake-loader`.
+//! MERL binary). The file formats live in `clothbake-loader`, except the baker's own
+//! shard and checkpoint files ([`shard`], [`merge`], [`checkpoint`]; docs/cluster.md).
 
 pub mod albedo;
 pub mod bake;
+pub mod checkpoint;
 pub mod compare;
 pub mod export;
 pub mod golden;
+pub mod merge;
 pub mod output;
+pub mod shard;

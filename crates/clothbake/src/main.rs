@@ -10,6 +10,7 @@ mod error;
 mod eval_cmd;
 mod export_cmd;
 mod info_cmd;
+mod merge_cmd;
 mod report;
 
 use clap::error::ErrorKind;
@@ -64,6 +65,7 @@ fn run() -> Result<u8, CliError> {
                 Some("info") => "clothbake info",
                 Some("diff") => "clothbake diff",
                 Some("export") => "clothbake export",
+                Some("merge") => "clothbake merge",
                 _ => "clothbake",
             };
             return Err(error::from_clap(&e, sub));
@@ -75,6 +77,7 @@ fn run() -> Result<u8, CliError> {
         Some(Command::Info(args)) => (info_cmd::run(&args)?, 0),
         Some(Command::Diff(args)) => diff_cmd::run(&args)?,
         Some(Command::Export(args)) => (export_cmd::run(&args)?, 0),
+        Some(Command::Merge(args)) => (merge_cmd::run(&args)?, 0),
         None => match &cli.weave {
             Some(w) => (bake_cmd::run(w, &cli.bake)?, 0),
             None => return Err(no_command()),

@@ -1,0 +1,49 @@
+//! `clothbake merge -o TABLE SHARD...`: the shards of a bake into its table.
+//!
+//! Reads every shard (refusing damaged or foreign files), checks them with
+//! [`clothbake::merge::merge`] (same fabric, options, grid and tool version; every shard once),
+//! then writes the table atomically through the loader. Any failure: one line naming the shard
+//! and the cause, exit 2, nothing written.
+
+use crate::bake_cmd::{output_format, preflight};
+use crate::cli::{FormatArg, MergeArgs};
+use crate::error::CliError;
+use clothbake::merge::{merge, orbits_of};
+use clothbake::output::{write_table, Format};
+use clothbake::shard::read_part;
+
+/// Runs the merge and returns the summary line for stdout (empty with --quiet).
+pub fn run(a: &MergeArgs) -> Result<String, CliError> {
+    let (format, precision) = output_format(a.format, Some(&a.output), a.precision)?;
+    if a.output.file_name().is_none() {
+        return Err(CliError::new(
+            format!("the output {} does not name a file", a.output.display()),
+            "give a file name with -o TABLE, e.g. -o twill.exr",
+        ));
+    }
+    preflight(&a.output, a.force)?;
+    let mut parts = Vec::with_capacity(a.shards.len());
+    for p in &a.shards {
+        let part = read_part(p, orbits_of).map_err(|e| CliError::line(e.to_string()))?;
+        parts.push((p.clone(), part));
+    }
+    let table = merge(&parts).map_err(|e| CliError::line(e.to_string()))?;
+    let format = match format {
+        FormatArg::Exr => Format::Exr(precision),
+        FormatArg::Bin => Format::Binary,
+    };
+    write_table(&a.output, &table, format, a.force)?;
+    if a.quiet {
+        return Ok(String::new());
+    }
+    let g = table.meta.grid;
+    Ok(format!(
+        "wrote {}: {} shards merged, grid {}x{}x{}x{} (theta_i x phi_i x theta_o x phi_o)\n",
+        a.output.display(),
+        parts.len(),
+        g.n_theta_i,
+        g.n_phi_i,
+        g.n_theta_o,
+        g.n_phi_o
+    ))
+}

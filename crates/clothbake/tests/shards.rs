@@ -1,0 +1,413 @@
+//! Shards, merge, checkpoint and resume, driving the built binary as separate processes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn fabric(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tables")
+        .join(format!("{name}.json"))
+        .canonicalize()
+        .unwrap()
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn fresh_dir(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("shards-{name}"));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn cmd(dir: &Path, args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_clothbake"));
+    c.args(args)
+        .current_dir(dir)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("JOB_COMPLETION_INDEX")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    c
+}
+
+fn run_in(dir: &Path, args: &[&str]) -> Output {
+    cmd(dir, args).output().expect("run the clothbake binary")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn succeeds(out: &Output) -> String {
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "stdout: {}\nstderr: {}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    text(&out.stdout)
+}
+
+/// Exit status 2, one line on stderr containing every needle.
+fn fails_with(out: &Output, needles: &[&str]) -> String {
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert_eq!(err.lines().count(), 1, "not one line: {err:?}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} does not contain {n:?}");
+    }
+    err
+}
+
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// `clothbake diff A B --tol 0 --abs 0`: exit 0 and no value differs.
+fn identical(dir: &Path, a: &str, b: &str) {
+    let out = succeeds(&run_in(dir, &["diff", a, b, "--tol", "0", "--abs", "0"]));
+    assert!(out.contains("every value is equal"), "{out}");
+    assert!(out.contains("same fabric, options and tool"), "{out}");
+    assert_eq!(
+        std::fs::read(dir.join(a)).unwrap(),
+        std::fs::read(dir.join(b)).unwrap(),
+        "{a} and {b} differ in their bytes"
+    );
+}
+
+const RES: &str = "8,16,8,16";
+
+#[test]
+fn four_shards_two_at_a_time_merge_to_the_single_bake() {
+    let d = fresh_dir("four");
+    let twill = fabric("twill");
+    let base = [
+        "bake",
+        "--weave",
+        twill.as_str(),
+        "--res",
+        RES,
+        "--threads",
+        "1",
+    ];
+    succeeds(&run_in(&d, &[&base[..], &["-o", "single.exr"]].concat()));
+    // Four shards as separate processes, two at a time.
+    for pair in [[0, 1], [2, 3]] {
+        let kids: Vec<Child> = pair
+            .iter()
+            .map(|k| {
+                let s = format!("{k}/4");
+                cmd(&d, &[&base[..], &["--shard", &s]].concat())
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        for k in kids {
+            let out = succeeds(&k.wait_with_output().unwrap());
+            assert!(
+                out.contains("shard ") && out.contains("of-4.shard"),
+                "{out}"
+            );
+        }
+    }
+    let shards: Vec<String> = (0..4).map(|k| format!("twill-{k}-of-4.shard")).collect();
+    let sh: Vec<&str> = shards.iter().map(String::as_str).collect();
+    // In any order.
+    let rev: Vec<&str> = sh.iter().rev().copied().collect();
+    let out = succeeds(&run_in(
+        &d,
+        &[&["merge", "-o", "merged.exr"], &rev[..]].concat(),
+    ));
+    assert!(out.contains("4 shards merged"), "{out}");
+    identical(&d, "single.exr", "merged.exr");
+
+    // One shard missing: exit 2, names the shard and its rows; nothing written.
+    let before = listing(&d);
+    let missing = [sh[0], sh[1], sh[3]];
+    let err = fails_with(
+        &run_in(&d, &[&["merge", "-o", "bad.exr"], &missing[..]].concat()),
+        &["shard 2/4", "missing", "rows 56-87", "--shard 2/4"],
+    );
+    assert!(err.contains("theta_i cell 3"), "{err}");
+    // The same shard twice (an overlap).
+    let twice = [sh[0], sh[1], sh[1], sh[2], sh[3]];
+    fails_with(
+        &run_in(&d, &[&["merge", "-o", "bad.exr"], &twice[..]].concat()),
+        &["twill-1-of-4.shard", "twice", "rows 24-55"],
+    );
+    // A shard of another fabric.
+    let plain = fabric("plain");
+    succeeds(&run_in(
+        &d,
+        &[
+            "bake",
+            "--weave",
+            &plain,
+            "--res",
+            RES,
+            "--shard",
+            "2/4",
+            "-o",
+            "plain2.shard",
+        ],
+    ));
+    let before_plain = [&before[..], &["plain2.shard".to_string()]].concat();
+    let other = [sh[0], sh[1], "plain2.shard", sh[3]];
+    fails_with(
+        &run_in(&d, &[&["merge", "-o", "bad.exr"], &other[..]].concat()),
+        &["plain2.shard", "another fabric (plain)", "twill"],
+    );
+    // A shard of other options (another facet model) and of a split into 2.
+    succeeds(&run_in(
+        &d,
+        &[&base[..], &["--shard", "1/2", "-o", "half.shard"]].concat(),
+    ));
+    fails_with(
+        &run_in(&d, &["merge", "-o", "bad.exr", sh[0], "half.shard"]),
+        &["half.shard", "shard 1/2", "of 4"],
+    );
+    // A damaged shard.
+    let mut bytes = std::fs::read(d.join(sh[2])).unwrap();
+    let n = bytes.len() / 2;
+    bytes[n] ^= 1;
+    std::fs::write(d.join("damaged.shard"), &bytes).unwrap();
+    fails_with(
+        &run_in(
+            &d,
+            &[
+                "merge",
+                "-o",
+                "bad.exr",
+                sh[0],
+                sh[1],
+                "damaged.shard",
+                sh[3],
+            ],
+        ),
+        &["damaged.shard", "checksum"],
+    );
+    let expect = [
+        &before_plain[..],
+        &["damaged.shard".into(), "half.shard".into()],
+    ]
+    .concat();
+    let mut expect = expect;
+    expect.sort();
+    assert_eq!(listing(&d), expect, "a failed merge wrote something");
+}
+
+#[test]
+fn shard_auto_reads_slurm_and_kubernetes() {
+    let d = fresh_dir("auto");
+    let twill = fabric("twill");
+    let base = [
+        "bake",
+        "--weave",
+        twill.as_str(),
+        "--res",
+        "2,4,2,4",
+        "--shard",
+        "auto",
+    ];
+    // SLURM --array=1-2: task 2 is shard 1/2.
+    let out = cmd(&d, &base)
+        .env("SLURM_ARRAY_TASK_ID", "2")
+        .env("SLURM_ARRAY_TASK_MIN", "1")
+        .env("SLURM_ARRAY_TASK_COUNT", "2")
+        .output()
+        .unwrap();
+    succeeds(&out);
+    assert!(text(&out.stderr).contains("shard 1/2 from SLURM_ARRAY_TASK_ID=2"));
+    assert!(d.join("twill-1-of-2.shard").exists());
+    // Kubernetes: JOB_COMPLETION_INDEX with --shards.
+    let out = cmd(&d, &[&base[..], &["--shards", "2"]].concat())
+        .env("JOB_COMPLETION_INDEX", "0")
+        .output()
+        .unwrap();
+    succeeds(&out);
+    assert!(text(&out.stderr).contains("shard 0/2 from JOB_COMPLETION_INDEX=0 and --shards 2"));
+    succeeds(&run_in(
+        &d,
+        &[
+            "merge",
+            "-o",
+            "m.bin",
+            "twill-0-of-2.shard",
+            "twill-1-of-2.shard",
+        ],
+    ));
+    succeeds(&run_in(
+        &d,
+        &["bake", "--weave", &twill, "--res", "2,4,2,4", "-o", "s.bin"],
+    ));
+    identical(&d, "s.bin", "m.bin");
+    // Neither: a clear error.
+    fails_with(
+        &run_in(&d, &base),
+        &["neither SLURM_ARRAY_TASK_ID", "--shard K/N"],
+    );
+    let out = cmd(&d, &base)
+        .env("JOB_COMPLETION_INDEX", "1")
+        .output()
+        .unwrap();
+    fails_with(&out, &["--shards N"]);
+    fails_with(
+        &run_in(&d, &["bake", "--weave", &twill, "--shard", "4/4"]),
+        &["0-based"],
+    );
+    fails_with(
+        &run_in(
+            &d,
+            &[
+                "bake", "--weave", &twill, "--shard", "0/4", "--format", "bin",
+            ],
+        ),
+        &["--format", "merge"],
+    );
+}
+
+/// Waits for `path` to appear (at most `limit`).
+fn wait_for(path: &Path, limit: Duration) -> bool {
+    let t = Instant::now();
+    while t.elapsed() < limit {
+        if path.exists() {
+            return true;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    false
+}
+
+/// A bake SIGKILLed mid-way and resumed equals an uninterrupted one, bit for bit.
+#[cfg(unix)]
+#[test]
+fn killed_bake_resumes_to_the_same_table() {
+    let d = fresh_dir("resume");
+    let twill = fabric("twill");
+    // The ray tracer (per-cell seeds): about 1.5 s of one core on this grid.
+    let base = [
+        "--weave",
+        twill.as_str(),
+        "--res",
+        RES,
+        "--method",
+        "raytrace",
+        "--samples",
+        "600",
+    ];
+    let t = ["-o", "t.bin"];
+    let mut child = cmd(
+        &d,
+        &[
+            &base[..],
+            &t[..],
+            &["--threads", "1", "--checkpoint-every", "0"],
+        ]
+        .concat(),
+    )
+    .spawn()
+    .unwrap();
+    let ck = d.join("t.bin.checkpoint");
+    assert!(
+        wait_for(&ck, Duration::from_secs(60)),
+        "no checkpoint appeared"
+    );
+    std::thread::sleep(Duration::from_millis(100));
+    child.kill().unwrap(); // SIGKILL
+    let status = child.wait().unwrap();
+    assert!(
+        status.code().is_none(),
+        "the bake ended before the kill: {status:?}"
+    );
+    assert!(
+        !d.join("t.bin").exists(),
+        "the bake finished before the kill"
+    );
+    // Without --resume an existing checkpoint is not overwritten.
+    fails_with(
+        &run_in(&d, &[&base[..], &t[..]].concat()),
+        &["t.bin.checkpoint", "--resume"],
+    );
+    let out = run_in(
+        &d,
+        &[&base[..], &t[..], &["--resume", "--threads", "2"]].concat(),
+    );
+    succeeds(&out);
+    let err = text(&out.stderr);
+    let done: usize = err
+        .split("rows done")
+        .next()
+        .and_then(|s| s.split(": ").last())
+        .and_then(|s| s.split(" of ").next())
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no resume line: {err}"));
+    assert!(done > 0 && done < 128, "{err}");
+    assert!(!ck.exists(), "the checkpoint outlived the table");
+    // The uninterrupted bake.
+    succeeds(&run_in(
+        &d,
+        &[&base[..], &["-o", "u.bin", "--threads", "2"]].concat(),
+    ));
+    identical(&d, "u.bin", "t.bin");
+}
+
+/// SIGINT (Ctrl-C) saves a checkpoint; the resumed shard equals the shard baked at once.
+#[cfg(unix)]
+#[test]
+fn interrupted_shard_resumes() {
+    let d = fresh_dir("sigint");
+    let twill = fabric("twill");
+    let base = [
+        "bake",
+        "--weave",
+        twill.as_str(),
+        "--res",
+        RES,
+        "--method",
+        "raytrace",
+        "--samples",
+        "600",
+        "--shard",
+        "1/2",
+        "--threads",
+        "1",
+    ];
+    let every = ["--checkpoint-every", "0"];
+    let child = cmd(&d, &[&base[..], &["-o", "a.shard"], &every[..]].concat())
+        .spawn()
+        .unwrap();
+    assert!(wait_for(
+        &d.join("a.shard.checkpoint"),
+        Duration::from_secs(60)
+    ));
+    let ok = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    let out = child.wait_with_output().unwrap();
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("a.shard.checkpoint") && err.contains("--resume"),
+        "{err}"
+    );
+    succeeds(&run_in(
+        &d,
+        &[&base[..], &["-o", "a.shard", "--resume"]].concat(),
+    ));
+    succeeds(&run_in(&d, &[&base[..], &["-o", "b.shard"]].concat()));
+    assert_eq!(
+        std::fs::read(d.join("a.shard")).unwrap(),
+        std::fs::read(d.join("b.shard")).unwrap()
+    );
+    assert_eq!(listing(&d), ["a.shard", "b.shard"]);
+}
