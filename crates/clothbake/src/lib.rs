@@ -4,10 +4,14 @@
 //! theta_o, phi_o) grid of a fabric in parallel and returns the table; [`compare`] holds two
 //! tables against each other (`clothbake diff`, the golden tables of [`golden`]); [`albedo`]
 //! integrates a table's directional albedo (`clothbake info`); [`output`] writes tables with
-//! reproducible bytes. The file formats live in `clothbake-loader`.
+//! reproducible bytes; [`render`] draws pictures of cloth (`clothbake render`) and [`plot`]
+//! plots BRDF slices and hemisphere maps (`clothbake plot`). The file formats live in
+//! `clothbake-loader`.
 
 pub mod albedo;
 pub mod bake;
 pub mod compare;
 pub mod golden;
 pub mod output;
+pub mod plot;
+pub mod render;

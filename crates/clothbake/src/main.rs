@@ -9,6 +9,7 @@ mod diff_cmd;
 mod error;
 mod eval_cmd;
 mod info_cmd;
+mod render_cmd;
 mod report;
 
 use clap::error::ErrorKind;
@@ -62,6 +63,8 @@ fn run() -> Result<u8, CliError> {
                 Some("bake") => "clothbake bake",
                 Some("info") => "clothbake info",
                 Some("diff") => "clothbake diff",
+                Some("render") => "clothbake render",
+                Some("plot") => "clothbake plot",
                 _ => "clothbake",
             };
             return Err(error::from_clap(&e, sub));
@@ -72,6 +75,8 @@ fn run() -> Result<u8, CliError> {
         Some(Command::Bake(args)) => (bake_cmd::run(&args.weave, &args.opts)?, 0),
         Some(Command::Info(args)) => (info_cmd::run(&args)?, 0),
         Some(Command::Diff(args)) => diff_cmd::run(&args)?,
+        Some(Command::Render(args)) => (render_cmd::run_render(&args)?, 0),
+        Some(Command::Plot(args)) => (render_cmd::run_plot(&args)?, 0),
         None => match &cli.weave {
             Some(w) => (bake_cmd::run(w, &cli.bake)?, 0),
             None => return Err(no_command()),
