@@ -10,8 +10,8 @@
 //!   above the plane toward (0, -cos 75, sin 75), as `cargo xtask ch5`) shaded with I_ss alone
 //!   (Fig. 5.10) and I_2 alone (Fig. 5.11) for n = 1, 2, 4, 8, 16, 24, 32, left to right.
 //!
-//! All are rendered with the model directly (`clothbake render --weave`): the loader's
-//! interpolated table lookup is not available yet. Tone mapping: clamp + sRGB, one exposure per
+//! All are rendered with the model directly (`clothbake render --weave`: exact, no table
+//! interpolation; the direct-reflection scenes would render as fast from a table). Tone mapping: clamp + sRGB, one exposure per
 //! figure (Fig. 4.5 and 5.17 share exposure 1, V itself, so the inter-reflection's brightening shows;
 //! each disk figure uses 1 / its largest value over all seven n).
 

@@ -9,7 +9,7 @@ use crate::eval_cmd::apply_material;
 use clothbake::plot::{self, Plot, Source};
 use clothbake::render::camera::{Camera, CameraError};
 use clothbake::render::scene::Scene;
-use clothbake::render::shade::{Component, Lighting, ModelShader, Shader};
+use clothbake::render::shade::{Component, Lighting, ModelShader, Shader, TableShader};
 use clothbake::render::tonemap::{self, Curve};
 use clothbake::render::{self as renderer};
 use clothbake_core::{Fabric, FacetModel, Vec3};
@@ -54,17 +54,10 @@ fn component_name(c: ComponentArg) -> &'static str {
     }
 }
 
-/// The shader of a baked table: reads the table (so that a bad file gets its own clear error
-/// first), then refuses, since the loader's interpolated lookup is not there yet.
+/// The shader of a baked table (the loader's interpolated lookup).
 fn table_shader(path: &Path) -> Result<Box<dyn Shader>, CliError> {
-    clothbake_loader::read_table(path).map_err(|e| table_error(&e))?;
-    Err(CliError::new(
-        format!(
-            "{}: shading with a baked table is not available yet (the loader's interpolated \
-             lookup is not in this build)",
-            path.display()
-        ),
-        "shade with the model directly: --weave FILE (the fabric the table was baked from)",
+    Ok(Box::new(
+        TableShader::open(path).map_err(|e| table_error(&e))?,
     ))
 }
 

@@ -298,6 +298,52 @@ fn secondary_components_need_two_bounces() {
     }
 }
 
+/// A table baked from the twill and looked up by the loader renders the swatch like the model
+/// itself, up to the table's interpolation error.
+#[test]
+fn table_shader_agrees_with_the_model() {
+    use clothbake::bake::{bake, BakeOptions};
+    use clothbake::render::shade::TableShader;
+    let twill = fabric("twill");
+    let opts = BakeOptions {
+        grid: clothbake_loader::Grid {
+            n_theta_i: 16,
+            n_phi_i: 32,
+            n_theta_o: 16,
+            n_phi_o: 32,
+        },
+        ..BakeOptions::default()
+    };
+    let table = bake(&twill, &opts, &|_| {}, &AtomicBool::new(false))
+        .unwrap()
+        .table;
+    let path = temp("twill-16.bin");
+    clothbake_loader::write_binary(&path, &table, true).unwrap();
+    let ts = TableShader::open(&path).unwrap();
+    let ms = shader(&twill);
+    let scene = Scene::swatch(30.0);
+    let cam = Camera::new(Vec3::new(0.0, -55.0, 45.0), Vec3::default(), 60.0, 24, 24).unwrap();
+    let l = lighting(Vec3::new(0.0, 0.707, 0.707), 0.0);
+    let (a, b) = (
+        draw(&scene, &cam, &l, &ms, 1, 2),
+        draw(&scene, &cam, &l, &ts, 1, 2),
+    );
+    let (mut n, mut sum, mut worst) = (0, 0.0, 0.0f64);
+    for (p, q) in a.pixels.iter().zip(&b.pixels) {
+        if p[0] > 0.0 {
+            let d = f64::from((p[0] - q[0]).abs() / p[0]);
+            (n, sum, worst) = (n + 1, sum + d, worst.max(d));
+        }
+    }
+    assert!(n > 200);
+    assert!(
+        sum / f64::from(n) < 0.03 && worst < 0.15,
+        "mean {} worst {worst}",
+        sum / f64::from(n)
+    );
+    assert_eq!(ts.tint(), [1.0; 3], "the twill is grey");
+}
+
 fn temp(name: &str) -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
 }

@@ -1,4 +1,5 @@
-//! Shading: the BRDF behind one small trait, and the pixel value of a lit surface point.
+//! Shading: the BRDF behind one small trait ([`ModelShader`]: the analytic model;
+//! [`TableShader`]: a baked table), and the pixel value of a lit surface point.
 //!
 //! Pixel value (linear, per RGB channel), for a surface point seen from the eye:
 //!
@@ -140,4 +141,42 @@ pub fn radiance(
         }
     }
     v
+}
+
+/// A baked table, looked up with the loader's interpolation (`clothbake_loader::Brdf::eval`).
+pub struct TableShader {
+    brdf: clothbake_loader::Brdf,
+    tint: [f32; 3],
+}
+
+impl TableShader {
+    /// Opens the table at `path` (either format). The tint comes from the fabric file stored in
+    /// the table's metadata ((1, 1, 1) if it cannot be read).
+    pub fn open(path: &std::path::Path) -> Result<TableShader, clothbake_loader::TableError> {
+        let options = clothbake_loader::Options {
+            sampling: false,
+            ..Default::default()
+        };
+        let brdf = clothbake_loader::Brdf::open(path, options)?;
+        let tint = Fabric::from_json_str(&brdf.meta().fabric_json, "table metadata").map_or(
+            [1.0; 3],
+            |f| {
+                tint_of(std::array::from_fn(|k| {
+                    0.5 * (f.warp.material.albedo[k] + f.weft.material.albedo[k])
+                }))
+            },
+        );
+        Ok(TableShader { brdf, tint })
+    }
+}
+
+impl Shader for TableShader {
+    fn f_r(&self, wi: UnitVec3, wo: UnitVec3) -> [f32; 3] {
+        let v = |u: UnitVec3| [u.x as f32, u.y as f32, u.z as f32];
+        self.brdf.eval(v(wi), v(wo))
+    }
+
+    fn tint(&self) -> [f32; 3] {
+        self.tint
+    }
 }
