@@ -2,6 +2,7 @@
 //!
 //! * `ch5`: the comparisons of thesis sec. 5.4 (sphere, disk, convergence) into
 //!   `docs/interreflection-results.md`.
+//! * `figures`: the thesis's rendered scenes (Figs 4.5, 5.10, 5.11, 5.17) into `docs/figures/`.
 //! * `validate`: holds the analytic model against the ray-traced ground truth for every shipped
 //!   fabric and writes the error tables to `docs/validation.md`.
 //! * `golden`: bakes every shipped fabric (`tables/*.json`) at the golden grid into
@@ -12,6 +13,7 @@
 use clothbake::bake::{bake, BakeOptions};
 use clothbake::golden::{bake_golden, golden_path, shipped_fabrics};
 mod ch5;
+mod figures;
 
 use clothbake_core::validate::{compare_with, direction_set, Report};
 use clothbake_core::{Caps, Fabric, FacetModel, Variant};
@@ -33,10 +35,13 @@ fn main() {
     match task.as_str() {
         "validate" => validate(),
         "ch5" => ch5::run(&root()),
+        "figures" => figures::run(&root()),
         "golden" => golden(),
         "bench-bake" => bench_bake(std::env::args().skip(2).any(|a| a == "--bounces-2")),
         _ => {
-            eprintln!("usage: cargo xtask validate | golden | ch5 | bench-bake [--bounces-2]");
+            eprintln!(
+                "usage: cargo xtask validate | golden | ch5 | figures | bench-bake [--bounces-2]"
+            );
             std::process::exit(2);
         }
     }

@@ -18,6 +18,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use bincode::Options;
 use serde::{Deserialize, Serialize};
 
+use crate::stored::{Samples, StoredTable};
+
 /// Version of both table formats. Readers reject any other version.
 pub const FORMAT_VERSION: u32 = 1;
 
@@ -294,31 +296,12 @@ impl Table {
 
     /// Checks what [`Table::new`] checks; the writers call it, as the fields are public.
     pub fn validate(&self) -> Result<(), TableError> {
-        let (meta, values) = (&self.meta, &self.values);
-        meta.validate()?;
-        let expected = meta.grid.len() * 3;
-        if values.len() != expected {
-            return Err(TableError::InvalidTable {
-                reason: format!(
-                    "grid {} has {} cells and needs {expected} values (RGB), but there are {}",
-                    meta.grid,
-                    meta.grid.len(),
-                    values.len()
-                ),
-            });
-        }
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(TableError::InvalidTable {
-                reason: format!(
-                    "value {} of cell {} (channel {}) is {}; every value must be finite",
-                    i,
-                    i / 3,
-                    ['R', 'G', 'B'][i % 3],
-                    values[i]
-                ),
-            });
-        }
-        Ok(())
+        let bad = self.values.iter().position(|v| !v.is_finite());
+        check_values(
+            &self.meta,
+            self.values.len(),
+            bad.map(|i| (i, self.values[i])),
+        )
     }
 
     /// The grid of the table.
@@ -335,6 +318,38 @@ impl Table {
             self.values[3 * c + 2],
         ]
     }
+}
+
+/// Checks a table's metadata, its number of values (`len`) and the first non-finite value, if
+/// any (its index and value): the rules of [`Table::new`], for any sample type.
+pub(crate) fn check_values(
+    meta: &Metadata,
+    len: usize,
+    non_finite: Option<(usize, f32)>,
+) -> Result<(), TableError> {
+    meta.validate()?;
+    let expected = meta.grid.len() * 3;
+    if len != expected {
+        return Err(TableError::InvalidTable {
+            reason: format!(
+                "grid {} has {} cells and needs {expected} values (RGB), but there are {len}",
+                meta.grid,
+                meta.grid.len(),
+            ),
+        });
+    }
+    if let Some((i, v)) = non_finite {
+        return Err(TableError::InvalidTable {
+            reason: format!(
+                "value {} of cell {} (channel {}) is {}; every value must be finite",
+                i,
+                i / 3,
+                ['R', 'G', 'B'][i % 3],
+                v
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Sample type of the EXR channels.
@@ -1016,9 +1031,14 @@ mod exr_io {
             }
         };
         let meta_json = table.meta.to_ascii_json();
-        let crc = samples_crc(
+        let kept = [stored(&planes[0]), stored(&planes[1]), stored(&planes[2])];
+        let crc = planes_crc(
             meta_json.as_bytes(),
-            &[stored(&planes[0]), stored(&planes[1]), stored(&planes[2])],
+            &[
+                Plane::F32(&kept[0]),
+                Plane::F32(&kept[1]),
+                Plane::F32(&kept[2]),
+            ],
         );
         let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
         for (name, p) in ["R", "G", "B"].into_iter().zip(planes) {
@@ -1087,24 +1107,6 @@ mod exr_io {
         }
     }
 
-    /// The [`ATTR_CRC32`] checksum of a metadata text and three row-major planes.
-    pub(super) fn samples_crc(meta_json: &[u8], planes: &[Vec<f32>; 3]) -> u32 {
-        let mut hasher = crc32fast::Hasher::new();
-        hasher.update(meta_json);
-        let mut bytes = Vec::with_capacity(CHUNK_VALUES * 12);
-        let n = planes[0].len();
-        for start in (0..n).step_by(CHUNK_VALUES) {
-            bytes.clear();
-            for i in start..n.min(start + CHUNK_VALUES) {
-                for p in planes {
-                    bytes.extend_from_slice(&p[i].to_le_bytes());
-                }
-            }
-            hasher.update(&bytes);
-        }
-        hasher.finalize()
-    }
-
     fn attribute_text(value: &AttributeValue) -> Option<String> {
         match value {
             AttributeValue::Text(t) => Some(String::from_utf8_lossy(t.bytes()).into_owned()),
@@ -1112,7 +1114,7 @@ mod exr_io {
         }
     }
 
-    pub(super) fn read(path: &Path) -> Result<Table, TableError> {
+    pub(super) fn read(path: &Path) -> Result<StoredTable, TableError> {
         let bytes = fs::read(path).map_err(|e| TableError::io(path, "read the table", e))?;
         if bytes.is_empty() {
             return Err(TableError::Empty {
@@ -1138,7 +1140,7 @@ mod exr_io {
         };
 
         // The exr decoder is not trusted to never panic on damaged files.
-        let guarded = |f: &dyn Fn() -> Result<Table, TableError>| {
+        let guarded = |f: &dyn Fn() -> Result<StoredTable, TableError>| {
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|_| {
                 Err(corrupted(
                     "the OpenEXR decoder failed on this file".to_string(),
@@ -1239,7 +1241,7 @@ mod exr_io {
                 .first()
                 .ok_or_else(|| corrupted("the EXR has no layer".to_string()))?;
             let (width, height) = (grid.exr_width() as usize, grid.exr_height() as usize);
-            let mut planes: [Vec<f32>; 3] = Default::default();
+            let mut planes: [Option<Plane>; 3] = Default::default();
             for channel in &layer.channel_data.list {
                 let k = match channel.name.bytes() {
                     b"R" => 0,
@@ -1247,9 +1249,9 @@ mod exr_io {
                     b"B" => 2,
                     _ => continue,
                 };
-                let plane: Vec<f32> = match &channel.sample_data {
-                    FlatSamples::F16(v) => v.iter().map(|h| h.to_f32()).collect(),
-                    FlatSamples::F32(v) => v.clone(),
+                let plane = match &channel.sample_data {
+                    FlatSamples::F16(v) => Plane::F16(v),
+                    FlatSamples::F32(v) => Plane::F32(v),
                     FlatSamples::U32(_) => {
                         return Err(foreign(
                             "channel samples are u32; a table has f16 or f32 samples".to_string(),
@@ -1263,10 +1265,16 @@ mod exr_io {
                         width * height
                     )));
                 }
-                planes[k] = plane;
+                planes[k] = Some(plane);
             }
+            let [Some(r), Some(g), Some(b)] = planes else {
+                return Err(foreign(
+                    "the EXR lacks one of the channels R, G and B".to_string(),
+                ));
+            };
+            let planes = [r, g, b];
             if let Some(stored) = attrs.get(&Text::from(ATTR_CRC32)).and_then(attribute_text) {
-                let computed = samples_crc(&meta_json_bytes, &planes);
+                let computed = planes_crc(&meta_json_bytes, &planes);
                 if u32::from_str_radix(stored.trim(), 16).ok() != Some(computed) {
                     return Err(TableError::Checksum {
                         path: path.to_path_buf(),
@@ -1275,22 +1283,72 @@ mod exr_io {
                     });
                 }
             }
-            let mut values = vec![0f32; grid.len() * 3];
-            for (k, plane) in planes.iter().enumerate() {
-                for ti in 0..grid.n_theta_i {
-                    for to in 0..grid.n_theta_o {
-                        let y = (ti * grid.n_theta_o + to) as usize;
-                        for pi in 0..grid.n_phi_i {
-                            for po in 0..grid.n_phi_o {
-                                let x = (pi * grid.n_phi_o + po) as usize;
-                                values[3 * grid.index(ti, pi, to, po) + k] = plane[y * width + x];
-                            }
-                        }
-                    }
+            // Pixel of each cell, in cell order (see `docs/table-format.md`).
+            let pixels = || {
+                (0..grid.n_theta_i).flat_map(move |ti| {
+                    (0..grid.n_phi_i).flat_map(move |pi| {
+                        (0..grid.n_theta_o).flat_map(move |to| {
+                            (0..grid.n_phi_o).map(move |po| {
+                                let y = (ti * grid.n_theta_o + to) as usize;
+                                y * width + (pi * grid.n_phi_o + po) as usize
+                            })
+                        })
+                    })
+                })
+            };
+            let samples = match &planes {
+                [Plane::F16(r), Plane::F16(g), Plane::F16(b)] => {
+                    Samples::F16(pixels().flat_map(|x| [r[x], g[x], b[x]]).collect())
+                }
+                _ => Samples::F32(
+                    pixels()
+                        .flat_map(|x| [planes[0].get(x), planes[1].get(x), planes[2].get(x)])
+                        .collect(),
+                ),
+            };
+            StoredTable::new(meta.clone(), samples).map_err(|e| e.in_file(path))
+        })
+    }
+
+    /// One channel's samples as decoded, borrowed from the image.
+    enum Plane<'a> {
+        F16(&'a [half::f16]),
+        F32(&'a [f32]),
+    }
+
+    impl Plane<'_> {
+        fn len(&self) -> usize {
+            match self {
+                Plane::F16(v) => v.len(),
+                Plane::F32(v) => v.len(),
+            }
+        }
+
+        fn get(&self, i: usize) -> f32 {
+            match self {
+                Plane::F16(v) => v[i].to_f32(),
+                Plane::F32(v) => v[i],
+            }
+        }
+    }
+
+    /// The [`ATTR_CRC32`] checksum of a metadata text and three row-major planes, widened to
+    /// f32 chunk by chunk (no full f32 copy).
+    fn planes_crc(meta_json: &[u8], planes: &[Plane; 3]) -> u32 {
+        let mut hasher = crc32fast::Hasher::new();
+        hasher.update(meta_json);
+        let mut bytes = Vec::with_capacity(CHUNK_VALUES * 12);
+        let n = planes[0].len();
+        for start in (0..n).step_by(CHUNK_VALUES) {
+            bytes.clear();
+            for i in start..n.min(start + CHUNK_VALUES) {
+                for p in planes {
+                    bytes.extend_from_slice(&p.get(i).to_le_bytes());
                 }
             }
-            Table::new(meta.clone(), values).map_err(|e| e.in_file(path))
-        })
+            hasher.update(&bytes);
+        }
+        hasher.finalize()
     }
 }
 
@@ -1315,11 +1373,23 @@ pub fn write_exr(
 /// the metadata, the image size against the grid, the channels and, when present, the
 /// [`ATTR_CRC32`] checksum.
 pub fn read_exr(path: &Path) -> Result<Table, TableError> {
+    exr_io::read(path).map(StoredTable::into_table)
+}
+
+/// Reads an OpenEXR table like [`read_exr`], keeping the samples at their stored precision
+/// (half samples stay half: half the memory).
+pub fn read_exr_stored(path: &Path) -> Result<StoredTable, TableError> {
     exr_io::read(path)
 }
 
 /// Reads a table in either format, recognised by its first bytes.
 pub fn read_table(path: &Path) -> Result<Table, TableError> {
+    read_table_stored(path).map(StoredTable::into_table)
+}
+
+/// Reads a table in either format like [`read_table`], keeping the samples at their stored
+/// precision: half for half-float EXR tables, f32 otherwise.
+pub fn read_table_stored(path: &Path) -> Result<StoredTable, TableError> {
     let mut file = File::open(path).map_err(|e| TableError::io(path, "open the table", e))?;
     let mut head = [0u8; 8];
     let n =
@@ -1331,9 +1401,9 @@ pub fn read_table(path: &Path) -> Result<Table, TableError> {
             path: path.to_path_buf(),
         })
     } else if head.starts_with(&EXR_MAGIC) {
-        read_exr(path)
+        read_exr_stored(path)
     } else if BINARY_MAGIC.starts_with(head) || head.starts_with(&BINARY_MAGIC[..4]) {
-        read_binary(path)
+        read_binary(path).map(StoredTable::from)
     } else {
         Err(TableError::Foreign {
             path: path.to_path_buf(),

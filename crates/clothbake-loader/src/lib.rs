@@ -1,12 +1,21 @@
-//! clothbake-loader: the baked BRDF table formats, and (issue 5, not yet built) render-time
-//! lookup of baked tables.
+//! clothbake-loader: the baked BRDF table formats and render-time lookup of baked tables.
 //!
-//! This crate is the one renderers link. [`mod@format`] reads and writes tables in both formats
-//! (OpenEXR and the checksummed binary file); see `docs/table-format.md`.
+//! This crate is the one renderers link (from C through `clothbake-capi`). [`mod@format`]
+//! reads and writes tables in both formats (OpenEXR and the checksummed binary file); see
+//! `docs/table-format.md`. [`mod@stored`] keeps half-float tables half in memory.
+//! [`mod@lookup`] interpolates them ([`Brdf::eval`]) and [`mod@sampling`] importance-samples
+//! them ([`Brdf::sample`]); see `docs/loader.md`.
 
+pub mod angles;
 pub mod format;
+pub mod lookup;
+pub mod sampling;
+pub mod stored;
 
 pub use format::{
-    read_binary, read_exr, read_table, write_atomic, write_binary, write_exr, Grid, Metadata,
-    Precision, Table, TableError, FORMAT_VERSION,
+    read_binary, read_exr, read_exr_stored, read_table, read_table_stored, write_atomic,
+    write_binary, write_exr, Grid, Metadata, Precision, Table, TableError, FORMAT_VERSION,
 };
+pub use half::f16;
+pub use lookup::{Brdf, LengthMismatch, Memory, Options, Sample, HORIZON_COS};
+pub use stored::{Samples, StoredTable};

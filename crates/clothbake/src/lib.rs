@@ -7,6 +7,8 @@
 //! reproducible bytes; [`export`] writes the BRDF for other renderers (RGL `.bsdf`,
 //! MERL binary). The file formats live in `clothbake-loader`, except the baker's own
 //! shard and checkpoint files ([`shard`], [`merge`], [`checkpoint`]; docs/cluster.md).
+//! [`render`] draws pictures of cloth (`clothbake render`) and [`plot`] plots BRDF slices and
+//! hemisphere maps (`clothbake plot`).
 
 pub mod albedo;
 pub mod bake;
@@ -16,4 +18,6 @@ pub mod export;
 pub mod golden;
 pub mod merge;
 pub mod output;
+pub mod plot;
+pub mod render;
 pub mod shard;

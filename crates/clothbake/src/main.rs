@@ -11,6 +11,7 @@ mod eval_cmd;
 mod export_cmd;
 mod info_cmd;
 mod merge_cmd;
+mod render_cmd;
 mod report;
 
 use clap::error::ErrorKind;
@@ -66,6 +67,8 @@ fn run() -> Result<u8, CliError> {
                 Some("diff") => "clothbake diff",
                 Some("export") => "clothbake export",
                 Some("merge") => "clothbake merge",
+                Some("render") => "clothbake render",
+                Some("plot") => "clothbake plot",
                 _ => "clothbake",
             };
             return Err(error::from_clap(&e, sub));
@@ -78,6 +81,8 @@ fn run() -> Result<u8, CliError> {
         Some(Command::Diff(args)) => diff_cmd::run(&args)?,
         Some(Command::Export(args)) => (export_cmd::run(&args)?, 0),
         Some(Command::Merge(args)) => (merge_cmd::run(&args)?, 0),
+        Some(Command::Render(args)) => (render_cmd::run_render(&args)?, 0),
+        Some(Command::Plot(args)) => (render_cmd::run_plot(&args)?, 0),
         None => match &cli.weave {
             Some(w) => (bake_cmd::run(w, &cli.bake)?, 0),
             None => return Err(no_command()),

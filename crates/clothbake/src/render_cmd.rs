@@ -1,0 +1,325 @@
+//! `clothbake render` and `clothbake plot`: the command-line side of `clothbake::render` and
+//! `clothbake::plot` (building the shader, checking outputs, progress, summary line).
+
+use crate::cli::{
+    BrdfArgs, ComponentArg, Exposure, PlotArgs, PlotKind, RenderArgs, SceneArg, TonemapArg,
+};
+use crate::error::{table_error, CliError};
+use crate::eval_cmd::apply_material;
+use clothbake::plot::{self, Plot, Source};
+use clothbake::render::camera::{Camera, CameraError};
+use clothbake::render::scene::Scene;
+use clothbake::render::shade::{Component, Lighting, ModelShader, Shader, TableShader};
+use clothbake::render::tonemap::{self, Curve};
+use clothbake::render::{self as renderer};
+use clothbake_core::{Fabric, FacetModel, Vec3};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Instant;
+
+/// The model shader of `--weave`, with its options checked.
+fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<ModelShader, CliError> {
+    let opts = b.bounces.options()?;
+    let secondary = (b.bounces.bounces == 2).then_some(opts);
+    let component = match b.component {
+        ComponentArg::Total => Component::Total,
+        ComponentArg::Direct => Component::Direct,
+        ComponentArg::Secondary => Component::Secondary,
+        ComponentArg::Iss => Component::SecondarySpecular,
+    };
+    let fabric = apply_material(Fabric::from_path(weave)?, &b.material);
+    ModelShader::new(
+        &fabric,
+        FacetModel::from(b.facet),
+        b.variant.into(),
+        secondary,
+        component,
+    )
+    .map_err(|m| {
+        CliError::new(
+            format!("--component {}: {m}", component_name(b.component)),
+            "add --bounces 2, or use --component total or direct",
+        )
+    })
+}
+
+fn component_name(c: ComponentArg) -> &'static str {
+    match c {
+        ComponentArg::Total => "total",
+        ComponentArg::Direct => "direct",
+        ComponentArg::Secondary => "secondary",
+        ComponentArg::Iss => "iss",
+    }
+}
+
+/// The shader of a baked table (the loader's interpolated lookup).
+fn table_shader(path: &Path) -> Result<Box<dyn Shader>, CliError> {
+    Ok(Box::new(
+        TableShader::open(path).map_err(|e| table_error(&e))?,
+    ))
+}
+
+/// Options that only apply to the model, given with --table.
+fn check_model_only(b: &BrdfArgs) -> Result<(), CliError> {
+    let model_only = b.bounces.bounces != 1
+        || b.bounces.secondary.is_some()
+        || b.bounces.kernel.is_some()
+        || b.component != ComponentArg::Total
+        || b.material != Default::default();
+    if model_only {
+        return Err(CliError::new(
+            "--bounces, --secondary, --kernel, --component and the material overrides apply \
+             only to the model (--weave); a table already holds its BRDF",
+            "drop them, or bake a table with those options",
+        ));
+    }
+    Ok(())
+}
+
+/// A named BRDF source.
+type Named = (String, Box<dyn Shader>);
+
+/// The sources named on the command line, in order: tables first, then the model.
+fn sources(b: &BrdfArgs, most: usize) -> Result<Vec<Named>, CliError> {
+    let n = b.table.len() + usize::from(b.weave.is_some());
+    if n == 0 {
+        return Err(CliError::new(
+            "no BRDF given",
+            "give --weave FILE (the model, e.g. tables/twill.json) or --table FILE (a baked table)",
+        ));
+    }
+    if n > most {
+        return Err(CliError::new(
+            format!("{n} BRDF sources given, at most {most} here",),
+            if most == 1 {
+                "give either --weave FILE or one --table FILE"
+            } else {
+                "give two of --weave FILE and --table FILE to compare"
+            },
+        ));
+    }
+    if !b.table.is_empty() && b.weave.is_none() {
+        check_model_only(b)?;
+    }
+    let mut out: Vec<Named> = Vec::new();
+    for t in &b.table {
+        out.push((file_name(t), table_shader(t)?));
+    }
+    if let Some(w) = &b.weave {
+        out.push((
+            format!("model {}", file_name(w)),
+            Box::new(model_shader(w, b)?),
+        ));
+    }
+    Ok(out)
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name().map_or_else(
+        || p.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}
+
+/// Refuses an existing output without --force before any work is done.
+fn preflight(path: &Path, force: bool) -> Result<(), CliError> {
+    if !force && std::fs::symlink_metadata(path).is_ok() {
+        return Err(CliError::new(
+            format!("{} exists", path.display()),
+            "add --force to overwrite it, or choose another path with -o",
+        ));
+    }
+    Ok(())
+}
+
+fn vec3(v: [f64; 3]) -> Vec3 {
+    Vec3::new(v[0], v[1], v[2])
+}
+
+fn progress_bar(total: u64, quiet: bool) -> Option<ProgressBar> {
+    if quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+    let style = ProgressStyle::with_template(
+        "{elapsed_precise} [{wide_bar}] {percent:>3}% {pos}/{len} rows, ETA {eta}",
+    )
+    .expect("valid template")
+    .progress_chars("=> ");
+    bar.set_style(style);
+    Some(bar)
+}
+
+/// Runs `clothbake render`; returns the summary line.
+pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
+    let mut srcs = sources(&a.brdf, 1)?;
+    let (_, shader) = srcs.pop().expect("one source");
+    preflight(&a.output, a.force)?;
+    if let Some(e) = &a.exr {
+        preflight(e, a.force)?;
+    }
+    let scene = Scene::by_name(match a.scene {
+        SceneArg::Drape => "drape",
+        SceneArg::Sphere => "sphere",
+        SceneArg::Disk => "disk",
+        SceneArg::Swatch => "swatch",
+    })
+    .expect("a known scene");
+    let light = vec3(a.light);
+    if light.length() < 1e-12 {
+        return Err(CliError::new(
+            "--light 0,0,0 has no direction",
+            "give the direction toward the light, e.g. --light 0,0.707,0.707",
+        ));
+    }
+    let (eye, look_at) = (vec3(a.eye), vec3(a.look_at));
+    let fov = a.fov.unwrap_or_else(|| {
+        let (lo, hi) = scene.bounds();
+        Camera::fitting_fov(eye, look_at, a.res.0, a.res.1, lo, hi)
+    });
+    let (w, h) = a.res;
+    let camera = Camera::new(eye, look_at, fov, w, h).map_err(|e| match e {
+        CameraError::EyeAtTarget => CliError::new(
+            "--eye and --look-at are the same point",
+            "move the eye away from the point it looks at",
+        ),
+        CameraError::BadFov(f) => CliError::new(
+            format!("field of view {f} is outside (0, 180) degrees"),
+            "give --fov between 0 and 180",
+        ),
+    })?;
+    let lighting = Lighting {
+        light: light * (1.0 / light.length()),
+        irradiance: a.irradiance.unwrap_or(std::f64::consts::PI),
+        ambient: a.ambient,
+    };
+    let threads = a
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| {
+            CliError::new(
+                format!("cannot start {threads} worker threads: {e}"),
+                "give fewer with --threads N",
+            )
+        })?;
+    let start = Instant::now();
+    let bar = progress_bar(u64::from(h), a.quiet);
+    let shown = AtomicU64::new(0);
+    let progress = |n: u64| {
+        if let Some(b) = &bar {
+            b.set_position(shown.fetch_max(n, Ordering::Relaxed).max(n));
+        }
+    };
+    let never = AtomicBool::new(false);
+    let img = pool
+        .install(|| {
+            renderer::render(
+                &scene,
+                &camera,
+                &lighting,
+                shader.as_ref(),
+                a.aa,
+                &progress,
+                &never,
+            )
+        })
+        .expect("never cancelled");
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let exposure = match a.exposure {
+        Exposure::Factor(x) => x,
+        Exposure::Auto => tonemap::auto_exposure(&img),
+    };
+    let curve = match a.tonemap {
+        TonemapArg::Clamp => Curve::Clamp,
+        TonemapArg::Reinhard => Curve::Reinhard,
+    };
+    let rgb = tonemap::to_rgb8(&img, exposure, curve);
+    tonemap::write_png_rgb8(&a.output, w, h, &rgb, a.force)?;
+    let mut wrote = a.output.display().to_string();
+    if let Some(e) = &a.exr {
+        tonemap::write_exr(e, &img, a.force)?;
+        wrote = format!("{wrote} and {}", e.display());
+    }
+    if a.quiet {
+        return Ok(String::new());
+    }
+    Ok(format!(
+        "wrote {wrote}: {w}x{h} pixels, {} samples each, fov {fov:.1} deg, exposure {exposure:.4}, \
+         max value {:.4}, {:.2} s on {threads} thread{}\n",
+        a.aa * a.aa,
+        img.max_value(),
+        start.elapsed().as_secs_f64(),
+        if threads == 1 { "" } else { "s" },
+    ))
+}
+
+/// Runs `clothbake plot`; returns the summary line.
+pub fn run_plot(a: &PlotArgs) -> Result<String, CliError> {
+    let outputs: Vec<PathBuf> = if a.output.is_empty() {
+        vec!["plot.png".into(), "plot.svg".into()]
+    } else {
+        a.output.clone()
+    };
+    for o in &outputs {
+        let ext = o
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        if !matches!(ext.as_deref(), Some("png" | "svg")) {
+            return Err(CliError::new(
+                format!("{}: unknown plot format", o.display()),
+                "name the output .png or .svg (repeat -o for both)",
+            ));
+        }
+        preflight(o, a.force)?;
+    }
+    let srcs = sources(&a.brdf, 2)?;
+    let sources: Vec<Source> = srcs
+        .iter()
+        .map(|(name, s)| Source {
+            name: name.clone(),
+            shader: s.as_ref(),
+        })
+        .collect();
+    let p = match a.kind {
+        PlotKind::Slices => Plot::Slices {
+            theta_i: a.theta_i.clone(),
+            phi_i: a.phi_i.clone(),
+        },
+        PlotKind::Hemisphere => {
+            if !a.wi.above_horizon() {
+                return Err(CliError::new(
+                    "--wi is at the horizon, where nothing is lit",
+                    "give theta below 90, e.g. --wi 45,0",
+                ));
+            }
+            Plot::Hemisphere {
+                theta_i: a.wi.theta,
+                phi_i: a.wi.phi,
+            }
+        }
+    };
+    for o in &outputs {
+        plot::write(o, &p, &sources, a.force).map_err(|m| {
+            CliError::new(
+                format!("cannot draw the plot: {m}"),
+                "check the output path",
+            )
+        })?;
+    }
+    Ok(format!(
+        "wrote {}\n",
+        outputs
+            .iter()
+            .map(|o| o.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ))
+}

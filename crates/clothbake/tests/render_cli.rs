@@ -1,0 +1,194 @@
+//! The command-line contract of `clothbake render` and `clothbake plot`, driving the binary.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tables() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables")
+}
+
+fn weave(name: &str) -> String {
+    tables()
+        .join(format!("{name}.json"))
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn temp(name: &str) -> PathBuf {
+    let p = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("render-cli-{name}"));
+    let _ = std::fs::remove_file(&p);
+    p
+}
+
+fn clothbake(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_clothbake"))
+        .args(args)
+        .output()
+        .expect("run the clothbake binary")
+}
+
+/// Exit 2, one line on stderr naming every needle, nothing on stdout.
+fn fails(out: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert!(out.stdout.is_empty());
+    assert_eq!(err.lines().count(), 1, "{err:?}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} lacks {n:?}");
+    }
+}
+
+#[test]
+fn render_writes_png_and_exr_of_the_stated_size() {
+    let (png_path, exr_path) = (temp("small.png"), temp("small.exr"));
+    let w = weave("twill");
+    let args = [
+        "render",
+        "--weave",
+        &w,
+        "--res",
+        "24,16",
+        "--aa",
+        "1",
+        "--quiet",
+        "-o",
+        png_path.to_str().unwrap(),
+        "--exr",
+        exr_path.to_str().unwrap(),
+    ];
+    let out = clothbake(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let dec = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(&png_path).unwrap(),
+    ));
+    let info = dec.read_info().unwrap().info().clone();
+    assert_eq!((info.width, info.height), (24, 16));
+    // The EXR read back by the exr crate's generic reader: same size, finite linear values.
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        &exr_path,
+        |res, _| vec![[0f32; 3]; res.width() * res.height()],
+        |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * 24 + pos.x()] = [r, g, b];
+        },
+    )
+    .unwrap();
+    let px = &img.layer_data.channel_data.pixels;
+    assert_eq!(px.len(), 24 * 16);
+    assert!(px.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(px.iter().any(|p| p[0] > 0.3), "the lit cloth is in view");
+    // An existing output is kept without --force, before any rendering.
+    let again = clothbake(&args);
+    fails(&again, &["exists", "--force"]);
+}
+
+#[test]
+fn render_and_plot_refuse_bad_requests_with_one_line() {
+    let w = weave("parallel");
+    let o = temp("bad.png");
+    let o = o.to_str().unwrap();
+    fails(
+        &clothbake(&["render", "--weave", &w, "--component", "secondary", "-o", o]),
+        &["--component secondary", "--bounces 2"],
+    );
+    fails(
+        &clothbake(&["render", "-o", o]),
+        &["no BRDF given", "--weave"],
+    );
+    fails(
+        &clothbake(&["render", "--weave", &w, "--eye", "1,2", "-o", o]),
+        &["expected 3", "X,Y,Z"],
+    );
+    fails(
+        &clothbake(&["render", "--weave", &w, "--light", "0,0,0", "-o", o]),
+        &["--light", "direction"],
+    );
+    fails(
+        &clothbake(&["render", "--weave", &w, "--eye", "0,0,0", "-o", o]),
+        &["same point"],
+    );
+    fails(
+        &clothbake(&["render", "--weave", &w, "--res", "0", "-o", o]),
+        &["1 to 16384"],
+    );
+    let t = tables().join("golden/twill.bin");
+    fails(
+        &clothbake(&[
+            "render",
+            "--table",
+            t.to_str().unwrap(),
+            "--bounces",
+            "2",
+            "-o",
+            o,
+        ]),
+        &["only to the model"],
+    );
+    let missing = temp("missing.exr");
+    fails(
+        &clothbake(&["render", "--table", missing.to_str().unwrap(), "-o", o]),
+        &["missing.exr"],
+    );
+    fails(
+        &clothbake(&["plot", "--weave", &w, "-o", temp("p.jpg").to_str().unwrap()]),
+        &["unknown plot format", ".png or .svg"],
+    );
+    fails(
+        &clothbake(&["plot", "--weave", &w, "--theta-i", "0,95"]),
+        &["theta 95"],
+    );
+    assert!(!Path::new(o).exists());
+}
+
+#[test]
+fn render_from_a_table() {
+    let t = tables().join("golden/twill.bin");
+    let p = temp("table.png");
+    let out = clothbake(&[
+        "render",
+        "--table",
+        t.to_str().unwrap(),
+        "--res",
+        "16",
+        "--aa",
+        "1",
+        "--quiet",
+        "-o",
+        p.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(p.exists());
+}
+
+#[test]
+fn plot_writes_png_and_svg() {
+    let (p, s) = (temp("plot.png"), temp("plot.svg"));
+    let w = weave("twill");
+    let out = clothbake(&[
+        "plot",
+        "--weave",
+        &w,
+        "--theta-i",
+        "30",
+        "--phi-i",
+        "0",
+        "-o",
+        p.to_str().unwrap(),
+        "-o",
+        s.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(std::fs::read_to_string(&s).unwrap().contains("theta_i 30"));
+    assert!(std::fs::metadata(&p).unwrap().len() > 1000);
+}

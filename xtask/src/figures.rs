@@ -1,0 +1,165 @@
+//! `cargo xtask figures`: the thesis's rendered scenes, regenerated into `docs/figures/`.
+//!
+//! * `fig4-5.png`: thesis Fig. 4.5, the drape in basket (top) and twill (bottom) weave, eye at
+//!   (0, -55, 45) (left) and (-45, 45, 80) (right), light toward (0, 0.707, 0.707), rho_a 0.3,
+//!   rho_d 0.4, rho_s 0.3, n 10 (tables/basket.json, tables/twill.json); direct reflection.
+//! * `fig5-17.png`: the same four scenes with the secondary reflection (thesis Fig. 5.17,
+//!   `--bounces 2`, radiometric kernel), at a lower resolution (about 0.5 ms a shading point).
+//! * `fig5-10.png`, `fig5-11.png`: the disk of thesis sec. 5.4 (radius 5 on z = 0, parallel
+//!   cylinders d 2, r 1, h 0 along +y, rho_d 0.4, rho_s 0.7, eye (0, -10, 10), light 75 degrees
+//!   above the plane toward (0, -cos 75, sin 75), as `cargo xtask ch5`) shaded with I_ss alone
+//!   (Fig. 5.10) and I_2 alone (Fig. 5.11) for n = 1, 2, 4, 8, 16, 24, 32, left to right.
+//!
+//! All are rendered with the model directly (`clothbake render --weave`: exact, no table
+//! interpolation; the direct-reflection scenes would render as fast from a table). Tone mapping: clamp + sRGB, one exposure per
+//! figure (Fig. 4.5 and 5.17 share exposure 1, V itself, so the inter-reflection's brightening shows;
+//! each disk figure uses 1 / its largest value over all seven n).
+
+use clothbake::render::camera::Camera;
+use clothbake::render::render;
+use clothbake::render::scene::Scene;
+use clothbake::render::shade::{Component, Lighting, ModelShader};
+use clothbake::render::tonemap::{self, Curve, Image};
+use clothbake_core::{Fabric, FacetModel, SecondaryOptions, Variant, Vec3};
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+fn unit(v: Vec3) -> Vec3 {
+    v * (1.0 / v.length())
+}
+
+/// Images side by side in `cols` columns, separated by 2 black pixels.
+fn montage(images: &[Image], cols: usize) -> Image {
+    let (w, h) = (images[0].width, images[0].height);
+    let rows = images.len().div_ceil(cols);
+    let gap = 2;
+    let (mw, mh) = (
+        cols as u32 * w + (cols as u32 - 1) * gap,
+        rows as u32 * h + (rows as u32 - 1) * gap,
+    );
+    let mut px = vec![[0.0f32; 3]; (mw * mh) as usize];
+    for (k, img) in images.iter().enumerate() {
+        let (ox, oy) = ((k % cols) as u32 * (w + gap), (k / cols) as u32 * (h + gap));
+        for j in 0..h {
+            for i in 0..w {
+                px[((oy + j) * mw + ox + i) as usize] = img.get(i, j);
+            }
+        }
+    }
+    Image {
+        width: mw,
+        height: mh,
+        pixels: px,
+    }
+}
+
+fn shot(
+    scene: &Scene,
+    eye: Vec3,
+    size: u32,
+    aa: u32,
+    lighting: &Lighting,
+    shader: &ModelShader,
+) -> Image {
+    let (lo, hi) = scene.bounds();
+    let fov = Camera::fitting_fov(eye, Vec3::default(), size, size, lo, hi);
+    let cam = Camera::new(eye, Vec3::default(), fov, size, size).expect("valid camera");
+    render(
+        scene,
+        &cam,
+        lighting,
+        shader,
+        aa,
+        &|_| {},
+        &AtomicBool::new(false),
+    )
+    .expect("not cancelled")
+}
+
+fn save(path: &Path, img: &Image, exposure: f64) {
+    let rgb = tonemap::to_rgb8(img, exposure, Curve::Clamp);
+    tonemap::write_png_rgb8(path, img.width, img.height, &rgb, true)
+        .unwrap_or_else(|e| panic!("{e}"));
+    eprintln!("wrote {} ({}x{})", path.display(), img.width, img.height);
+}
+
+fn cloth(root: &Path, dir: &Path, bounces: u32, size: u32, aa: u32, name: &str) {
+    let start = Instant::now();
+    let lighting = Lighting {
+        light: unit(Vec3::new(0.0, 0.707, 0.707)),
+        irradiance: std::f64::consts::PI,
+        ambient: 0.3,
+    };
+    let secondary = (bounces == 2).then(SecondaryOptions::default);
+    let scene = Scene::by_name("drape").expect("drape");
+    let mut images = Vec::new();
+    for weave in ["basket", "twill"] {
+        let f = Fabric::from_path(&root.join(format!("tables/{weave}.json"))).unwrap();
+        let s = ModelShader::new(
+            &f,
+            FacetModel::Huo,
+            Variant::Refined,
+            secondary,
+            Component::Total,
+        )
+        .unwrap();
+        for eye in [Vec3::new(0.0, -55.0, 45.0), Vec3::new(-45.0, 45.0, 80.0)] {
+            images.push(shot(&scene, eye, size, aa, &lighting, &s));
+        }
+    }
+    save(&dir.join(name), &montage(&images, 2), 1.0);
+    eprintln!("{name}: {:.1} s", start.elapsed().as_secs_f64());
+}
+
+fn parallel(n: f64) -> Fabric {
+    let json = format!(
+        r#"{{"name": "parallel cylinders", "pattern": [[1]],
+            "warp": {{"radius": 1, "spacing": 2, "material": {{"albedo": 0.4, "specular": 0.7, "exponent": {n}}}}},
+            "weft": {{"radius": 1, "spacing": 2}}}}"#
+    );
+    Fabric::from_json_str(&json, "figures").expect("valid")
+}
+
+fn disks(dir: &Path, size: u32) {
+    let start = Instant::now();
+    let t = 75f64.to_radians();
+    let lighting = Lighting {
+        light: Vec3::new(0.0, -t.cos(), t.sin()),
+        irradiance: std::f64::consts::PI,
+        ambient: 0.0,
+    };
+    let scene = Scene::by_name("disk").expect("disk");
+    let eye = Vec3::new(0.0, -10.0, 10.0);
+    for (component, name) in [
+        (Component::SecondarySpecular, "fig5-10.png"),
+        (Component::Secondary, "fig5-11.png"),
+    ] {
+        let images: Vec<Image> = [1.0, 2.0, 4.0, 8.0, 16.0, 24.0, 32.0]
+            .iter()
+            .map(|&n| {
+                let s = ModelShader::new(
+                    &parallel(n),
+                    FacetModel::Huo,
+                    Variant::Refined,
+                    Some(SecondaryOptions::default()),
+                    component,
+                )
+                .unwrap();
+                shot(&scene, eye, size, 1, &lighting, &s)
+            })
+            .collect();
+        let m = montage(&images, images.len());
+        save(&dir.join(name), &m, tonemap::auto_exposure(&m));
+    }
+    eprintln!("disks: {:.1} s", start.elapsed().as_secs_f64());
+}
+
+/// Renders every figure into `docs/figures/`.
+pub fn run(root: &Path) {
+    let dir = root.join("docs/figures");
+    std::fs::create_dir_all(&dir).unwrap();
+    cloth(root, &dir, 1, 256, 2, "fig4-5.png");
+    disks(&dir, 128);
+    cloth(root, &dir, 2, 192, 1, "fig5-17.png");
+}
