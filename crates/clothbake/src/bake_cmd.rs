@@ -9,10 +9,10 @@
 use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg};
 use crate::cli::{DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
-use crate::eval_cmd::apply_material;
+use crate::eval_cmd::load_fabric;
 use clothbake::bake::{self, BakeError, BakeOptions, Method, DEFAULT_GRID};
 use clothbake::output::{write_table, Format};
-use clothbake_core::{Caps, Fabric, Variant};
+use clothbake_core::{Caps, Variant};
 use clothbake_loader::{Precision, TableError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -266,8 +266,7 @@ pub fn thousands(n: u64) -> String {
 /// Runs a bake and returns the summary line for stdout (empty with --quiet).
 pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     let plan = plan(weave, o)?;
-    let fabric = Fabric::from_path(&plan.weave)?;
-    let fabric = apply_material(fabric, &o.material);
+    let fabric = load_fabric(&plan.weave, &o.draft, &o.material)?;
     preflight(&plan.output, o.force)?;
     install_ctrlc();
 
