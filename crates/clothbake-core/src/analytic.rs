@@ -323,7 +323,7 @@ impl AnalyticModel {
                 extent: seg.extent,
                 end_plus,
                 end_minus,
-                material: fabric.group(g).material,
+                material: fabric.thread_material(g, seg.thread),
             };
             let mid = |k: isize| 0.5 * (geo.position(c, k - 1) + geo.position(c, k));
             let a = seg.float.start as isize;
@@ -359,7 +359,7 @@ impl AnalyticModel {
                         radius: yarn.radius,
                         height: yarn.height,
                         axial,
-                        material: data.material,
+                        material: geo.fabric.thread_material(g, nt),
                     })
                 };
                 let unit = Unit {
@@ -383,6 +383,10 @@ impl AnalyticModel {
                 let mat = data.material;
                 key.extend(mat.albedo);
                 key.extend([mat.specular, mat.exponent]);
+                // Per-thread colours: the neighbours' albedos enter the secondary reflection.
+                for nb in &unit.neighbours {
+                    key.extend(nb.map_or([-1.0; 3], |n| n.material.albedo));
+                }
                 for t in [
                     &unit.side_plus,
                     &unit.side_minus,

@@ -11,6 +11,7 @@
 //! an array with one value per thread of the period.
 
 use crate::weave::{Group, Weave};
+use crate::wif::WifOptions;
 use serde::Deserialize;
 use serde_json::Value;
 use std::fmt;
@@ -83,6 +84,9 @@ pub struct Yarn {
     pub spacing: f64,
     /// Explicit length of every float of this thread, or `None` to derive it (see `geometry`).
     pub segment_length: Option<f64>,
+    /// This thread's own diffuse albedo rho_d (RGB), overriding the group material's albedo;
+    /// `None` to use the group's (fabric files: `thread_albedo`).
+    pub albedo: Option<[f64; 3]>,
 }
 
 /// A yarn group (warp or weft): its threads in the period and their facet material.
@@ -90,8 +94,25 @@ pub struct Yarn {
 pub struct YarnGroup {
     /// One entry per thread of the period.
     pub threads: Vec<Yarn>,
-    /// Facet material of the whole group.
+    /// Facet material of the whole group (a thread's own albedo overrides its `albedo`).
     pub material: Material,
+}
+
+impl YarnGroup {
+    /// Diffuse albedo of thread `t` (index modulo the period): its own, else the group's.
+    pub fn albedo(&self, t: usize) -> [f64; 3] {
+        self.threads[t % self.threads.len()]
+            .albedo
+            .unwrap_or(self.material.albedo)
+    }
+
+    /// Facet material of thread `t` (index modulo the period).
+    pub fn thread_material(&self, t: usize) -> Material {
+        Material {
+            albedo: self.albedo(t),
+            ..self.material
+        }
+    }
 }
 
 /// A validated fabric: weave period, both yarn groups. Every invariant the model relies on holds.
@@ -130,6 +151,8 @@ struct GroupFile {
     segment_length: Option<Value>,
     #[serde(default)]
     material: Option<MaterialFile>,
+    #[serde(default)]
+    thread_albedo: Option<Vec<Value>>,
 }
 
 #[derive(Deserialize)]
@@ -178,6 +201,42 @@ impl Ctx<'_> {
         }
     }
 
+    /// A diffuse albedo: one number (grey) or `[r, g, b]`, each in [0, 1].
+    fn albedo(&self, f: &str, a: &Value) -> Result<[f64; 3], FabricError> {
+        let out = match a {
+            Value::Array(v) if v.len() == 3 => {
+                let mut c = [0.0; 3];
+                for (k, x) in v.iter().enumerate() {
+                    c[k] = self.number(&format!("{f}[{k}]"), x)?;
+                }
+                c
+            }
+            Value::Array(v) => {
+                return Err(self.err(
+                    f,
+                    format!("has {} values", v.len()),
+                    "give one number or three (R, G, B)",
+                ))
+            }
+            v => [self.number(f, v)?; 3],
+        };
+        for (k, c) in out.iter().enumerate() {
+            if !(0.0..=1.0).contains(c) {
+                let field = if a.is_array() {
+                    format!("{f}[{k}]")
+                } else {
+                    f.to_string()
+                };
+                return Err(self.err(
+                    field,
+                    format!("is {c}, outside [0, 1]"),
+                    "give a diffuse albedo between 0 and 1",
+                ));
+            }
+        }
+        Ok(out)
+    }
+
     /// One value for the group or one per thread.
     fn per_thread(&self, field: &str, v: &Value, n: usize) -> Result<Vec<f64>, FabricError> {
         match v {
@@ -204,14 +263,31 @@ impl Ctx<'_> {
 }
 
 impl Fabric {
-    /// Reads and validates a fabric file.
+    /// Reads and validates a fabric file: JSON, or a WIF weaving draft when the name ends in
+    /// `.wif` (any case; see [`crate::wif`]) with the default [`WifOptions`].
     pub fn from_path(path: &Path) -> Result<Fabric, FabricError> {
+        Fabric::from_path_with(path, &WifOptions::default())
+    }
+
+    /// As [`Fabric::from_path`], with the sizes a WIF draft may leave out.
+    pub fn from_path_with(path: &Path, wif: &WifOptions) -> Result<Fabric, FabricError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| FabricError {
+        let bytes = std::fs::read(path).map_err(|e| FabricError {
             file: file.clone(),
             field: String::new(),
             problem: format!("cannot read the fabric file: {e}"),
             fix: "check the path (e.g. tables/twill.json)".into(),
+        })?;
+        if is_wif(path) {
+            // Drafts are often Latin-1 or Windows-1252; only their [TEXT] can hold non-ASCII.
+            let text = String::from_utf8_lossy(&bytes);
+            return Ok(crate::wif::parse(&text, &file, wif)?);
+        }
+        let text = String::from_utf8(bytes).map_err(|e| FabricError {
+            file: file.clone(),
+            field: String::new(),
+            problem: format!("the fabric file is not UTF-8 text: {e}"),
+            fix: "save it as UTF-8 JSON (see docs/fabric-format.md)".into(),
         })?;
         Fabric::from_json_str(&text, &file)
     }
@@ -308,6 +384,10 @@ impl Fabric {
             if g.threads.iter().all(|y| y.segment_length.is_some()) {
                 v["segment_length"] = col(|y| y.segment_length.unwrap_or(0.0));
             }
+            if g.threads.iter().any(|y| y.albedo.is_some()) {
+                let per: Vec<[f64; 3]> = (0..g.threads.len()).map(|t| g.albedo(t)).collect();
+                v["thread_albedo"] = serde_json::json!(per);
+            }
             v
         };
         serde_json::json!({
@@ -326,11 +406,20 @@ impl Fabric {
         }
     }
 
-    /// A copy with every facet material replaced (CLI material overrides).
+    /// A copy with every facet material replaced (CLI material overrides); per-thread albedos
+    /// are dropped, so `m.albedo` holds for every thread.
     pub fn with_material(mut self, m: Material) -> Fabric {
-        self.warp.material = m;
-        self.weft.material = m;
+        for g in [&mut self.warp, &mut self.weft] {
+            g.material = m;
+            g.threads.iter_mut().for_each(|y| y.albedo = None);
+        }
         self
+    }
+
+    /// The facet material of thread `thread` of group `g`: the group's material with the
+    /// thread's own albedo where it has one.
+    pub fn thread_material(&self, g: Group, thread: usize) -> Material {
+        self.group(g).thread_material(thread)
     }
 
     fn check_segment_lengths(&self, cx: &Ctx) -> Result<(), FabricError> {
@@ -427,6 +516,30 @@ fn group(cx: &Ctx, name: &str, g: &GroupFile, n: usize) -> Result<YarnGroup, Fab
         }
     }
     let material = material(cx, name, g.material.as_ref())?;
+    let albedo = match &g.thread_albedo {
+        Some(list) => {
+            let f = format!("{name}.thread_albedo");
+            if list.len() != n {
+                return Err(cx.err(
+                    &f,
+                    format!(
+                        "has {} values but the period has {n} threads of this group",
+                        list.len()
+                    ),
+                    format!(
+                        "give exactly {n} albedos (each one number or [r, g, b]), one per thread"
+                    ),
+                ));
+            }
+            let per = list
+                .iter()
+                .enumerate()
+                .map(|(i, v)| cx.albedo(&format!("{f}[{i}]"), v).map(Some))
+                .collect::<Result<Vec<_>, _>>()?;
+            per
+        }
+        None => vec![None; n],
+    };
     Ok(YarnGroup {
         threads: (0..n)
             .map(|i| Yarn {
@@ -434,6 +547,7 @@ fn group(cx: &Ctx, name: &str, g: &GroupFile, n: usize) -> Result<YarnGroup, Fab
                 height: height[i],
                 spacing: spacing[i],
                 segment_length: seg.as_ref().map(|s| s[i]),
+                albedo: albedo[i],
             })
             .collect(),
         material,
@@ -444,33 +558,7 @@ fn material(cx: &Ctx, name: &str, m: Option<&MaterialFile>) -> Result<Material, 
     let mut out = Material::default();
     let Some(m) = m else { return Ok(out) };
     if let Some(a) = &m.albedo {
-        let f = format!("{name}.material.albedo");
-        out.albedo = match a {
-            Value::Array(v) if v.len() == 3 => {
-                let mut c = [0.0; 3];
-                for (k, x) in v.iter().enumerate() {
-                    c[k] = cx.number(&format!("{f}[{k}]"), x)?;
-                }
-                c
-            }
-            Value::Array(v) => {
-                return Err(cx.err(
-                    &f,
-                    format!("has {} values", v.len()),
-                    "give one number or three (R, G, B)",
-                ))
-            }
-            v => [cx.number(&f, v)?; 3],
-        };
-        for (k, c) in out.albedo.iter().enumerate() {
-            if !(0.0..=1.0).contains(c) {
-                return Err(cx.err(
-                    format!("{f}[{k}]"),
-                    format!("is {c}, outside [0, 1]"),
-                    "give a diffuse albedo between 0 and 1",
-                ));
-            }
-        }
+        out.albedo = cx.albedo(&format!("{name}.material.albedo"), a)?;
     }
     if let Some(s) = m.specular {
         if !(0.0..=1.0).contains(&s) {
@@ -493,6 +581,12 @@ fn material(cx: &Ctx, name: &str, m: Option<&MaterialFile>) -> Result<Material, 
         out.exponent = n;
     }
     Ok(out)
+}
+
+/// True when `path` names a WIF draft (extension `.wif`, any case).
+pub fn is_wif(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("wif"))
 }
 
 #[cfg(test)]
@@ -569,5 +663,30 @@ mod tests {
         ));
         assert_eq!(e.field, "warp.segment_length");
         assert!(err("{").problem.contains("EOF"));
+    }
+
+    #[test]
+    fn thread_albedo_overrides_the_group_and_round_trips() {
+        let t = OK.replace(
+            r#""weft": {"radius""#,
+            r#""weft": {"thread_albedo": [0.2, [0.9, 0.5, 0.1]], "radius""#,
+        );
+        let f = Fabric::from_json_str(&t, "t.json").unwrap();
+        assert_eq!(f.weft.albedo(0), [0.2; 3]);
+        assert_eq!(f.weft.albedo(1), [0.9, 0.5, 0.1]);
+        // The rest of the material is the group's; the warp has no list and keeps its own.
+        assert_eq!(f.thread_material(Group::Weft, 1).specular, DEFAULT_SPECULAR);
+        assert_eq!(f.warp.albedo(1), [DEFAULT_ALBEDO; 3]);
+        let back = Fabric::from_json_str(&f.to_json().to_string(), "t.json").unwrap();
+        assert_eq!(back.weft, f.weft);
+        // The material override drops the list.
+        let m = Material::default();
+        assert_eq!(f.clone().with_material(m).weft.albedo(1), m.albedo);
+        let e = err(&t.replace("[0.2, [0.9, 0.5, 0.1]]", "[0.2]"));
+        assert_eq!(e.field, "weft.thread_albedo");
+        let e = err(&t.replace("[0.9, 0.5, 0.1]", "[0.9, 0.5, 1.5]"));
+        assert_eq!(e.field, "weft.thread_albedo[1][2]");
+        let e = err(&t.replace("[0.2,", "[-0.2,"));
+        assert_eq!(e.field, "weft.thread_albedo[0]");
     }
 }

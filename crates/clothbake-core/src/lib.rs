@@ -23,6 +23,7 @@ pub mod symmetry;
 pub mod validate;
 pub mod vec3;
 pub mod weave;
+pub mod wif;
 
 pub use analytic::{AnalyticModel, SecondaryMethod, SecondaryOptions, Variant};
 pub use fabric::{Fabric, FabricError, Material};
@@ -33,3 +34,4 @@ pub use raytrace::{Caps, Estimate, RayTracer};
 pub use reflect::{intensity_to_brdf, Reflection};
 pub use vec3::{UnitVec3, Vec3};
 pub use weave::{Group, Weave};
+pub use wif::{WifError, WifOptions};

@@ -19,7 +19,7 @@
 //!   [`Caps::Shaded`] counts them as shaded yarn.
 //! * At a yarn hit with outward normal N, the facet intensity `facet.intensity(material, N, wi,
 //!   wo)` is taken when the shadow ray toward `wi` leaves the top plane without hitting anything
-//!   (zero otherwise): its diffuse factor times the group's RGB albedo goes to `i_d`, its specular
+//!   (zero otherwise): its diffuse factor times the thread's RGB albedo goes to `i_d`, its specular
 //!   part to `i_s`.
 //! * The estimate is the ratio (sum of shading) / (number of yarn hits). Its standard error comes
 //!   from [`BATCHES`] independent batches, each a stratified set of its own, see [`Estimate`].
@@ -565,7 +565,7 @@ impl RayTracer {
         let materials = geometry
             .segments
             .iter()
-            .map(|s| geometry.fabric.group(s.group).material)
+            .map(|s| geometry.fabric.thread_material(s.group, s.thread))
             .collect();
         let top = geometry.max_top();
         let z_top = top + 1e-6 * top.max(1e-3);

@@ -75,8 +75,8 @@ fn weave_equal(w: &Weave, f: impl Fn(usize, usize) -> bool, sx: usize, sy: usize
 }
 
 /// The symmetries (among mirror x, mirror y, rotation by 180 degrees) under which the fabric's
-/// micro-geometry is invariant up to a translation by whole threads. Materials are per group
-/// and unaffected.
+/// micro-geometry is invariant up to a translation by whole threads. Materials are per group,
+/// except per-thread albedos, which are part of each [`Yarn`] and so must map onto each other too.
 pub fn symmetries(fabric: &Fabric) -> Vec<Symmetry> {
     let w = &fabric.weave;
     let (nx, ny) = (w.n_warp(), w.n_weft());
@@ -139,6 +139,12 @@ mod tests {
         // Unequal warp radii in a non-palindromic order break the mirror in x.
         let odd = fabric("[[1,1,1],[1,1,1]]", "[1.0, 1.2, 1.4]");
         assert_eq!(symmetries(&odd), vec![Symmetry::MirrorY]);
+        // So do unequal per-thread colours: they are part of each thread.
+        let mut striped = fabric("[[1,1,1],[1,1,1]]", "1.5");
+        for (y, a) in striped.warp.threads.iter_mut().zip([0.1, 0.2, 0.3]) {
+            y.albedo = Some([a; 3]);
+        }
+        assert_eq!(symmetries(&striped), vec![Symmetry::MirrorY]);
     }
 
     #[test]

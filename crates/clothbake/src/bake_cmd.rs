@@ -9,7 +9,7 @@
 use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg, ShardArg};
 use crate::cli::{DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::{table_error, CliError};
-use crate::eval_cmd::apply_material;
+use crate::eval_cmd::load_fabric;
 use clothbake::bake::{self, BakeError, BakeOptions, Baker, Method, DEFAULT_GRID};
 use clothbake::checkpoint::{checkpoint_path, Checkpointer, DEFAULT_INTERVAL};
 use clothbake::merge;
@@ -17,7 +17,7 @@ use clothbake::output::{write_table, Format};
 use clothbake::shard::{
     describe_rows, read_part, shard_from_env, shard_rows, write_part, Kind, Part, ShardId,
 };
-use clothbake_core::{Caps, Fabric, Variant};
+use clothbake_core::{Caps, Variant};
 use clothbake_loader::{Precision, TableError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
@@ -386,8 +386,7 @@ fn load_checkpoint(
 /// Runs a bake and returns the summary line for stdout (empty with --quiet).
 pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     let plan = plan(weave, o)?;
-    let fabric = Fabric::from_path(&plan.weave)?;
-    let fabric = apply_material(fabric, &o.material);
+    let fabric = load_fabric(&plan.weave, &o.draft, &o.material)?;
     preflight(&plan.output, o.force)?;
     let shard = plan.shard.as_ref().map(|(id, _)| *id);
     if let Some((_, Some(how))) = &plan.shard {

@@ -36,7 +36,8 @@ pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
 
-    /// Fabric description to bake into a BRDF table (JSON, see docs/fabric-format.md).
+    /// Fabric description to bake into a BRDF table (JSON, see docs/fabric-format.md, or a
+    /// WIF weaving draft, *.wif, see docs/wif.md).
     #[arg(long, value_name = "FILE")]
     pub weave: Option<PathBuf>,
 
@@ -70,7 +71,8 @@ pub enum Command {
 /// `clothbake bake`.
 #[derive(Args, Debug)]
 pub struct BakeCmd {
-    /// Fabric description to bake (JSON, see docs/fabric-format.md), e.g. tables/twill.json.
+    /// Fabric description to bake (JSON, see docs/fabric-format.md, or a WIF draft, *.wif, see
+    /// docs/wif.md), e.g. tables/twill.json.
     #[arg(long, value_name = "FILE")]
     pub weave: PathBuf,
 
@@ -163,6 +165,10 @@ pub struct BakeOpts {
     /// Seconds between checkpoints of the finished rows [default: 60].
     #[arg(long, value_name = "SECS", value_parser = parse_seconds)]
     pub checkpoint_every: Option<f64>,
+
+    /// Yarn sizes for a WIF draft that gives none.
+    #[command(flatten)]
+    pub draft: DraftArgs,
 }
 
 /// `--shard` values.
@@ -360,7 +366,8 @@ pub struct DiffArgs {
 /// `clothbake eval`.
 #[derive(Args, Debug)]
 pub struct EvalArgs {
-    /// Fabric description (JSON, see docs/fabric-format.md), e.g. tables/twill.json.
+    /// Fabric description (JSON, see docs/fabric-format.md, or a WIF draft, *.wif, see
+    /// docs/wif.md), e.g. tables/twill.json.
     #[arg(long, value_name = "FILE")]
     pub weave: PathBuf,
 
@@ -407,6 +414,10 @@ pub struct EvalArgs {
     #[command(flatten)]
     pub material: MaterialArgs,
 
+    /// Yarn sizes for a WIF draft that gives none.
+    #[command(flatten)]
+    pub draft: DraftArgs,
+
     /// Print one JSON object instead of a table: keys I_d, I_s, I (reflected intensity for unit
     /// incident intensity) and brdf (1/sr), each [r, g, b]; with --bounces 2 also I_ss, I_sd,
     /// I_ds, I_dd and I_2 (I is then I_1 + I_2); raytrace adds std_err ([r, g, b], null when
@@ -429,6 +440,45 @@ pub struct MaterialArgs {
     /// Specular exponent n >= 0 (cloth: 6 to 15).
     #[arg(long, value_name = "N", value_parser = parse_exponent, allow_hyphen_values = true)]
     pub exponent: Option<f64>,
+}
+
+/// Yarn sizes for a WIF draft whose `[WARP]` / `[WEFT]` sections leave them out (docs/wif.md).
+#[derive(Args, Debug, Default, Clone, Copy, PartialEq)]
+pub struct DraftArgs {
+    /// WIF drafts only: yarn radius in mm where the draft gives no Thickness [default: from the
+    /// spacing in the ratio 1.5 : 3.1, else 0.15].
+    #[arg(long, value_name = "MM", value_parser = parse_length)]
+    pub radius: Option<f64>,
+
+    /// WIF drafts only: thread spacing (centre to centre) in mm where the draft gives no Spacing
+    /// [default: from the thickness in the ratio 3.1 : 3.0, else 0.31].
+    #[arg(long, value_name = "MM", value_parser = parse_length)]
+    pub spacing: Option<f64>,
+}
+
+impl DraftArgs {
+    /// The core's options for reading a draft.
+    pub fn options(&self) -> clothbake_core::WifOptions {
+        clothbake_core::WifOptions {
+            radius: self.radius,
+            spacing: self.spacing,
+        }
+    }
+
+    /// True when a size was given.
+    pub fn any(&self) -> bool {
+        self.radius.is_some() || self.spacing.is_some()
+    }
+}
+
+/// Parses a positive length in mm (`--radius`, `--spacing`).
+pub fn parse_length(s: &str) -> Result<f64, String> {
+    const FIX: &str = "give a positive length in millimetres, e.g. 0.15";
+    let x = number(s, "length").map_err(|e| format!("{e}; {FIX}"))?;
+    if !(x > 0.0 && x.is_finite()) {
+        return Err(format!("length {x} is not positive; {FIX}"));
+    }
+    Ok(x)
 }
 
 /// How to compute the reflection.

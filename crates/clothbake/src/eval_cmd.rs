@@ -1,11 +1,12 @@
 //! `clothbake eval`: the reflection of a fabric for one light and one eye direction.
 
-use crate::cli::{EvalArgs, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
+use crate::cli::{DraftArgs, EvalArgs, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
 use crate::report::{self, Report};
 use clothbake_core::pathtrace::PathOptions;
 use clothbake_core::Secondary;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, Reflection};
+use std::path::Path;
 
 /// Runs `clothbake eval` and returns the text to print on stdout.
 pub fn run(args: &EvalArgs) -> Result<String, CliError> {
@@ -24,8 +25,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     }
     let kernel = opts.kernel;
     let secondary = (args.bounces.bounces == 2).then_some(opts);
-    let fabric = Fabric::from_path(&args.weave)?;
-    let fabric = apply_material(fabric, &args.material);
+    let fabric = load_fabric(&args.weave, &args.draft, &args.material)?;
     let facet = FacetModel::from(args.facet);
     let (wi, wo) = (args.wi.unit(), args.wo.unit());
     let horizon = !(args.wi.above_horizon() && args.wo.above_horizon());
@@ -98,12 +98,30 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     Ok(if args.json { rep.json() } else { rep.table() })
 }
 
+/// Reads the fabric of `--weave` (JSON or WIF draft, with the draft's size flags) and applies the
+/// material overrides.
+pub fn load_fabric(weave: &Path, draft: &DraftArgs, m: &MaterialArgs) -> Result<Fabric, CliError> {
+    if draft.any() && !clothbake_core::fabric::is_wif(weave) {
+        return Err(CliError::new(
+            format!(
+                "--radius and --spacing apply only to a WIF draft (*.wif), and {} is a fabric file, which gives its sizes itself",
+                weave.display()
+            ),
+            "drop them, or edit radius and spacing in the fabric file",
+        ));
+    }
+    let fabric = Fabric::from_path_with(weave, &draft.options())?;
+    Ok(apply_material(fabric, m))
+}
+
 /// Replaces the facet-material fields given on the command line, in both yarn groups; fields not
-/// given keep each group's value from the file. (The values were range-checked by the parsers.)
+/// given keep each group's value from the file. `--albedo` also replaces per-thread albedos.
+/// (The values were range-checked by the parsers.)
 pub fn apply_material(mut fabric: Fabric, m: &MaterialArgs) -> Fabric {
     for g in [&mut fabric.warp, &mut fabric.weft] {
         if let Some(a) = m.albedo {
             g.material.albedo = a;
+            g.threads.iter_mut().for_each(|y| y.albedo = None);
         }
         if let Some(s) = m.specular {
             g.material.specular = s;

@@ -414,3 +414,88 @@ fn export_writes_an_rgl_file_and_refuses_bad_requests() {
     );
     std::fs::remove_file(&out).unwrap();
 }
+
+fn draft(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tables")
+        .join(name)
+}
+
+#[test]
+fn eval_reads_a_wif_draft() {
+    // Near-overhead light and eye on the 3/1 denim: three quarters indigo warp, so the diffuse
+    // part is bluer than red (the specular part is white).
+    let out = eval(
+        &draft("denim.wif"),
+        &["--wi", "10,0", "--wo", "10,180", "--json"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let i_d: Vec<f64> = v["I_d"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert!(i_d[2] > 1.2 * i_d[0], "{i_d:?}");
+}
+
+#[test]
+fn malformed_draft_names_section_and_line() {
+    let text = std::fs::read_to_string(draft("denim.wif")).unwrap();
+    let line = text.lines().position(|l| l == "3=3,4,1").unwrap() + 1;
+    let p = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-bad.wif");
+    std::fs::write(&p, text.replace("3=3,4,1", "3=3,4,5")).unwrap();
+    fails(
+        &eval(&p, &["--wi", "30,0", "--wo", "30,180"]),
+        &[
+            "cli-bad.wif",
+            &format!("[TIEUP] line {line}"),
+            "shaft 5 is beyond the 4 of [WEAVING] Shafts",
+        ],
+    );
+}
+
+#[test]
+fn draft_size_flags_only_with_a_draft() {
+    fails(
+        &eval(
+            &table("plain"),
+            &["--wi", "30,0", "--wo", "30,180", "--radius", "0.2"],
+        ),
+        &["--radius and --spacing apply only to a WIF draft"],
+    );
+    // twill22.wif gives no sizes: the flags set them (radius 0.1 of spacing 0.25 differs from
+    // the default proportions, so the reflection changes).
+    let a = eval(
+        &draft("twill22.wif"),
+        &["--wi", "40,10", "--wo", "30,200", "--json"],
+    );
+    let b = eval(
+        &draft("twill22.wif"),
+        &[
+            "--wi",
+            "40,10",
+            "--wo",
+            "30,200",
+            "--json",
+            "--radius",
+            "0.1",
+            "--spacing",
+            "0.25",
+        ],
+    );
+    assert!(a.status.success() && b.status.success());
+    assert_ne!(a.stdout, b.stdout);
+    fails(
+        &eval(
+            &draft("twill22.wif"),
+            &["--wi", "40,10", "--wo", "30,200", "--radius", "0"],
+        ),
+        &["--radius"],
+    );
+}

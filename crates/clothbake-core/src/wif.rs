@@ -1,0 +1,1022 @@
+//! Weaving drafts in WIF (Weaving Information File, version 1.1) read into a [`Fabric`].
+//!
+//! A WIF is an INI-like text file: `[SECTION]` headers, `key=value` lines, `;` comment lines,
+//! names case-insensitive. What is read (the full account is `docs/wif.md`):
+//!
+//! * **Pattern.** Warp end e (1-based) is on the shafts of `[THREADING] e=`; pick p lifts the
+//!   shafts of `[LIFTPLAN] p=`, or, without a liftplan, the union of the `[TIEUP]` shafts of the
+//!   treadles of `[TREADLING] p=`. The end is *raised* at pick p when one of its shafts is among
+//!   them. With `[WEAVING] Rising Shed=true` (the default) a raised end lies over the weft on
+//!   the face; with `Rising Shed=false` the listed shafts sink, so a raised end lies under it.
+//!   The face is the +Z side of clothbake's point paper: **column i = end i + 1, row j =
+//!   pick j + 1**, a cell 1 where the warp is over.
+//! * **Period.** The drawdown of all ends by all picks is taken as one repeat of the cloth and
+//!   reduced to its smallest repeat in each direction that also repeats the threads' colours,
+//!   spacings and thicknesses.
+//! * **Colours.** `[COLOR TABLE]` entries `i=r,g,b` in the `[COLOR PALETTE]` range `lo,hi`
+//!   (default 0,255), chosen per thread by `[WARP COLORS]` / `[WEFT COLORS]` or for a whole group
+//!   by `[WARP] Color=`, become diffuse albedos: c = (v - lo) / (hi - lo), decoded from the sRGB
+//!   transfer curve to linear ([`srgb_to_linear`]).
+//! * **Sizes.** `[WARP]` / `[WEFT]` `Spacing=` and `Thickness=` (per thread: `[WARP SPACING]`,
+//!   `[WARP THICKNESS]`, ...) in `Units=` (decipoints, inches or centimeters) become spacings and
+//!   radii (thickness / 2) in millimetres; WIF gives each thread the width `Spacing`, so the
+//!   centre-to-centre distance of threads i and i+1 is (s_i + s_{i+1}) / 2. Missing sizes come
+//!   from [`WifOptions`] or the defaults of [`resolve_sizes`].
+
+use crate::fabric::{Fabric, FabricError, Material, Yarn, YarnGroup};
+use crate::weave::Weave;
+use std::fmt;
+
+/// Default spacing (mm) of a group when neither the draft nor the options give any size: the
+/// thesis's samples' spacing-to-diameter ratio 3.1 : 3.0.
+pub const DEFAULT_SPACING_MM: f64 = 0.31;
+/// Default thickness (mm, the yarn diameter) paired with [`DEFAULT_SPACING_MM`].
+pub const DEFAULT_THICKNESS_MM: f64 = 0.30;
+
+/// Millimetres per WIF length unit (decipoint = 1/720 inch).
+fn unit_mm(units: &str) -> Option<f64> {
+    match units.trim().to_ascii_lowercase().as_str() {
+        "decipoints" | "decipoint" => Some(25.4 / 720.0),
+        "inches" | "inch" => Some(25.4),
+        "centimeters" | "centimeter" | "centimetres" | "centimetre" => Some(10.0),
+        _ => None,
+    }
+}
+
+/// A bad draft: the file, the section and line, what is wrong and how to fix it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WifError {
+    /// The file.
+    pub file: String,
+    /// The section, upper case without brackets (empty: the file as a whole).
+    pub section: String,
+    /// 1-based line number, where one line is at fault.
+    pub line: Option<usize>,
+    /// What is wrong.
+    pub problem: String,
+    /// How to fix it.
+    pub fix: String,
+}
+
+impl WifError {
+    /// Where: `[SECTION] line N`, `[SECTION]`, `line N` or nothing.
+    pub fn location(&self) -> String {
+        match (self.section.is_empty(), self.line) {
+            (false, Some(l)) => format!("[{}] line {l}", self.section),
+            (false, None) => format!("[{}]", self.section),
+            (true, Some(l)) => format!("line {l}"),
+            (true, None) => String::new(),
+        }
+    }
+}
+
+impl fmt::Display for WifError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let loc = self.location();
+        if loc.is_empty() {
+            write!(f, "{}: {}; {}", self.file, self.problem, self.fix)
+        } else {
+            write!(f, "{}: {loc}: {}; {}", self.file, self.problem, self.fix)
+        }
+    }
+}
+impl std::error::Error for WifError {}
+
+impl From<WifError> for FabricError {
+    fn from(e: WifError) -> FabricError {
+        let loc = e.location();
+        FabricError {
+            file: e.file,
+            field: String::new(),
+            problem: if loc.is_empty() {
+                e.problem
+            } else {
+                format!("{loc}: {}", e.problem)
+            },
+            fix: e.fix,
+        }
+    }
+}
+
+/// Sizes for a draft that does not give them (the command line's `--radius`, `--spacing`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WifOptions {
+    /// Yarn radius in mm for a group whose draft gives no `Thickness`.
+    pub radius: Option<f64>,
+    /// Spacing in mm for a group whose draft gives no `Spacing`.
+    pub spacing: Option<f64>,
+}
+
+/// Decodes an sRGB-encoded value in [0, 1] to linear light (IEC 61966-2-1).
+pub fn srgb_to_linear(c: f64) -> f64 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+struct Entry {
+    key: String,
+    value: String,
+    line: usize,
+}
+
+struct Section {
+    name: String,
+    line: usize,
+    entries: Vec<Entry>,
+}
+
+/// The parsed file: sections in order, with the file name for errors.
+struct Draft<'a> {
+    file: &'a str,
+    sections: Vec<Section>,
+}
+
+fn split_ini(text: &str, file: &str) -> Result<Vec<Section>, WifError> {
+    let err = |section: &str, line, problem: String, fix: &str| WifError {
+        file: file.into(),
+        section: section.into(),
+        line: Some(line),
+        problem,
+        fix: fix.into(),
+    };
+    let mut sections: Vec<Section> = Vec::new();
+    for (n, raw) in text.lines().enumerate() {
+        let line = n + 1;
+        let s = raw.trim_start_matches('\u{feff}').trim();
+        if s.is_empty() || s.starts_with(';') {
+            continue;
+        }
+        if let Some(rest) = s.strip_prefix('[') {
+            let Some(name) = rest.strip_suffix(']') else {
+                return Err(err(
+                    "",
+                    line,
+                    format!("`{s}` opens a section name without closing it"),
+                    "write the section header as [NAME]",
+                ));
+            };
+            let name = name.trim().to_ascii_uppercase();
+            if let Some(first) = sections.iter().find(|x| x.name == name) {
+                return Err(err(
+                    &name,
+                    line,
+                    format!(
+                        "the section appears a second time (first at line {})",
+                        first.line
+                    ),
+                    "merge the two sections into one",
+                ));
+            }
+            sections.push(Section {
+                name,
+                line,
+                entries: Vec::new(),
+            });
+            continue;
+        }
+        let Some((key, value)) = s.split_once('=') else {
+            let sec = sections.last().map_or("", |x| x.name.as_str());
+            return Err(err(
+                sec,
+                line,
+                format!("`{s}` is neither a [SECTION] header nor a key=value line"),
+                "write key=value, or start the line with ; to make it a comment",
+            ));
+        };
+        let Some(sec) = sections.last_mut() else {
+            return Err(err(
+                "",
+                line,
+                "a key=value line comes before any [SECTION] header".into(),
+                "start the file with [WIF]",
+            ));
+        };
+        let key = key.trim().to_string();
+        if let Some(first) = sec
+            .entries
+            .iter()
+            .find(|e| e.key.eq_ignore_ascii_case(&key))
+        {
+            let (name, first) = (sec.name.clone(), first.line);
+            return Err(err(
+                &name,
+                line,
+                format!("key `{key}` appears a second time (first at line {first})"),
+                "keep one entry per key",
+            ));
+        }
+        sec.entries.push(Entry {
+            key,
+            value: value.trim().to_string(),
+            line,
+        });
+    }
+    Ok(sections)
+}
+
+fn parse_bool(v: &str) -> Option<bool> {
+    match v.trim().to_ascii_lowercase().as_str() {
+        "true" | "yes" | "on" | "1" => Some(true),
+        "false" | "no" | "off" | "0" => Some(false),
+        _ => None,
+    }
+}
+
+/// The value without a trailing `; comment`.
+fn bare(v: &str) -> &str {
+    v.split(';').next().unwrap_or("").trim()
+}
+
+impl<'a> Draft<'a> {
+    fn err(
+        &self,
+        section: &str,
+        line: Option<usize>,
+        problem: impl Into<String>,
+        fix: impl Into<String>,
+    ) -> WifError {
+        WifError {
+            file: self.file.into(),
+            section: section.into(),
+            line,
+            problem: problem.into(),
+            fix: fix.into(),
+        }
+    }
+
+    /// A section, unless missing or switched off in `[CONTENTS]`.
+    fn section(&self, name: &str) -> Option<&Section> {
+        let off = self
+            .raw_section("CONTENTS")
+            .and_then(|c| c.entries.iter().find(|e| e.key.eq_ignore_ascii_case(name)))
+            .is_some_and(|e| parse_bool(&e.value) == Some(false));
+        if off {
+            None
+        } else {
+            self.raw_section(name)
+        }
+    }
+
+    fn raw_section(&self, name: &str) -> Option<&Section> {
+        self.sections.iter().find(|s| s.name == name)
+    }
+
+    fn value(&self, section: &str, key: &str) -> Option<&Entry> {
+        self.section(section)?
+            .entries
+            .iter()
+            .find(|e| e.key.eq_ignore_ascii_case(key))
+    }
+
+    fn int(&self, section: &str, e: &Entry, what: &str) -> Result<usize, WifError> {
+        bare(&e.value).parse::<usize>().map_err(|_| {
+            self.err(
+                section,
+                Some(e.line),
+                format!("{}={}: {what} is not a whole number", e.key, e.value),
+                format!("give {what} as a whole number"),
+            )
+        })
+    }
+
+    fn number(&self, section: &str, e: &Entry, what: &str) -> Result<f64, WifError> {
+        match bare(&e.value).parse::<f64>() {
+            Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+            _ => Err(self.err(
+                section,
+                Some(e.line),
+                format!("{}={}: {what} is not a positive number", e.key, e.value),
+                format!("give {what} as a positive decimal number"),
+            )),
+        }
+    }
+
+    fn boolean(&self, section: &str, key: &str, default: bool) -> Result<bool, WifError> {
+        let Some(e) = self.value(section, key) else {
+            return Ok(default);
+        };
+        parse_bool(bare(&e.value)).ok_or_else(|| {
+            self.err(
+                section,
+                Some(e.line),
+                format!("{}={} is not a yes/no value", e.key, e.value),
+                "write true or false (yes/no, on/off, 1/0)",
+            )
+        })
+    }
+
+    /// The entries of a numbered section (`n=...`, n >= 1), keyed by n, each at most `max`.
+    fn numbered(
+        &self,
+        section: &str,
+        what: &str,
+        max: Option<(usize, &str)>,
+    ) -> Result<Vec<(usize, &Entry)>, WifError> {
+        let Some(s) = self.section(section) else {
+            return Ok(Vec::new());
+        };
+        let mut out = Vec::with_capacity(s.entries.len());
+        for e in &s.entries {
+            let n = match e.key.parse::<usize>() {
+                Ok(n) if n >= 1 => n,
+                _ => {
+                    return Err(self.err(
+                        section,
+                        Some(e.line),
+                        format!("key `{}` is not a {what} number (1, 2, ...)", e.key),
+                        format!("number each line by its {what}, from 1"),
+                    ))
+                }
+            };
+            if let Some((m, source)) = max {
+                if n > m {
+                    return Err(self.err(
+                        section,
+                        Some(e.line),
+                        format!("{what} {n} is beyond the {m} of {source}"),
+                        format!("remove the line or raise {source}"),
+                    ));
+                }
+            }
+            out.push((n, e));
+        }
+        Ok(out)
+    }
+
+    /// A comma list of numbers, each in 1..=max (0 entries, meaning none, are dropped).
+    fn list(
+        &self,
+        section: &str,
+        e: &Entry,
+        what: &str,
+        max: Option<(usize, &str)>,
+    ) -> Result<Vec<usize>, WifError> {
+        let mut out = Vec::new();
+        for tok in bare(&e.value).split(',').map(str::trim) {
+            if tok.is_empty() {
+                continue;
+            }
+            let n = tok.parse::<usize>().map_err(|_| {
+                self.err(
+                    section,
+                    Some(e.line),
+                    format!("{}={}: `{tok}` is not a {what} number", e.key, e.value),
+                    format!("list {what} numbers separated by commas, e.g. 1,3"),
+                )
+            })?;
+            if n == 0 {
+                continue;
+            }
+            if let Some((m, source)) = max {
+                if n > m {
+                    return Err(self.err(
+                        section,
+                        Some(e.line),
+                        format!(
+                            "{}={}: {what} {n} is beyond the {m} of {source}",
+                            e.key, e.value
+                        ),
+                        format!("use {what}s 1 to {m} or raise {source}"),
+                    ));
+                }
+            }
+            out.push(n);
+        }
+        Ok(out)
+    }
+}
+
+/// Sizes (mm) of one group before the per-thread sections: spacing and thickness.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct GroupSizes {
+    spacing: Option<f64>,
+    thickness: Option<f64>,
+    unit: f64,
+}
+
+/// Group spacing and thickness (mm) from the draft, else the options, else each other (in the
+/// ratio 3.1 : 3.0 of the thesis's samples), else the other group's, else
+/// [`DEFAULT_SPACING_MM`] and [`DEFAULT_THICKNESS_MM`].
+pub fn resolve_sizes(
+    draft: (Option<f64>, Option<f64>),
+    other: (Option<f64>, Option<f64>),
+    opts: &WifOptions,
+) -> (f64, f64) {
+    let one = |(s, d): (Option<f64>, Option<f64>)| {
+        let s = s.or(opts.spacing);
+        let d = d.or(opts.radius.map(|r| 2.0 * r));
+        match (s, d) {
+            (Some(s), Some(d)) => Some((s, d)),
+            (Some(s), None) => Some((s, s * 3.0 / 3.1)),
+            (None, Some(d)) => Some((d * 3.1 / 3.0, d)),
+            (None, None) => None,
+        }
+    };
+    one(draft)
+        .or_else(|| one(other))
+        .unwrap_or((DEFAULT_SPACING_MM, DEFAULT_THICKNESS_MM))
+}
+
+/// One thread as read: its colour and its own sizes (mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Thread {
+    albedo: Option<[f64; 3]>,
+    spacing: f64,
+    thickness: f64,
+}
+
+impl Thread {
+    fn key(&self) -> [u64; 5] {
+        let a = self.albedo.unwrap_or([-1.0; 3]);
+        [
+            a[0].to_bits(),
+            a[1].to_bits(),
+            a[2].to_bits(),
+            self.spacing.to_bits(),
+            self.thickness.to_bits(),
+        ]
+    }
+}
+
+/// The smallest p dividing `n` with `same(i, (i + p) % n)` for every i.
+fn minimal_period(n: usize, same: impl Fn(usize, usize) -> bool) -> usize {
+    (1..=n)
+        .filter(|&p| n.is_multiple_of(p))
+        .find(|&p| (0..n).all(|i| same(i, (i + p) % n)))
+        .unwrap_or(n)
+}
+
+/// Reads and validates a WIF draft; `file` names it in errors (and, without a `[TEXT] Title`,
+/// gives the fabric its name).
+pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifError> {
+    let d = Draft {
+        file,
+        sections: split_ini(text, file)?,
+    };
+    if d.raw_section("WIF").is_none() {
+        return Err(d.err(
+            "",
+            None,
+            "this is not a WIF draft: it has no [WIF] section",
+            "give a Weaving Information File (version 1.1), or a JSON fabric file (docs/fabric-format.md)",
+        ));
+    }
+    let rising = d.boolean("WEAVING", "Rising Shed", true)?;
+    let count = |section: &str, key: &str, what: &str| -> Result<Option<usize>, WifError> {
+        match d.value(section, key) {
+            Some(e) => d.int(section, e, what).map(Some),
+            None => Ok(None),
+        }
+    };
+    let shafts = count("WEAVING", "Shafts", "the number of shafts")?;
+    let treadles = count("WEAVING", "Treadles", "the number of treadles")?;
+    let shaft_max = shafts.map(|m| (m, "[WEAVING] Shafts"));
+    let treadle_max = treadles.map(|m| (m, "[WEAVING] Treadles"));
+
+    // Threading: the shafts of each end.
+    let ends_given = count("WARP", "Threads", "the number of warp ends")?;
+    let ends_max = ends_given.map(|m| (m, "[WARP] Threads"));
+    if d.section("THREADING").is_none() {
+        return Err(d.err(
+            "THREADING",
+            None,
+            "the draft has no [THREADING] section",
+            "add [THREADING] with a line end=shaft for every warp end",
+        ));
+    }
+    let th = d.numbered("THREADING", "end", ends_max)?;
+    let ends = ends_given.unwrap_or_else(|| th.iter().map(|(n, _)| *n).max().unwrap_or(0));
+    let mut threading = vec![None; ends];
+    for &(n, e) in &th {
+        let shafts = d.list("THREADING", e, "shaft", shaft_max)?;
+        if shafts.is_empty() {
+            return Err(d.err(
+                "THREADING",
+                Some(e.line),
+                format!("end {n} is on no shaft"),
+                "put every warp end on a shaft (clothbake weaves every end), or remove the end and renumber",
+            ));
+        }
+        threading[n - 1] = Some(shafts);
+    }
+    if ends == 0 {
+        return Err(d.err(
+            "THREADING",
+            d.section("THREADING").map(|s| s.line),
+            "the draft has no warp ends",
+            "give [THREADING] a line end=shaft for each end",
+        ));
+    }
+    let threading: Vec<Vec<usize>> = threading
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| {
+            t.ok_or_else(|| {
+                d.err(
+                    "THREADING",
+                    d.section("THREADING").map(|s| s.line),
+                    format!("end {} of {ends} has no entry", i + 1),
+                    format!(
+                        "add the line {}=shaft (every end 1..{ends} needs one)",
+                        i + 1
+                    ),
+                )
+            })
+        })
+        .collect::<Result<_, _>>()?;
+
+    // The shafts lifted (or sunk) at each pick.
+    let picks_given = count("WEFT", "Threads", "the number of picks")?;
+    let picks_max = picks_given.map(|m| (m, "[WEFT] Threads"));
+    let (plan_section, plan) = if d.section("LIFTPLAN").is_some() {
+        let lp = d.numbered("LIFTPLAN", "pick", picks_max)?;
+        let mut rows = Vec::with_capacity(lp.len());
+        for &(n, e) in &lp {
+            rows.push((n, d.list("LIFTPLAN", e, "shaft", shaft_max)?));
+        }
+        ("LIFTPLAN", rows)
+    } else if d.section("TREADLING").is_some() {
+        if d.section("TIEUP").is_none() {
+            return Err(d.err(
+                "TIEUP",
+                None,
+                "the draft has a [TREADLING] but no [TIEUP]",
+                "add [TIEUP] with a line treadle=shafts for each treadle, or give a [LIFTPLAN]",
+            ));
+        }
+        let mut tieup: Vec<(usize, Vec<usize>)> = Vec::new();
+        for &(n, e) in &d.numbered("TIEUP", "treadle", treadle_max)? {
+            tieup.push((n, d.list("TIEUP", e, "shaft", shaft_max)?));
+        }
+        let mut rows = Vec::new();
+        for &(n, e) in &d.numbered("TREADLING", "pick", picks_max)? {
+            let mut lifted = Vec::new();
+            for t in d.list("TREADLING", e, "treadle", treadle_max)? {
+                if let Some((_, s)) = tieup.iter().find(|(k, _)| *k == t) {
+                    lifted.extend(s);
+                }
+            }
+            rows.push((n, lifted));
+        }
+        ("TREADLING", rows)
+    } else {
+        return Err(d.err(
+            "TREADLING",
+            None,
+            "the draft has neither a [TREADLING] nor a [LIFTPLAN] section",
+            "add [TREADLING] (with [TIEUP]) or [LIFTPLAN]: a line pick=treadles or pick=shafts for every pick",
+        ));
+    };
+    let picks = picks_given.unwrap_or_else(|| plan.iter().map(|(n, _)| *n).max().unwrap_or(0));
+    let plan_line = d.section(plan_section).map(|s| s.line);
+    if picks == 0 {
+        return Err(d.err(
+            plan_section,
+            plan_line,
+            "the draft has no picks",
+            format!("give [{plan_section}] a line for each pick"),
+        ));
+    }
+    let mut lift: Vec<Option<Vec<usize>>> = vec![None; picks];
+    for (n, s) in plan {
+        lift[n - 1] = Some(s);
+    }
+    let lift: Vec<Vec<usize>> = lift
+        .into_iter()
+        .enumerate()
+        .map(|(j, l)| {
+            l.ok_or_else(|| {
+                d.err(
+                    plan_section,
+                    plan_line,
+                    format!("pick {} of {picks} has no entry", j + 1),
+                    format!(
+                        "add the line {}=... (every pick 1..{picks} needs one; 0 lifts nothing)",
+                        j + 1
+                    ),
+                )
+            })
+        })
+        .collect::<Result<_, _>>()?;
+
+    // Drawdown: row j = pick j + 1, column i = end i + 1, true where the warp is over.
+    let over = |i: usize, j: usize| {
+        let raised = threading[i].iter().any(|s| lift[j].contains(s));
+        raised == rising
+    };
+
+    let warp = threads(&d, "WARP", ends, "end", opts, "WEFT")?;
+    let weft = threads(&d, "WEFT", picks, "pick", opts, "WARP")?;
+
+    // The smallest repeat of pattern and threads.
+    let px = minimal_period(ends, |a, b| {
+        warp[a].key() == warp[b].key() && (0..picks).all(|j| over(a, j) == over(b, j))
+    });
+    let py = minimal_period(picks, |a, b| {
+        weft[a].key() == weft[b].key() && (0..px).all(|i| over(i, a) == over(i, b))
+    });
+    let rows: Vec<Vec<bool>> = (0..py)
+        .map(|j| (0..px).map(|i| over(i, j)).collect())
+        .collect();
+    let weave = Weave::new(rows).expect("non-empty and rectangular by construction");
+
+    let name = d
+        .value("TEXT", "Title")
+        .map(|e| e.value.clone())
+        .filter(|t| !t.is_empty())
+        .unwrap_or_else(|| {
+            std::path::Path::new(file)
+                .file_stem()
+                .map_or("draft".into(), |s| s.to_string_lossy().into_owned())
+        });
+    Ok(Fabric {
+        name,
+        weave,
+        warp: group(&d, "WARP", &warp[..px])?,
+        weft: group(&d, "WEFT", &weft[..py])?,
+    })
+}
+
+/// The threads of one group: colours and sizes, per thread of the whole draft.
+fn threads(
+    d: &Draft,
+    g: &str,
+    n: usize,
+    what: &str,
+    opts: &WifOptions,
+    other: &str,
+) -> Result<Vec<Thread>, WifError> {
+    let sizes = group_sizes(d, g)?;
+    let theirs = group_sizes(d, other)?;
+    let (s, t) = resolve_sizes(
+        (sizes.spacing, sizes.thickness),
+        (theirs.spacing, theirs.thickness),
+        opts,
+    );
+    let colour = colours(d)?;
+    let lookup = |section: &str, e: &Entry, idx: usize| {
+        colour
+            .iter()
+            .find(|(k, _)| *k == idx)
+            .map(|(_, c)| *c)
+            .ok_or_else(|| {
+                d.err(
+                    section,
+                    Some(e.line),
+                    format!(
+                        "{}={}: colour {idx} is not in the [COLOR TABLE]",
+                        e.key, e.value
+                    ),
+                    "add the colour to [COLOR TABLE] or use one of its entries",
+                )
+            })
+    };
+    let default = match d.value(g, "Color") {
+        Some(e) => {
+            let v: Vec<&str> = bare(&e.value).split(',').map(str::trim).collect();
+            let idx = v[0].parse::<usize>().map_err(|_| {
+                d.err(
+                    g,
+                    Some(e.line),
+                    format!("Color={}: `{}` is not a colour number", e.value, v[0]),
+                    "give the number of a [COLOR TABLE] entry, e.g. Color=1",
+                )
+            })?;
+            Some(lookup(g, e, idx)?)
+        }
+        None => None,
+    };
+    let per_section = format!("{g} COLORS");
+    let mut albedo = vec![default; n];
+    let max = Some((
+        n,
+        if g == "WARP" {
+            "[WARP] Threads"
+        } else {
+            "[WEFT] Threads"
+        },
+    ));
+    for (k, e) in d.numbered(&per_section, what, max)? {
+        if k > n {
+            return Err(d.err(
+                &per_section,
+                Some(e.line),
+                format!("{what} {k} is beyond the {n} {what}s of the draft"),
+                "remove the line",
+            ));
+        }
+        let idx = d.int(&per_section, e, "a colour number")?;
+        albedo[k - 1] = Some(lookup(&per_section, e, idx)?);
+    }
+    let per = |suffix: &str, base: f64| -> Result<Vec<f64>, WifError> {
+        let section = format!("{g} {suffix}");
+        let mut v = vec![base; n];
+        for (k, e) in d.numbered(&section, what, None)? {
+            if k > n {
+                return Err(d.err(
+                    &section,
+                    Some(e.line),
+                    format!("{what} {k} is beyond the {n} {what}s of the draft"),
+                    "remove the line",
+                ));
+            }
+            v[k - 1] = d.number(&section, e, suffix.to_ascii_lowercase().as_str())? * sizes.unit;
+        }
+        Ok(v)
+    };
+    let spacing = per("SPACING", s)?;
+    let thickness = per("THICKNESS", t)?;
+    Ok((0..n)
+        .map(|k| Thread {
+            albedo: albedo[k],
+            spacing: spacing[k],
+            thickness: thickness[k],
+        })
+        .collect())
+}
+
+/// `[G] Units`, `Spacing`, `Thickness`, in mm.
+fn group_sizes(d: &Draft, g: &str) -> Result<GroupSizes, WifError> {
+    let unit = match d.value(g, "Units") {
+        Some(e) => unit_mm(&e.value).ok_or_else(|| {
+            d.err(
+                g,
+                Some(e.line),
+                format!("Units={} is not a WIF unit", e.value),
+                "write Units=Decipoints, Units=Inches or Units=Centimeters",
+            )
+        })?,
+        None => unit_mm("decipoints").expect("known unit"),
+    };
+    let get = |key: &str| -> Result<Option<f64>, WifError> {
+        match d.value(g, key) {
+            Some(e) => Ok(Some(d.number(g, e, &key.to_ascii_lowercase())? * unit)),
+            None => Ok(None),
+        }
+    };
+    Ok(GroupSizes {
+        spacing: get("Spacing")?,
+        thickness: get("Thickness")?,
+        unit,
+    })
+}
+
+/// `[COLOR TABLE]` as albedos, scaled by the `[COLOR PALETTE]` range.
+fn colours(d: &Draft) -> Result<Vec<(usize, [f64; 3])>, WifError> {
+    let (lo, hi) = match d.value("COLOR PALETTE", "Range") {
+        Some(e) => {
+            let v: Vec<Option<f64>> = bare(&e.value)
+                .split(',')
+                .map(|t| t.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+                .collect();
+            match v[..] {
+                [Some(lo), Some(hi)] if hi > lo => (lo, hi),
+                [Some(hi)] if hi > 0.0 => (0.0, hi),
+                _ => {
+                    return Err(d.err(
+                        "COLOR PALETTE",
+                        Some(e.line),
+                        format!("Range={} is not a range low,high with low < high", e.value),
+                        "write e.g. Range=0,255",
+                    ))
+                }
+            }
+        }
+        None => (0.0, 255.0),
+    };
+    if let Some(e) = d.value("COLOR PALETTE", "Form") {
+        if !bare(&e.value).eq_ignore_ascii_case("RGB") {
+            return Err(d.err(
+                "COLOR PALETTE",
+                Some(e.line),
+                format!("Form={}: only RGB colours are read", e.value),
+                "give the palette as Form=RGB",
+            ));
+        }
+    }
+    let mut out = Vec::new();
+    for (k, e) in d.numbered("COLOR TABLE", "colour", None)? {
+        let v: Vec<Option<f64>> = bare(&e.value)
+            .split(',')
+            .map(|t| t.trim().parse::<f64>().ok())
+            .collect();
+        let rgb = match v[..] {
+            [Some(r), Some(g), Some(b)] => [r, g, b],
+            _ => {
+                return Err(d.err(
+                    "COLOR TABLE",
+                    Some(e.line),
+                    format!("{}={} is not three numbers r,g,b", e.key, e.value),
+                    format!("write the colour as r,g,b, each from {lo} to {hi}"),
+                ))
+            }
+        };
+        if rgb.iter().any(|c| !(lo..=hi).contains(c)) {
+            return Err(d.err(
+                "COLOR TABLE",
+                Some(e.line),
+                format!(
+                    "{}={}: a component lies outside the [COLOR PALETTE] range {lo},{hi}",
+                    e.key, e.value
+                ),
+                "fix the colour or the palette's Range",
+            ));
+        }
+        out.push((k, rgb.map(|c| srgb_to_linear((c - lo) / (hi - lo)))));
+    }
+    Ok(out)
+}
+
+/// The clothbake yarn group of one period of threads: radii, centre-to-centre spacings, colours.
+fn group(d: &Draft, g: &str, t: &[Thread]) -> Result<YarnGroup, WifError> {
+    let n = t.len();
+    let mut threads = Vec::with_capacity(n);
+    for i in 0..n {
+        let next = &t[(i + 1) % n];
+        let spacing = 0.5 * (t[i].spacing + next.spacing);
+        let (r, r_next) = (0.5 * t[i].thickness, 0.5 * next.thickness);
+        if spacing < (r + r_next) * (1.0 - 1e-12) {
+            let what = if g == "WARP" { "ends" } else { "picks" };
+            return Err(d.err(
+                g,
+                d.section(g).map(|s| s.line),
+                format!(
+                    "{what} {} and {} would overlap: thicknesses {:.4} mm and {:.4} mm, centres {:.4} mm apart",
+                    i + 1,
+                    (i + 1) % n + 1,
+                    t[i].thickness,
+                    next.thickness,
+                    spacing
+                ),
+                format!(
+                    "make Thickness at most Spacing in [{g}] (or in [{g} THICKNESS] / [{g} SPACING]): clothbake's yarns are round and may touch but not overlap"
+                ),
+            ));
+        }
+        threads.push(Yarn {
+            radius: r,
+            height: 0.0,
+            spacing,
+            segment_length: None,
+            albedo: t[i].albedo,
+        });
+    }
+    let mut material = Material::default();
+    // One colour for the whole group: the group material's; otherwise per thread, with the
+    // default albedo for threads that have no colour.
+    let first = threads[0].albedo;
+    if threads.iter().all(|y| y.albedo == first) {
+        if let Some(a) = first {
+            material.albedo = a;
+        }
+        threads.iter_mut().for_each(|y| y.albedo = None);
+    } else {
+        for y in &mut threads {
+            y.albedo.get_or_insert(material.albedo);
+        }
+    }
+    Ok(YarnGroup { threads, material })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn draft(body: &str) -> String {
+        format!("[WIF]\nVersion=1.1\n{body}")
+    }
+
+    fn err(body: &str) -> WifError {
+        parse(&draft(body), "t.wif", &WifOptions::default()).unwrap_err()
+    }
+
+    #[test]
+    fn srgb_decode_end_points_and_mid_grey() {
+        assert_eq!(srgb_to_linear(0.0), 0.0);
+        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-15);
+        // sRGB 188/255 is about linear 0.5 (the well-known mid grey).
+        assert!((srgb_to_linear(188.0 / 255.0) - 0.5).abs() < 0.005);
+        // The two branches meet at the threshold.
+        let t = 0.04045;
+        assert!((t / 12.92 - ((t + 0.055) / 1.055f64).powf(2.4)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn minimal_period_finds_the_smallest_divisor() {
+        let v = [1, 2, 1, 2, 1, 2];
+        assert_eq!(minimal_period(6, |a, b| v[a] == v[b]), 2);
+        let w = [1, 2, 3, 1, 2, 4];
+        assert_eq!(minimal_period(6, |a, b| w[a] == w[b]), 6);
+        // 5 ends of a 2-end repeat: not a whole number of repeats, kept whole.
+        let x = [1, 2, 1, 2, 1];
+        assert_eq!(minimal_period(5, |a, b| x[a] == x[b]), 5);
+    }
+
+    #[test]
+    fn resolve_sizes_precedence() {
+        let none = WifOptions::default();
+        assert_eq!(
+            resolve_sizes((Some(1.0), Some(0.5)), (None, None), &none),
+            (1.0, 0.5)
+        );
+        let (s, t) = resolve_sizes((Some(3.1), None), (None, None), &none);
+        assert_eq!(s, 3.1);
+        assert!((t - 3.0).abs() < 1e-12);
+        // The other group's sizes before the defaults; the options before both.
+        assert_eq!(
+            resolve_sizes((None, None), (Some(2.0), Some(1.0)), &none),
+            (2.0, 1.0)
+        );
+        let o = WifOptions {
+            radius: Some(0.2),
+            spacing: Some(0.5),
+        };
+        assert_eq!(
+            resolve_sizes((None, None), (Some(2.0), Some(1.0)), &o),
+            (0.5, 0.4)
+        );
+        assert_eq!(
+            resolve_sizes((None, None), (None, None), &none),
+            (DEFAULT_SPACING_MM, DEFAULT_THICKNESS_MM)
+        );
+    }
+
+    const PLAIN: &str = "[WEAVING]\nShafts=2\nTreadles=2\n[WARP]\nThreads=2\n[WEFT]\nThreads=2\n\
+        [THREADING]\n1=1\n2=2\n[TIEUP]\n1=1\n2=2\n[TREADLING]\n1=1\n2=2\n";
+
+    #[test]
+    fn errors_name_section_and_line() {
+        // Line numbers count from the draft's first line: [WIF] 1, Version 2, [WEAVING] 3,
+        // Shafts 4, ..., [THREADING] 10, [TIEUP] 13 with 2=... on 15, [TREADLING] 16, 1=... 17.
+        let e = err(&PLAIN.replace("2=2\n[TREADLING]", "2=3\n[TREADLING]"));
+        assert_eq!((e.section.as_str(), e.line), ("TIEUP", Some(15)));
+        assert!(
+            e.problem
+                .contains("shaft 3 is beyond the 2 of [WEAVING] Shafts"),
+            "{e}"
+        );
+        assert!(e.to_string().starts_with("t.wif: [TIEUP] line 15: "), "{e}");
+
+        let e = err(&PLAIN.replace("[THREADING]\n1=1\n2=2", "[THREADING]\n1=1"));
+        assert_eq!((e.section.as_str(), e.line), ("THREADING", Some(10)));
+        assert!(e.problem.contains("end 2 of 2 has no entry"), "{e}");
+
+        let e = err(&PLAIN.replace("[TREADLING]\n1=1", "[TREADLING]\n1=x"));
+        assert_eq!((e.section.as_str(), e.line), ("TREADLING", Some(17)));
+
+        let e = err(&PLAIN.replace("Shafts=2", "Shafts two"));
+        assert_eq!((e.section.as_str(), e.line), ("WEAVING", Some(4)));
+
+        let e = err(&PLAIN.replace("[TIEUP]\n1=1\n2=2\n", ""));
+        assert_eq!(e.section, "TIEUP");
+
+        let e = err(&format!("{PLAIN}[TIEUP]\n1=1\n"));
+        assert!(e.problem.contains("second time (first at line 13)"), "{e}");
+
+        let e = err(&format!(
+            "{PLAIN}[COLOR TABLE]\n1=300,0,0\n[WARP COLORS]\n1=1\n"
+        ));
+        assert_eq!(e.section, "COLOR TABLE");
+        assert!(
+            e.problem
+                .contains("outside the [COLOR PALETTE] range 0,255"),
+            "{e}"
+        );
+
+        let e = err(&format!("{PLAIN}[WARP COLORS]\n1=4\n"));
+        assert_eq!(e.section, "WARP COLORS");
+        assert!(
+            e.problem.contains("colour 4 is not in the [COLOR TABLE]"),
+            "{e}"
+        );
+
+        let e = err(&PLAIN.replace(
+            "[WARP]\nThreads=2",
+            "[WARP]\nThreads=2\nSpacing=1\nThickness=1.2\nUnits=centimeters",
+        ));
+        assert_eq!(e.section, "WARP");
+        assert!(e.problem.contains("would overlap"), "{e}");
+
+        let e = err(&PLAIN
+            .replace("Units", "")
+            .replace("[WARP]\n", "[WARP]\nUnits=furlongs\n"));
+        assert!(e.problem.contains("Units=furlongs"), "{e}");
+
+        let e = parse("[DRAFT]\n1=1\n", "x.wif", &WifOptions::default()).unwrap_err();
+        assert!(e.problem.contains("no [WIF] section"), "{e}");
+    }
+
+    #[test]
+    fn contents_can_switch_a_section_off() {
+        // A [LIFTPLAN] marked false in [CONTENTS] is ignored: the treadling is woven.
+        let body = format!("[CONTENTS]\nLIFTPLAN=false\n{PLAIN}[LIFTPLAN]\n1=1,2\n2=1,2\n");
+        let f = parse(&draft(&body), "t.wif", &WifOptions::default()).unwrap();
+        assert_eq!(f.weave.to_rows(), vec![vec![1, 0], vec![0, 1]]);
+        let body = format!("{PLAIN}[LIFTPLAN]\n1=1,2\n2=1,2\n");
+        let f = parse(&draft(&body), "t.wif", &WifOptions::default()).unwrap();
+        assert_eq!(f.weave.to_rows(), vec![vec![1]]);
+    }
+}

@@ -1,0 +1,234 @@
+//! WIF drafts (`tables/*.wif`, written by hand) against point papers derived by hand from the
+//! weaving logic, and the documented colour and size mappings (`docs/wif.md`).
+
+use clothbake_core::wif::{parse, WifOptions};
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, Group, UnitVec3};
+use std::path::{Path, PathBuf};
+
+fn tables() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables")
+}
+
+fn load(name: &str) -> Fabric {
+    Fabric::from_path(&tables().join(name)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * b.abs().max(1.0)
+}
+
+/// sRGB value v of a 0..hi range to linear albedo, written out here from IEC 61966-2-1.
+fn lin(v: f64, hi: f64) -> f64 {
+    let c = v / hi;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[test]
+fn every_wif_in_tables_is_checked_here() {
+    let mut found: Vec<String> = std::fs::read_dir(tables())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "wif"))
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    found.sort();
+    assert_eq!(found, ["denim.wif", "gingham.wif", "twill22.wif"]);
+}
+
+#[test]
+fn denim_is_the_warp_faced_3_1_twill() {
+    // Straight draw (end e on shaft e), rising shed, pick p treads treadle p, and treadle t lifts
+    // shafts t, t+1, t+2 (mod 4). Pick 1 lifts shafts 1,2,3: ends 1-3 over, end 4 under, so
+    // row 0 = 1110; every later pick lifts the next three shafts, moving the under-cell one end
+    // to the right (+X) and wrapping: 0111, 1011, 1101.
+    let f = load("denim.wif");
+    let want = vec![
+        vec![1, 1, 1, 0],
+        vec![0, 1, 1, 1],
+        vec![1, 0, 1, 1],
+        vec![1, 1, 0, 1],
+    ];
+    assert_eq!(f.weave.to_rows(), want);
+    // The same point paper as the hand-written JSON fabric of the 3/1 twill.
+    assert_eq!(load("twill31.json").weave, f.weave);
+    assert_eq!(f.name, "denim");
+    // Indigo warp 21,46,110 and off-white weft 240,240,235 of 0..255, decoded from sRGB.
+    let indigo = [lin(21.0, 255.0), lin(46.0, 255.0), lin(110.0, 255.0)];
+    let white = [lin(240.0, 255.0), lin(240.0, 255.0), lin(235.0, 255.0)];
+    for k in 0..3 {
+        assert!(close(f.warp.material.albedo[k], indigo[k]), "{k}");
+        assert!(close(f.weft.material.albedo[k], white[k]), "{k}");
+    }
+    // Published sRGB decodings: 240 -> 0.8714, 110 -> 0.1559.
+    assert!((white[0] - 0.8714).abs() < 1e-4 && (indigo[2] - 0.1559).abs() < 1e-4);
+    // Spacing 0.031 cm and thickness 0.030 cm: 0.31 mm centre to centre, radius 0.15 mm.
+    for g in [&f.warp, &f.weft] {
+        for y in &g.threads {
+            assert!(close(y.spacing, 0.31) && close(y.radius, 0.15), "{y:?}");
+            assert_eq!(y.albedo, None);
+        }
+    }
+}
+
+#[test]
+fn denim_reflects_like_the_json_twill_of_the_same_proportions() {
+    // twill31.json: radius 1.5, spacing 3.1, the ratio of denim.wif's 0.15 mm and 0.31 mm; only
+    // ratios matter, so with denim's material the two give the same reflection.
+    let wif = load("denim.wif");
+    let mut json = load("twill31.json");
+    json.warp.material = wif.warp.material;
+    json.weft.material = wif.weft.material;
+    let (a, b) = (
+        AnalyticModel::new(&wif, FacetModel::Huo),
+        AnalyticModel::new(&json, FacetModel::Huo),
+    );
+    for (ti, pi, to, po) in [(30.0, 0.0, 45.0, 180.0), (50.0, 80.0, 20.0, 300.0)] {
+        let (wi, wo) = (
+            UnitVec3::from_degrees(ti, pi),
+            UnitVec3::from_degrees(to, po),
+        );
+        let (x, y) = (a.eval(wi, wo).total(), b.eval(wi, wo).total());
+        for k in 0..3 {
+            assert!((x[k] - y[k]).abs() <= 1e-9 * y[k], "{x:?} {y:?}");
+        }
+    }
+}
+
+#[test]
+fn gingham_reduces_to_its_colour_repeat() {
+    // Plain weave: ends alternate shafts 1, 2; pick p treads treadle 1 for odd p, 2 for even p,
+    // each lifting its own shaft. Pick 1 raises the odd ends (columns 0, 2, ...): cell (i, j) is 1
+    // where i + j is even. The weave repeats every 2 threads, but the colour stripes (4 red,
+    // 4 white) every 8, and the draft writes 16: the period is 8 x 8.
+    let f = load("gingham.wif");
+    let want: Vec<Vec<u8>> = (0..8)
+        .map(|j| (0..8).map(|i| ((i + j) % 2 == 0) as u8).collect())
+        .collect();
+    assert_eq!(f.weave.to_rows(), want);
+    let red = [lin(800.0, 999.0), lin(80.0, 999.0), lin(80.0, 999.0)];
+    let white = [lin(950.0, 999.0); 3];
+    for g in [Group::Warp, Group::Weft] {
+        for t in 0..8 {
+            let want = if t < 4 { red } else { white };
+            let got = f.group(g).albedo(t);
+            assert!((0..3).all(|k| close(got[k], want[k])), "{g:?} {t}: {got:?}");
+        }
+    }
+    // 0.0125 inch spacing, 0.012 inch thickness.
+    let y = f.warp.threads[3];
+    assert!(close(y.spacing, 0.0125 * 25.4) && close(y.radius, 0.006 * 25.4));
+}
+
+#[test]
+fn twill22_liftplan_on_a_sinking_shed() {
+    // Sinking shed: the listed shafts go down, taking their ends under the weft. Pick 1 sinks
+    // shafts 1, 2: ends 1, 2 under, 3, 4 over: 0011. Each pick sinks the next pair: 1001, 1100,
+    // 0110. Eight ends and picks written, two repeats of four.
+    let f = load("twill22.wif");
+    let want = vec![
+        vec![0, 0, 1, 1],
+        vec![1, 0, 0, 1],
+        vec![1, 1, 0, 0],
+        vec![0, 1, 1, 0],
+    ];
+    assert_eq!(f.weave.to_rows(), want);
+    // No sizes and no colours in the draft: the documented defaults (0.31 mm, 0.30 mm thick;
+    // the thesis's rho_d 0.4).
+    for y in f.warp.threads.iter().chain(&f.weft.threads) {
+        assert!(close(y.spacing, 0.31) && close(y.radius, 0.15), "{y:?}");
+    }
+    assert_eq!(f.warp.material.albedo, [0.4; 3]);
+    // The same draft on a rising shed is the other face: every cell flipped.
+    let text = std::fs::read_to_string(tables().join("twill22.wif")).unwrap();
+    let rising = parse(
+        &text.replace("Rising Shed=false", "Rising Shed=true"),
+        "t.wif",
+        &WifOptions::default(),
+    )
+    .unwrap();
+    let flipped: Vec<Vec<u8>> = want
+        .iter()
+        .map(|r| r.iter().map(|&c| 1 - c).collect())
+        .collect();
+    assert_eq!(rising.weave.to_rows(), flipped);
+}
+
+#[test]
+fn options_fill_in_missing_sizes_only() {
+    let text = std::fs::read_to_string(tables().join("twill22.wif")).unwrap();
+    let o = WifOptions {
+        radius: Some(0.1),
+        spacing: Some(0.25),
+    };
+    let f = parse(&text, "t.wif", &o).unwrap();
+    assert!(close(f.weft.threads[0].radius, 0.1) && close(f.weft.threads[0].spacing, 0.25));
+    // denim.wif gives both: the options do not override them.
+    let text = std::fs::read_to_string(tables().join("denim.wif")).unwrap();
+    let f = parse(&text, "d.wif", &o).unwrap();
+    assert!(close(f.warp.threads[0].radius, 0.15));
+}
+
+#[test]
+fn per_thread_sizes_give_centre_distances() {
+    // [WARP SPACING] gives each end its own width; centres of ends i and i+1 are half the sum
+    // apart. Ends of widths 0.4, 0.2, 0.4, 0.2 (decipoints, the default unit) repeat every 2.
+    let body = "[WIF]\nVersion=1.1\n[WEAVING]\nShafts=2\n[WARP]\nThreads=4\nThickness=0.2\n\
+        [WEFT]\nThreads=2\nSpacing=0.4\nThickness=0.2\n[WARP SPACING]\n1=0.4\n2=0.2\n3=0.4\n4=0.2\n\
+        [THREADING]\n1=1\n2=2\n3=1\n4=2\n[LIFTPLAN]\n1=1\n2=2\n";
+    let f = parse(body, "t.wif", &WifOptions::default()).unwrap();
+    let dp = 25.4 / 720.0;
+    assert_eq!(f.weave.n_warp(), 2);
+    for y in &f.warp.threads {
+        assert!(
+            close(y.spacing, 0.3 * dp) && close(y.radius, 0.1 * dp),
+            "{y:?}"
+        );
+    }
+}
+
+#[test]
+fn malformed_drafts_name_file_section_and_line() {
+    let text = std::fs::read_to_string(tables().join("denim.wif")).unwrap();
+    let line = |needle: &str| text.lines().position(|l| l == needle).unwrap() + 1;
+    let bad = |from: &str, to: &str| {
+        parse(&text.replace(from, to), "denim.wif", &WifOptions::default()).unwrap_err()
+    };
+    let e = bad("3=3,4,1", "3=3,4,5");
+    assert_eq!(
+        (e.section.as_str(), e.line),
+        ("TIEUP", Some(line("3=3,4,1")))
+    );
+    assert!(
+        e.to_string().starts_with(&format!(
+            "denim.wif: [TIEUP] line {}: 3=3,4,5: shaft 5 is beyond the 4 of [WEAVING] Shafts; ",
+            line("3=3,4,1")
+        )),
+        "{e}"
+    );
+    let e = bad("1=21,46,110", "1=21,46");
+    assert_eq!(
+        (e.section.as_str(), e.line),
+        ("COLOR TABLE", Some(line("1=21,46,110")))
+    );
+    let e = bad(
+        "Units=Centimeters\nSpacing=0.031",
+        "Units=Centimeters\nSpacing=0.025",
+    );
+    assert_eq!(e.section, "WARP");
+    assert!(e.problem.contains("would overlap"), "{e}");
+    let e = bad("Rising Shed=true", "Rising Shed=maybe");
+    assert_eq!(
+        (e.section.as_str(), e.line),
+        ("WEAVING", Some(line("Rising Shed=true")))
+    );
+    // Through Fabric::from_path the error keeps section and line.
+    let p = Path::new(env!("CARGO_TARGET_TMPDIR")).join("bad-denim.wif");
+    std::fs::write(&p, text.replace("4=4\n", "4=0\n")).unwrap();
+    let e = Fabric::from_path(&p).unwrap_err().to_string();
+    assert!(e.contains("bad-denim.wif: [THREADING] line"), "{e}");
+    assert!(e.contains("end 4 is on no shaft"), "{e}");
+}
