@@ -29,7 +29,7 @@ thread_local! {
 
 fn set_error(message: &str) {
     let text = CString::new(message.replace('\0', " ")).unwrap_or_default();
-    LAST_ERROR.with(|e| *e.borrow_mut() = Some(text));
+    let _ = LAST_ERROR.try_with(|e| *e.borrow_mut() = Some(text));
 }
 
 /// Runs `f`, turning an `Err` or a panic into `fallback` and a last error.
@@ -276,7 +276,9 @@ pub unsafe extern "C" fn clothbake_pdf(
 /// none. Valid until the next failing call on the same thread; do not free it.
 #[no_mangle]
 pub extern "C" fn clothbake_last_error() -> *const c_char {
-    LAST_ERROR.with(|e| e.borrow().as_ref().map_or(std::ptr::null(), |s| s.as_ptr()))
+    LAST_ERROR
+        .try_with(|e| e.borrow().as_ref().map_or(std::ptr::null(), |s| s.as_ptr()))
+        .unwrap_or(std::ptr::null())
 }
 
 #[cfg(test)]
