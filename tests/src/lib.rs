@@ -1,1 +1,4 @@
-//! Integration tests live in `tests/tests/`.
+//! Cross-crate helpers shared by the integration tests (`tests/tests/`), the benchmarks
+//! (`tests/benches/`) and `cargo xtask loader-accuracy`.
+
+pub mod accuracy;

@@ -23,12 +23,8 @@ const ATAN_COEFFS: [f32; 6] = [
 fn atan_unit(a: f32) -> f32 {
     let s = a * a;
     let c = &ATAN_COEFFS;
-    let p = c[5]
-        .mul_add(s, c[4])
-        .mul_add(s, c[3])
-        .mul_add(s, c[2])
-        .mul_add(s, c[1])
-        .mul_add(s, c[0]);
+    // Horner; plain products and sums (`mul_add` is a slow library call without FMA hardware).
+    let p = ((((c[5] * s + c[4]) * s + c[3]) * s + c[2]) * s + c[1]) * s + c[0];
     a * p
 }
 

@@ -155,15 +155,33 @@ fn polar_span(theta: f32, n: u32, cells_per_rad: f32) -> Span {
     }
 }
 
-/// An azimuth axis of `n` cells, at `phi` radians (any value: periodic): the two cells whose
-/// centres bracket `phi`, wrapping from cell `n - 1` to cell 0.
+/// An azimuth axis of `n` cells, at `phi` radians in `[-2 pi, 4 pi)` (the vector path gives
+/// `[-pi, pi]`; [`Brdf::eval_deg`] wraps first): the two cells whose centres bracket `phi`,
+/// wrapping from cell `n - 1` to cell 0. No integer division: two conditional wraps.
 #[inline(always)]
 fn azimuth_span(phi: f32, n: u32, cells_per_rad: f32) -> Span {
     let c = phi * cells_per_rad - 0.5;
-    let f = c.floor();
-    let t = c - f;
+    // floor(c) without the `floorf` library call of baseline x86-64; NaN -> 0.
+    let mut lo = c as i32;
+    if (lo as f32) > c {
+        lo -= 1;
+    }
+    let t = c - lo as f32;
     let t = if t >= 0.0 { t.min(1.0) } else { 0.0 }; // NaN -> 0
-    let lo = (f as i64).rem_euclid(i64::from(n)) as usize;
+    let n = n as i32;
+    if lo < 0 {
+        lo += n;
+    }
+    if lo < 0 {
+        lo += n;
+    }
+    if lo >= n {
+        lo -= n;
+    }
+    if lo >= n {
+        lo -= n;
+    }
+    let lo = lo.clamp(0, n - 1) as usize;
     let hi = if lo + 1 == n as usize { 0 } else { lo + 1 };
     Span { lo, hi, t }
 }
@@ -290,7 +308,14 @@ impl Brdf {
             return [0.0; 3];
         }
         let r = f32::to_radians;
-        let (ti, pi, to, po) = (r(theta_i), r(phi_i), r(theta_o), r(phi_o));
+        let wrap = |phi: f32| {
+            if phi.is_finite() {
+                phi.rem_euclid(360.0)
+            } else {
+                0.0
+            }
+        };
+        let (ti, pi, to, po) = (r(theta_i), r(wrap(phi_i)), r(theta_o), r(wrap(phi_o)));
         match &self.store {
             Store::F16(v) => self.blend_reciprocal(v, ti, pi, to, po),
             Store::F32(v) => self.blend_reciprocal(v, ti, pi, to, po),
@@ -422,13 +447,13 @@ impl Brdf {
             for (oo, wo) in outgoing {
                 let k = oi + oo;
                 let node = &v[k..k + 3];
-                inner[0] = node[0].widen().mul_add(wo, inner[0]);
-                inner[1] = node[1].widen().mul_add(wo, inner[1]);
-                inner[2] = node[2].widen().mul_add(wo, inner[2]);
+                inner[0] += node[0].widen() * wo;
+                inner[1] += node[1].widen() * wo;
+                inner[2] += node[2].widen() * wo;
             }
-            acc[0] = inner[0].mul_add(wi, acc[0]);
-            acc[1] = inner[1].mul_add(wi, acc[1]);
-            acc[2] = inner[2].mul_add(wi, acc[2]);
+            acc[0] += inner[0] * wi;
+            acc[1] += inner[1] * wi;
+            acc[2] += inner[2] * wi;
         }
         acc
     }

@@ -155,7 +155,7 @@ impl Sampler {
         let row = (oc * nti + ti) * npi;
         let (pi, r2) = pick(&self.conditional[row..row + npi], u2);
         let (c_lo, c_hi) = (self.cos_edges[ti], self.cos_edges[ti + 1]);
-        let mu = r1.mul_add(c_hi - c_lo, c_lo);
+        let mu = c_lo + r1 * (c_hi - c_lo);
         let theta = mu.clamp(0.0, 1.0).acos();
         let phi = (pi as f32 + r2) * std::f32::consts::TAU / npi as f32;
         (theta, phi)

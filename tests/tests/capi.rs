@@ -1,0 +1,139 @@
+//! The C API from C: tests/c/lookup.c, compiled with the machine's `cc` against
+//! crates/clothbake-capi/include/clothbake.h and the crate's static library, opens a baked twill
+//! table and checks lookups, batched lookups, samples and pdfs against the Rust loader, bit for
+//! bit, and its error paths (missing file, NULL pointers, unknown flags).
+
+use clothbake::bake::{bake, BakeOptions};
+use clothbake_core::Fabric;
+use clothbake_loader::{write_exr, Brdf, Grid, Options, Precision};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::atomic::AtomicBool;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The static library cargo built for this test (a dev-dependency), next to the test binary.
+fn static_lib() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let deps = exe.parent().unwrap();
+    for dir in [deps, deps.parent().unwrap()] {
+        let p = dir.join("libclothbake_capi.a");
+        if p.exists() {
+            return p;
+        }
+    }
+    panic!("libclothbake_capi.a not found next to {}", exe.display());
+}
+
+fn f(x: f32) -> String {
+    format!("{x:.9e}")
+}
+
+fn v3(v: [f32; 3]) -> String {
+    v.map(f).join(" ")
+}
+
+#[test]
+fn the_c_program_agrees_with_the_rust_loader() {
+    let dir = tempfile_dir();
+    let grid = Grid {
+        n_theta_i: 8,
+        n_phi_i: 16,
+        n_theta_o: 8,
+        n_phi_o: 16,
+    };
+    let fabric = Fabric::from_path(&root().join("tables/twill.json")).unwrap();
+    let opts = BakeOptions {
+        grid,
+        ..BakeOptions::default()
+    };
+    let table = bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false))
+        .unwrap()
+        .table;
+    let table_path = dir.join("twill.exr");
+    write_exr(&table_path, &table, Precision::F16, false).unwrap();
+    let b = Brdf::open(&table_path, Options::default()).unwrap();
+
+    let mut cases = format!(
+        "G {} {} {} {}\n",
+        grid.n_theta_i, grid.n_phi_i, grid.n_theta_o, grid.n_phi_o
+    );
+    let dir_of = |t: f32, p: f32| {
+        let (t, p) = (t.to_radians(), p.to_radians());
+        [t.sin() * p.cos(), t.sin() * p.sin(), t.cos()]
+    };
+    for k in 0..200 {
+        let x = k as f32;
+        let wi = dir_of((x * 37.3) % 95.0, (x * 61.7) % 360.0);
+        let wo = dir_of((x * 53.1) % 92.0, (x * 97.9) % 360.0);
+        writeln!(cases, "E {} {} {}", v3(wi), v3(wo), v3(b.eval(wi, wo))).unwrap();
+        let a = [
+            (x * 7.1) % 89.0,
+            (x * 13.3) % 360.0,
+            (x * 5.7) % 89.0,
+            x * 3.1,
+        ];
+        let fd = b.eval_deg(a[0], a[1], a[2], a[3]);
+        writeln!(cases, "D {} {}", a.map(f).join(" "), v3(fd)).unwrap();
+        let (u1, u2) = ((x * 0.618_034) % 1.0, (x * 0.414_214) % 1.0);
+        let s = b.sample(wo, u1, u2);
+        writeln!(
+            cases,
+            "S {} {} {} {} {} {}",
+            v3(wo),
+            f(u1),
+            f(u2),
+            v3(s.wi),
+            v3(s.weight),
+            f(s.pdf)
+        )
+        .unwrap();
+        writeln!(cases, "P {} {} {}", v3(wo), v3(wi), f(b.pdf(wo, wi))).unwrap();
+    }
+    let cases_path = dir.join("cases.txt");
+    std::fs::write(&cases_path, cases).unwrap();
+
+    let exe = dir.join("lookup");
+    let cc = Command::new("cc")
+        .args(["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-I"])
+        .arg(root().join("crates/clothbake-capi/include"))
+        .arg(root().join("tests/c/lookup.c"))
+        .arg(static_lib())
+        .args(["-lpthread", "-ldl", "-lm", "-o"])
+        .arg(&exe)
+        .output()
+        .expect("the C compiler `cc` runs");
+    assert!(
+        cc.status.success(),
+        "cc failed:\n{}",
+        String::from_utf8_lossy(&cc.stderr)
+    );
+    let run = Command::new(&exe)
+        .arg(&table_path)
+        .arg(&cases_path)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "lookup.c failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(
+        stdout.contains(
+            "1 grid, 200 eval (and batch), 200 eval_deg, 200 sample, 200 pdf cases: 0 failures"
+        ),
+        "{stdout}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A fresh folder under the target directory's temporary space.
+fn tempfile_dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("clothbake-capi-test-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
