@@ -46,6 +46,9 @@ impl PyTable {
     }
 }
 
+/// Three floats as Python sees them: a direction or an RGB value.
+type Triple = (f32, f32, f32);
+
 /// Rows as f32 vectors (the loader's precision).
 fn narrow(r: &[[f64; 3]]) -> Vec<[f32; 3]> {
     r.iter().map(|w| w.map(|x| x as f32)).collect()
@@ -209,7 +212,7 @@ impl PyTable {
 
     /// f_r(wi, wo) in 1/sr for one pair of unit vectors given as 3 floats each: the scalar
     /// path renderers call per sample.
-    fn eval1(&self, wi: [f64; 3], wo: [f64; 3]) -> PyResult<(f32, f32, f32)> {
+    fn eval1(&self, wi: [f64; 3], wo: [f64; 3]) -> PyResult<Triple> {
         check_unit("wi", 0, wi)?;
         check_unit("wo", 0, wo)?;
         let f = self.brdf.eval(wi.map(|x| x as f32), wo.map(|x| x as f32));
@@ -218,12 +221,7 @@ impl PyTable {
 
     /// One importance sample for `wo` (3 floats, unit) and `u1, u2` in [0, 1):
     /// (wi, weight, pdf) as tuples and a float (see `sample`).
-    fn sample1(
-        &self,
-        wo: [f64; 3],
-        u1: f64,
-        u2: f64,
-    ) -> PyResult<((f32, f32, f32), (f32, f32, f32), f32)> {
+    fn sample1(&self, wo: [f64; 3], u1: f64, u2: f64) -> PyResult<(Triple, Triple, f32)> {
         check_unit("wo", 0, wo)?;
         let s = self.brdf.sample(wo.map(|x| x as f32), u1 as f32, u2 as f32);
         Ok((

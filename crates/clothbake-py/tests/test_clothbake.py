@@ -124,7 +124,7 @@ def test_sampling_estimates_the_albedo(twill_path):
         (np.array([[0.0, 0.0, 2.0], [0.0, 0.0, 1.0]]), ValueError, "wi[0]"),
         (np.array([[0.0, 0.0, 1.0], [np.nan, 0.0, 1.0]]), ValueError, "wi[1]"),
         (np.array([[0.0, 0.0, 1.0]]), ValueError, "same number of rows"),
-        ("not a vector", TypeError, "wi"),
+        ("not a vector", ValueError, "wi: shape"),
     ],
 )
 def test_bad_vectors_raise(twill_path, wi, exc, words):
