@@ -1,0 +1,72 @@
+"""Type stubs of the native module. Frame: +X weft, +Y warp, +Z normal; wi toward the light,
+wo toward the eye; f_r in 1/sr, RGB."""
+
+import os
+from typing import Any, Dict, Tuple, Union, overload
+
+import numpy as np
+import numpy.typing as npt
+
+UNIT_TOLERANCE: float
+"""How far from 1 a direction's length may be before it is rejected."""
+
+Vec3 = Tuple[float, float, float]
+
+class Fabric:
+    """A woven fabric, validated: from a fabric file path or a dict of the same schema.
+    Raises ValueError naming the file (or ``<dict>``) and the field."""
+
+    def __init__(self, source: Union[str, "os.PathLike[str]", Dict[str, Any]]) -> None: ...
+    @property
+    def name(self) -> str: ...
+    def to_dict(self) -> Dict[str, Any]:
+        """The fabric as a fabric-file dict, every field explicit."""
+    @overload
+    def eval(self, wi: npt.ArrayLike, wo: npt.ArrayLike, method: str = ..., bounces: int = ...,
+             facet: str = ..., split: bool = False, samples: int = ..., seed: int = ...
+             ) -> npt.NDArray[np.float64]: ...
+    @overload
+    def eval(self, wi: npt.ArrayLike, wo: npt.ArrayLike, method: str = ..., bounces: int = ...,
+             facet: str = ..., split: bool = True, samples: int = ..., seed: int = ...
+             ) -> Dict[str, npt.NDArray[np.float64]]: ...
+    def eval(self, wi: npt.ArrayLike, wo: npt.ArrayLike, method: str = "analytic",
+             bounces: int = 1, facet: str = "huo", split: bool = False,
+             samples: int = 100000, seed: int = 1) -> Any:
+        """f_r(wi, wo) in 1/sr, (N, 3) float64, for unit vectors (N, 3) or (3,).
+        method "analytic" | "raytrace"; bounces 1 | 2; facet "huo" | "lewis"; split=True
+        returns {"brdf", "diffuse", "specular", "secondary"}."""
+    def eval1(self, wi: Vec3, wo: Vec3, facet: str = "huo") -> Vec3:
+        """f_r of one pair (analytic, direct reflection), 1/sr."""
+
+class Table:
+    """A baked f_r table (1/sr, RGB) with interpolated lookup and importance sampling."""
+
+    @staticmethod
+    def open(path: Union[str, "os.PathLike[str]"], reciprocal: bool = False) -> "Table":
+        """Opens an .exr or binary table; FileNotFoundError / ValueError on failure."""
+    @property
+    def grid(self) -> Dict[str, int]: ...
+    @property
+    def metadata(self) -> Dict[str, Any]: ...
+    @property
+    def precision(self) -> str: ...
+    def to_numpy(self) -> npt.NDArray[np.float32]:
+        """(n_theta_i, n_phi_i, n_theta_o, n_phi_o, 3) float32, f_r at cell centres."""
+    def eval(self, wi: npt.ArrayLike, wo: npt.ArrayLike) -> npt.NDArray[np.float32]:
+        """Interpolated f_r (N, 3) float32 for unit vectors (N, 3)."""
+    def sample(self, wo: npt.ArrayLike, u: npt.ArrayLike
+               ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+        """(wi (N, 3), weight = f_r cos(theta_i) / pdf (N, 3), pdf (N,) per sr) for u (N, 2)."""
+    def pdf(self, wo: npt.ArrayLike, wi: npt.ArrayLike) -> npt.NDArray[np.float32]:
+        """Density (per sr) of sample() drawing wi for wo, (N,)."""
+    def eval1(self, wi: Vec3, wo: Vec3) -> Vec3: ...
+    def sample1(self, wo: Vec3, u1: float, u2: float) -> Tuple[Vec3, Vec3, float]: ...
+    def pdf1(self, wo: Vec3, wi: Vec3) -> float: ...
+    def save(self, path: Union[str, "os.PathLike[str]"], precision: str = "f16",
+             overwrite: bool = False) -> None:
+        """Writes atomically: .exr (f16 or f32) or the binary format (other extensions)."""
+    def _rust_batch_seconds(self, n: int, repeats: int = 5) -> float: ...
+
+def bake(fabric: Fabric, res: Tuple[int, int, int, int] = (32, 64, 32, 64), bounces: int = 1,
+         facet: str = "huo", progress: bool = False) -> Table:
+    """Bakes fabric into an in-memory Table (f32), GIL released, deterministic."""

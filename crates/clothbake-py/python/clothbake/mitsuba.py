@@ -1,0 +1,175 @@
+"""A Mitsuba 3 BSDF plugin for woven cloth: ``clothbake.mitsuba.register()``.
+
+After ``register()``, scenes can use ``{"type": "clothbake", "table": "twill.exr"}`` (a
+baked table: interpolated lookup and the loader's importance sampling) or
+``{"type": "clothbake", "weave": "tables/twill.json"}`` (the analytic model evaluated
+directly; cosine-weighted sampling). Optional parameters: ``facet`` ("huo" | "lewis", weave
+only), ``two_sided`` (bool, default True).
+
+Frame: the cloth's +X (the weft) follows the surface's ``dp_du`` (the U texture direction),
+made orthogonal to the shading normal; +Y (the warp) is ``n x s``, along V on a regular
+parameterisation; +Z is the shading normal. So warp and weft follow the mesh's UVs.
+
+Two-sided: seen from the back (both directions below the shading normal), the cloth is
+evaluated as its front mirrored through the cloth's plane (z negated for both directions):
+the same weave, seen from the other side. With ``two_sided=False`` the back is black. Light
+and eye on opposite sides give zero (no transmission).
+
+Scalar RGB variants only (``scalar_rgb``): the plugin calls the native module once per
+lookup, on Python floats.
+"""
+
+import math
+
+from . import Fabric, Table
+
+_REGISTERED = False
+
+
+def _variant_check(mi):
+    v = mi.variant()
+    if v is None or not v.startswith("scalar_") or "rgb" not in v:
+        raise RuntimeError(
+            f"clothbake.mitsuba: variant {v!r} is not supported; call "
+            "mitsuba.set_variant('scalar_rgb') before register()"
+        )
+
+
+def register():
+    """Registers the BSDF plugin ``clothbake`` with Mitsuba 3 (idempotent). Call it after
+    ``mitsuba.set_variant("scalar_rgb")``."""
+    global _REGISTERED
+    import drjit as dr
+    import mitsuba as mi
+
+    _variant_check(mi)
+
+    class ClothBSDF(mi.BSDF):
+        """Woven cloth from clothbake: a baked table or the analytic model."""
+
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            has_table, has_weave = "table" in props, "weave" in props
+            if has_table == has_weave:
+                raise ValueError(
+                    "clothbake BSDF: give exactly one of table= (a baked .exr/.bin table) "
+                    "or weave= (a fabric .json file)"
+                )
+            self._table = Table.open(str(props["table"])) if has_table else None
+            self._fabric = Fabric(str(props["weave"])) if has_weave else None
+            self._facet = str(props.get("facet", "huo"))
+            self._two_sided = bool(props.get("two_sided", True))
+            self._source = str(props["table"] if has_table else props["weave"])
+            flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
+            if self._two_sided:
+                flags = flags | mi.BSDFFlags.BackSide
+            self.m_components = [flags]
+            self.m_flags = flags
+
+        # -- frames --------------------------------------------------------------------
+        def _cloth_frame(self, si):
+            """The cloth frame in world space: s along dp_du, n the shading normal."""
+            n = si.sh_frame.n
+            du = si.dp_du
+            s = du - n * dr.dot(n, du)
+            if dr.squared_norm(s) < 1e-20:
+                s = si.sh_frame.s
+            s = dr.normalize(s)
+            return mi.Frame3f(s, dr.cross(n, s), n)
+
+        def _to_cloth(self, si, frame, v):
+            """A shading-frame vector in the cloth frame, as a tuple."""
+            w = frame.to_local(si.sh_frame.to_world(v))
+            return [float(w[0]), float(w[1]), float(w[2])]
+
+        def _from_cloth(self, si, frame, v):
+            return si.sh_frame.to_local(frame.to_world(mi.Vector3f(v[0], v[1], v[2])))
+
+        def _directions(self, si, wo):
+            """(light, eye, frame, flip) in the cloth frame, or None when they are on
+            opposite sides or on the back of a one-sided cloth."""
+            frame = self._cloth_frame(si)
+            eye = self._to_cloth(si, frame, si.wi)
+            light = self._to_cloth(si, frame, wo) if wo is not None else None
+            flip = eye[2] < 0.0
+            if flip and not self._two_sided:
+                return None
+            if flip:
+                eye[2] = -eye[2]
+                if light is not None:
+                    light[2] = -light[2]
+            if eye[2] <= 0.0 or (light is not None and light[2] <= 0.0):
+                return None
+            return light, _unit(eye), frame, flip
+
+        def _f(self, light, eye):
+            if self._table is not None:
+                return self._table.eval1(light, eye)
+            return self._fabric.eval1(light, eye, self._facet)
+
+        def _pdf(self, light, eye):
+            if self._table is not None:
+                return self._table.pdf1(eye, light)
+            return light[2] / math.pi
+
+        # -- the BSDF interface --------------------------------------------------------
+        def eval(self, ctx, si, wo, active=True):
+            d = self._directions(si, wo)
+            if d is None:
+                return mi.Color3f(0.0)
+            light, eye, _, _ = d
+            light = _unit(light)
+            f = self._f(light, eye)
+            return mi.Color3f(f[0], f[1], f[2]) * light[2]
+
+        def pdf(self, ctx, si, wo, active=True):
+            d = self._directions(si, wo)
+            if d is None:
+                return 0.0
+            light, eye, _, _ = d
+            return self._pdf(_unit(light), eye)
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            bs = mi.BSDFSample3f()
+            d = self._directions(si, None)
+            if d is None:
+                return bs, mi.Color3f(0.0)
+            _, eye, frame, flip = d
+            if self._table is not None:
+                light, weight, pdf = self._table.sample1(eye, sample2[0], sample2[1])
+                light = list(light)
+            else:
+                w = mi.warp.square_to_cosine_hemisphere(sample2)
+                light = [float(w[0]), float(w[1]), float(w[2])]
+                pdf = light[2] / math.pi
+                f = self._fabric.eval1(_unit(light), eye, self._facet) if pdf > 0 else (0, 0, 0)
+                weight = tuple(math.pi * x for x in f)
+            if pdf <= 0.0:
+                return bs, mi.Color3f(0.0)
+            if flip:
+                light[2] = -light[2]
+            bs.wo = self._from_cloth(si, frame, light)
+            bs.pdf = pdf
+            bs.eta = 1.0
+            bs.sampled_type = int(mi.BSDFFlags.GlossyReflection)
+            bs.sampled_component = 0
+            return bs, mi.Color3f(weight[0], weight[1], weight[2])
+
+        def traverse(self, callback):
+            pass
+
+        def to_string(self):
+            return f"ClothBSDF[source={self._source!r}, two_sided={self._two_sided}]"
+
+    if not _REGISTERED:
+        mi.register_bsdf("clothbake", lambda props: ClothBSDF(props))
+        _REGISTERED = True
+
+
+def _unit(v):
+    """v normalised (the frame changes round-trip through float32)."""
+    n = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    return [v[0] / n, v[1] / n, v[2] / n]

@@ -1,0 +1,210 @@
+//! `clothbake.Fabric`: a validated fabric description and its BRDF from the analytic model
+//! (thesis ch. 3-4, ch. 5 with two bounces) or the ray-traced ground truth.
+
+use crate::vectors::{check_unit, same_len, to_array, unit_rows};
+use clothbake_core::{
+    intensity_to_brdf, AnalyticModel, Fabric, FacetModel, RayTracer, Reflection, SecondaryOptions,
+    UnitVec3, Vec3,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use rayon::prelude::*;
+use std::sync::OnceLock;
+
+/// Parses a facet model name (`"huo"`, `"lewis"`).
+pub fn facet_model(name: &str) -> PyResult<FacetModel> {
+    match name {
+        "huo" => Ok(FacetModel::Huo),
+        "lewis" => Ok(FacetModel::Lewis),
+        other => Err(PyValueError::new_err(format!(
+            "facet: {other:?} is not a facet model; use \"huo\" (the thesis's, eqs 4.6, 4.8) or \"lewis\" (energy conserving)"
+        ))),
+    }
+}
+
+/// Checks a bounce count (1 or 2).
+pub fn check_bounces(bounces: u32) -> PyResult<()> {
+    if bounces == 1 || bounces == 2 {
+        return Ok(());
+    }
+    Err(PyValueError::new_err(format!(
+        "bounces: {bounces}; use 1 (direct reflection) or 2 (+ the secondary reflection of thesis ch. 5)"
+    )))
+}
+
+/// A woven fabric (weave pattern, yarn geometry, facet materials), validated.
+#[pyclass(name = "Fabric", module = "clothbake", frozen)]
+pub struct PyFabric {
+    pub(crate) fabric: Fabric,
+    /// Analytic models, built on first use: Huo's facets, Lewis's.
+    models: [OnceLock<AnalyticModel>; 2],
+}
+
+impl PyFabric {
+    /// The analytic model of this fabric with `facet` (built once).
+    pub fn model(&self, facet: FacetModel) -> &AnalyticModel {
+        let k = match facet {
+            FacetModel::Huo => 0,
+            FacetModel::Lewis => 1,
+        };
+        self.models[k].get_or_init(|| AnalyticModel::new(&self.fabric, facet))
+    }
+}
+
+fn unit(w: [f64; 3]) -> UnitVec3 {
+    UnitVec3::new(Vec3::new(w[0], w[1], w[2])).unwrap_or(UnitVec3::Z)
+}
+
+/// f_r of the parts of a reflection: total, diffuse, specular, secondary.
+fn parts(r: &Reflection, wi: UnitVec3) -> [[f64; 3]; 4] {
+    let i2 = r.secondary.map_or([0.0; 3], |s| s.total());
+    [
+        r.brdf(wi),
+        intensity_to_brdf(r.i_d, wi),
+        intensity_to_brdf(r.i_s, wi),
+        intensity_to_brdf(i2, wi),
+    ]
+}
+
+#[pymethods]
+impl PyFabric {
+    /// Reads a fabric from a file path or from a dict of the fabric-file schema
+    /// (docs/fabric-format.md). Raises ValueError naming the file (or `<dict>`) and the field.
+    #[new]
+    fn new(source: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let py = source.py();
+        let fabric = if source.is_instance_of::<PyDict>() {
+            let text: String = py
+                .import("json")?
+                .call_method1("dumps", (source,))
+                .map_err(|e| PyValueError::new_err(format!("<dict>: not JSON-serialisable: {e}")))?
+                .extract()?;
+            Fabric::from_json_str(&text, "<dict>")
+        } else {
+            let path: std::path::PathBuf = source.extract().map_err(|_| {
+                PyValueError::new_err(
+                    "Fabric: pass a path to a fabric file (e.g. tables/twill.json) or a dict",
+                )
+            })?;
+            Fabric::from_path(&path)
+        }
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(PyFabric {
+            fabric,
+            models: [OnceLock::new(), OnceLock::new()],
+        })
+    }
+
+    /// The fabric's name.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.fabric.name
+    }
+
+    /// The fabric as a dict of the fabric-file schema, every field explicit.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("json")?
+            .call_method1("loads", (self.fabric.to_json().to_string(),))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("clothbake.Fabric({:?})", self.fabric.name)
+    }
+
+    /// f_r(wi, wo) in 1/sr, RGB, for unit vectors in the fabric's frame (+X weft, +Y warp,
+    /// +Z normal; `wi` toward the light, `wo` toward the eye), arrays of shape (N, 3) or (3,).
+    /// Zero when either direction is at or below the horizon.
+    ///
+    /// method: "analytic" (the thesis's model) or "raytrace" (the exact ray tracer of the same
+    /// micro-geometry, `samples` rays per pair, seeded `seed + row`: ground truth, slow).
+    /// bounces: 1, or 2 to add the secondary reflection (thesis ch. 5; analytic only).
+    /// facet: "huo" (default, eqs 4.6 and 4.8) or "lewis" (energy conserving).
+    /// split: also return the diffuse, specular and secondary parts, each as f_r in 1/sr.
+    /// Returns an (N, 3) float64 array, or a dict of them with `split=True`.
+    #[pyo3(signature = (wi, wo, method="analytic", bounces=1, facet="huo", split=false, samples=100_000, seed=1))]
+    #[allow(clippy::too_many_arguments)]
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        method: &str,
+        bounces: u32,
+        facet: &str,
+        split: bool,
+        samples: usize,
+        seed: u64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let facet = facet_model(facet)?;
+        check_bounces(bounces)?;
+        let wi = unit_rows("wi", wi)?;
+        let wo = unit_rows("wo", wo)?;
+        same_len(("wi", wi.rows.len()), ("wo", wo.rows.len()))?;
+        let secondary = (bounces == 2).then(SecondaryOptions::default);
+        let pairs: Vec<(UnitVec3, UnitVec3)> = wi
+            .rows
+            .iter()
+            .zip(&wo.rows)
+            .map(|(&a, &b)| (unit(a), unit(b)))
+            .collect();
+        let out: Vec<[[f64; 3]; 4]> = match method {
+            "analytic" => {
+                let m = self.model(facet);
+                py.detach(|| {
+                    pairs
+                        .par_iter()
+                        .map(|&(a, b)| parts(&m.eval_with(a, b, secondary.as_ref()), a))
+                        .collect()
+                })
+            }
+            "raytrace" => {
+                if bounces != 1 {
+                    return Err(PyValueError::new_err(
+                        "bounces: the ray tracer here gives the direct reflection only; use bounces=1 with method=\"raytrace\"",
+                    ));
+                }
+                let rt = RayTracer::new(&self.fabric, facet);
+                py.detach(|| {
+                    pairs
+                        .par_iter()
+                        .enumerate()
+                        .map(|(k, &(a, b))| {
+                            let r = rt.render(a, b, samples, seed.wrapping_add(k as u64));
+                            parts(&r.reflection, a)
+                        })
+                        .collect()
+                })
+            }
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "method: {other:?}; use \"analytic\" or \"raytrace\""
+                )))
+            }
+        };
+        let single = wi.single && wo.single;
+        let part = |k: usize| -> Vec<[f64; 3]> { out.iter().map(|p| p[k]).collect() };
+        if !split {
+            return to_array(py, &part(0), single);
+        }
+        let d = PyDict::new(py);
+        for (k, name) in ["brdf", "diffuse", "specular", "secondary"]
+            .iter()
+            .enumerate()
+        {
+            d.set_item(PyString::new(py, name), to_array(py, &part(k), single)?)?;
+        }
+        Ok(d.into_any())
+    }
+
+    /// f_r(wi, wo) in 1/sr for one pair of unit vectors given as 3 floats each (fabric frame,
+    /// analytic model, direct reflection): the scalar path renderers call per sample.
+    #[pyo3(signature = (wi, wo, facet="huo"))]
+    fn eval1(&self, wi: [f64; 3], wo: [f64; 3], facet: &str) -> PyResult<(f64, f64, f64)> {
+        check_unit("wi", 0, wi)?;
+        check_unit("wo", 0, wo)?;
+        let (a, b) = (unit(wi), unit(wo));
+        let f = self.model(facet_model(facet)?).eval(a, b).brdf(a);
+        Ok((f[0], f[1], f[2]))
+    }
+}

@@ -1,0 +1,175 @@
+"""The Python API against independent references: cell-centre values of the bake, closed
+relations between the split terms, a quadrature of the albedo, the ray tracer; and errors."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import clothbake
+
+
+def dirs(theta_deg, phi_deg):
+    t, p = np.radians(theta_deg), np.radians(phi_deg)
+    return np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1)
+
+
+def hemisphere(n, rng):
+    z = rng.uniform(0.0, 1.0, n)
+    phi = rng.uniform(0.0, 2 * math.pi, n)
+    r = np.sqrt(1 - z * z)
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
+
+
+def test_fabric_from_path_and_dict_agree(twill_path):
+    a = clothbake.Fabric(twill_path)
+    b = clothbake.Fabric(json.loads(twill_path.read_text()))
+    c = clothbake.Fabric(a.to_dict())
+    wi, wo = dirs([30, 50], [0, 90]), dirs([45, 20], [180, 250])
+    fa = a.eval(wi, wo)
+    assert fa.shape == (2, 3) and fa.dtype == np.float64
+    np.testing.assert_array_equal(fa, b.eval(wi, wo))
+    np.testing.assert_array_equal(fa, c.eval(wi, wo))
+    assert a.name == "twill"
+
+
+def test_split_terms_add_up_and_horizon_is_zero(twill_path):
+    fab = clothbake.Fabric(twill_path)
+    wi, wo = dirs([30, 60, 10], [0, 120, 300]), dirs([45, 30, 70], [180, 10, 90])
+    s = fab.eval(wi, wo, split=True)
+    np.testing.assert_allclose(s["brdf"], s["diffuse"] + s["specular"], rtol=1e-12)
+    np.testing.assert_array_equal(s["secondary"], 0.0)
+    s2 = fab.eval(wi, wo, bounces=2, split=True)
+    np.testing.assert_allclose(s2["brdf"], s2["diffuse"] + s2["specular"] + s2["secondary"], rtol=1e-12)
+    assert (s2["secondary"] > 0).all()
+    # Light below the horizon: nothing.
+    below = np.array([[0.6, 0.0, -0.8]])
+    np.testing.assert_array_equal(fab.eval(below, wo[:1]), 0.0)
+
+
+def test_brdf_is_linear_in_the_albedo(twill_path):
+    """With Lewis facets and no specular part f_r is linear in each channel's albedo:
+    f(rho) = rho f(1), channel by channel."""
+    d = json.loads(twill_path.read_text())
+    for g in ("warp", "weft"):
+        d[g]["material"] = {"albedo": [1.0, 0.5, 0.25], "specular": 0.0, "exponent": 10}
+    fab = clothbake.Fabric(d)
+    f = fab.eval(dirs([40], [30]), dirs([20], [200]), facet="lewis")
+    np.testing.assert_allclose(f[0, 1] / f[0, 0], 0.5, rtol=1e-12)
+    np.testing.assert_allclose(f[0, 2] / f[0, 0], 0.25, rtol=1e-12)
+
+
+def test_analytic_against_ray_traced_ground_truth(twill_path):
+    fab = clothbake.Fabric(twill_path)
+    wi, wo = dirs([30, 50], [0, 90]), dirs([45, 20], [180, 250])
+    a = fab.eval(wi, wo)
+    rt = fab.eval(wi, wo, method="raytrace", samples=40000, seed=7)
+    # docs/validation.md: the twill's worst error is 4.1%; 40 000 rays add about 1%.
+    np.testing.assert_allclose(a, rt, rtol=0.08)
+
+
+def test_bake_matches_the_model_at_cell_centres(twill_path):
+    fab = clothbake.Fabric(twill_path)
+    t = clothbake.bake(fab, res=(4, 8, 4, 8))
+    assert t.grid == {"n_theta_i": 4, "n_phi_i": 8, "n_theta_o": 4, "n_phi_o": 8}
+    assert t.metadata["units"] == "1/sr" and t.metadata["fabric"]["name"] == "twill"
+    v = t.to_numpy()
+    assert v.shape == (4, 8, 4, 8, 3) and v.dtype == np.float32
+    ti, pi, to, po = np.meshgrid(np.arange(4), np.arange(8), np.arange(4), np.arange(8), indexing="ij")
+    th = lambda k, n: (k + 0.5) * 90.0 / n
+    ph = lambda k, n: (k + 0.5) * 360.0 / n
+    wi = dirs(th(ti, 4), ph(pi, 8)).reshape(-1, 3)
+    wo = dirs(th(to, 4), ph(po, 8)).reshape(-1, 3)
+    model = fab.eval(wi, wo).reshape(v.shape)
+    np.testing.assert_allclose(v, model, rtol=1e-6, atol=1e-9)
+    # At a cell centre the lookup returns the node (interpolation weight 1).
+    np.testing.assert_allclose(t.eval(wi, wo).reshape(v.shape), v, rtol=2e-5, atol=1e-7)
+
+
+def test_save_open_round_trip(tmp_path, twill_path):
+    t = clothbake.bake(clothbake.Fabric(twill_path), res=(4, 8, 4, 8))
+    for name, prec in (("t.exr", "f32"), ("t.bin", "f32")):
+        t.save(tmp_path / name, precision=prec)
+        back = clothbake.Table.open(tmp_path / name)
+        np.testing.assert_array_equal(back.to_numpy(), t.to_numpy())
+    with pytest.raises(FileExistsError, match="already exists"):
+        t.save(tmp_path / "t.bin")
+    t.save(tmp_path / "h.exr")
+    assert clothbake.Table.open(tmp_path / "h.exr").precision == "f16"
+
+
+def test_sampling_estimates_the_albedo(twill_path):
+    t = clothbake.bake(clothbake.Fabric(twill_path), res=(16, 32, 16, 32))
+    rng = np.random.default_rng(3)
+    wo = np.tile(dirs([35.0], [60.0]), (200000, 1))
+    wi, weight, pdf = t.sample(wo, rng.uniform(0, 1, (len(wo), 2)))
+    assert (pdf > 0).all()
+    np.testing.assert_allclose(t.pdf(wo[:1000], wi[:1000]), pdf[:1000], rtol=1e-5)
+    # Independent: midpoint quadrature of f_r cos(theta_i) over the hemisphere.
+    n = 400
+    tq, pq = np.meshgrid((np.arange(n) + 0.5) * 90.0 / n, (np.arange(2 * n) + 0.5) * 180.0 / n, indexing="ij")
+    w = dirs(tq, pq).reshape(-1, 3)
+    f = t.eval(w, np.tile(wo[:1], (len(w), 1))).astype(np.float64)
+    dw = (math.pi / 2 / n) * (math.pi / n) * np.sin(np.radians(tq)).reshape(-1)
+    albedo = (f * (w[:, 2] * dw)[:, None]).sum(axis=0)
+    np.testing.assert_allclose(weight.mean(axis=0), albedo, rtol=0.01)
+
+
+@pytest.mark.parametrize(
+    "wi, exc, words",
+    [
+        (np.zeros((2, 3), dtype=np.int64), TypeError, "dtype"),
+        (np.zeros((2, 2)), ValueError, "shape"),
+        (np.array([[0.0, 0.0, 2.0], [0.0, 0.0, 1.0]]), ValueError, "wi[0]"),
+        (np.array([[0.0, 0.0, 1.0], [np.nan, 0.0, 1.0]]), ValueError, "wi[1]"),
+        (np.array([[0.0, 0.0, 1.0]]), ValueError, "same number of rows"),
+        ("not a vector", ValueError, "wi: shape"),
+    ],
+)
+def test_bad_vectors_raise(twill_path, wi, exc, words):
+    fab = clothbake.Fabric(twill_path)
+    t = clothbake.bake(fab, res=(2, 4, 2, 4))
+    wo = dirs([10, 20], [0, 0])
+    with pytest.raises(exc, match=__import__("re").escape(words)):
+        fab.eval(wi, wo)
+    with pytest.raises(exc, match=__import__("re").escape(words)):
+        t.eval(wi, wo)
+
+
+def test_bad_fabric_names_the_field(twill_path):
+    d = json.loads(twill_path.read_text())
+    d["warp"]["radius"] = -1.0
+    with pytest.raises(ValueError, match=r"<dict>: field `warp\.radius"):
+        clothbake.Fabric(d)
+    d = json.loads(twill_path.read_text())
+    d["pattern"] = [[1, 2]]
+    with pytest.raises(ValueError, match=r"pattern\[0\]\[1\]"):
+        clothbake.Fabric(d)
+    with pytest.raises(ValueError, match="cannot read the fabric file"):
+        clothbake.Fabric("/nonexistent/fabric.json")
+    fab = clothbake.Fabric(twill_path)
+    with pytest.raises(ValueError, match="facet"):
+        fab.eval(dirs([10], [0]), dirs([10], [0]), facet="phong")
+    with pytest.raises(ValueError, match="bounces"):
+        fab.eval(dirs([10], [0]), dirs([10], [0]), bounces=3)
+    with pytest.raises(ValueError, match="res"):
+        clothbake.bake(fab, res=(0, 4, 4, 4))
+
+
+def test_bad_tables_raise(tmp_path, twill_path):
+    with pytest.raises(FileNotFoundError, match="missing.exr"):
+        clothbake.Table.open(tmp_path / "missing.exr")
+    junk = tmp_path / "junk.exr"
+    junk.write_bytes(b"\x00" * 100)
+    with pytest.raises(ValueError, match="junk.exr"):
+        clothbake.Table.open(junk)
+    t = clothbake.bake(clothbake.Fabric(twill_path), res=(4, 8, 4, 8))
+    t.save(tmp_path / "ok.bin")
+    data = bytearray((tmp_path / "ok.bin").read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    (tmp_path / "bad.bin").write_bytes(bytes(data))
+    with pytest.raises(ValueError, match="bad.bin"):
+        clothbake.Table.open(tmp_path / "bad.bin")
+    with pytest.raises(ValueError, match="not in"):
+        t.sample(dirs([10], [0]), np.array([[0.5, 1.5]]))
