@@ -155,11 +155,19 @@ fn disks(dir: &Path, size: u32) {
     eprintln!("disks: {:.1} s", start.elapsed().as_secs_f64());
 }
 
-/// Renders every figure into `docs/figures/`.
-pub fn run(root: &Path) {
+/// Renders the figures named in `only` (`fig4-5`, `disks` for figs 5.10-5.11, `fig5-17`), or
+/// every figure when `only` is empty, into `docs/figures/`.
+pub fn run(root: &Path, only: &[String]) {
     let dir = root.join("docs/figures");
     std::fs::create_dir_all(&dir).unwrap();
-    cloth(root, &dir, 1, 256, 2, "fig4-5.png");
-    disks(&dir, 128);
-    cloth(root, &dir, 2, 192, 1, "fig5-17.png");
+    let wanted = |name: &str| only.is_empty() || only.iter().any(|o| o == name);
+    if wanted("fig4-5") {
+        cloth(root, &dir, 1, 256, 2, "fig4-5.png");
+    }
+    if wanted("disks") {
+        disks(&dir, 128);
+    }
+    if wanted("fig5-17") {
+        cloth(root, &dir, 2, 192, 1, "fig5-17.png");
+    }
 }

@@ -37,13 +37,13 @@ fn main() {
     match task.as_str() {
         "validate" => validate(),
         "ch5" => ch5::run(&root()),
-        "figures" => figures::run(&root()),
+        "figures" => figures::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
         "golden" => golden(),
         "bench-bake" => bench_bake(std::env::args().skip(2).any(|a| a == "--bounces-2")),
         "loader-accuracy" => loader_accuracy(),
         _ => {
             eprintln!(
-                "usage: cargo xtask validate | golden | ch5 | figures | bench-bake [--bounces-2] | loader-accuracy"
+                "usage: cargo xtask validate | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy"
             );
             std::process::exit(2);
         }

@@ -179,11 +179,7 @@ pub fn plan_with_env(
             "give a file name with -o PATH, e.g. -o twill.exr",
         ));
     }
-    let threads = o.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
+    let threads = thread_count(o.threads);
     let method = if raytrace {
         Method::Raytrace {
             samples: o.samples.unwrap_or(DEFAULT_SAMPLES),
@@ -383,6 +379,25 @@ fn load_checkpoint(
     Ok(part.rows)
 }
 
+/// The worker thread count: `--threads N` if given, else every core.
+pub fn thread_count(arg: Option<usize>) -> usize {
+    arg.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+/// A rayon pool of `threads` workers, or the one-line error that says to give fewer (shared by
+/// bake, export and render).
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, CliError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| {
+            CliError::new(
+                format!("cannot start {threads} worker threads: {e}"),
+                "give fewer with --threads N",
+            )
+        })
+}
+
 /// Runs a bake and returns the summary line for stdout (empty with --quiet).
 pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     let plan = plan(weave, o)?;
@@ -436,15 +451,7 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     install_ctrlc();
 
     let start = Instant::now();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(plan.threads)
-        .build()
-        .map_err(|e| {
-            CliError::new(
-                format!("cannot start {} worker threads: {e}", plan.threads),
-                "give fewer with --threads N",
-            )
-        })?;
+    let pool = thread_pool(plan.threads)?;
     let g = plan.options.grid;
     let orbits = baker.orbits();
     let todo: Vec<usize> = rows.clone().filter(|r| !resumed.contains_key(r)).collect();

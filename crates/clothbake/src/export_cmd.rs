@@ -37,20 +37,8 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
     let facet = FacetModel::from(args.facet);
     let model = AnalyticModel::with_variant(&fabric, facet, args.variant.into());
     let brdf = export::model_brdf(&model, secondary);
-    let threads = args.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| {
-            CliError::new(
-                format!("cannot start {threads} worker threads: {e}"),
-                "give fewer with --threads N",
-            )
-        })?;
+    let threads = crate::bake_cmd::thread_count(args.threads);
+    let pool = crate::bake_cmd::thread_pool(threads)?;
     let mut summary = String::new();
     if let Some(out) = &args.rgl {
         let start = Instant::now();

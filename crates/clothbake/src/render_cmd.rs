@@ -195,18 +195,8 @@ pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
         irradiance: a.irradiance.unwrap_or(std::f64::consts::PI),
         ambient: a.ambient,
     };
-    let threads = a
-        .threads
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| {
-            CliError::new(
-                format!("cannot start {threads} worker threads: {e}"),
-                "give fewer with --threads N",
-            )
-        })?;
+    let threads = crate::bake_cmd::thread_count(a.threads);
+    let pool = crate::bake_cmd::thread_pool(threads)?;
     let start = Instant::now();
     let bar = progress_bar(u64::from(h), a.quiet);
     let shown = AtomicU64::new(0);
