@@ -29,11 +29,20 @@ fn python_ready() -> Result<(), String> {
     }
 }
 
-/// Builds the extension module; returns the shared library.
+/// Builds the extension module and the `clothbake` binary (for the comparison with
+/// `clothbake render`); returns the shared library, beside which the binary lies.
 fn build_extension() -> PathBuf {
     let status = Command::new(env!("CARGO"))
         .current_dir(root())
-        .args(["build", "--quiet", "-p", "clothbake-py", "--release"])
+        .args([
+            "build",
+            "--quiet",
+            "-p",
+            "clothbake-py",
+            "-p",
+            "clothbake",
+            "--release",
+        ])
         .status()
         .expect("cargo runs");
     assert!(status.success(), "cargo build -p clothbake-py failed");
@@ -69,10 +78,12 @@ fn python_package_and_mitsuba_plugin() {
         eprintln!("SKIPPED python_package_and_mitsuba_plugin: {why}");
         return;
     }
-    let dir = stage(&build_extension());
+    let lib = build_extension();
+    let dir = stage(&lib);
     let out = Command::new("python3")
         .current_dir(root())
         .env("PYTHONPATH", &dir)
+        .env("CLOTHBAKE_BIN", lib.with_file_name("clothbake"))
         .env("PYTHONDONTWRITEBYTECODE", "1")
         .args(["-m", "pytest", "-q", "-rs", "-s", "-p", "no:cacheprovider"])
         .arg("crates/clothbake-py/tests")
