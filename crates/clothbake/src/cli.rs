@@ -755,14 +755,22 @@ pub fn parse_specular(s: &str) -> Result<f64, String> {
     )
 }
 
+/// A number >= 0 named `what`, or the error with `fix`.
+fn non_negative(s: &str, what: &str, fix: &str) -> Result<f64, String> {
+    let x = number(s, what).map_err(|e| format!("{e}; {fix}"))?;
+    if x < 0.0 {
+        return Err(format!("{what} {x} is negative; {fix}"));
+    }
+    Ok(x)
+}
+
 /// Parses a specular exponent n >= 0.
 pub fn parse_exponent(s: &str) -> Result<f64, String> {
-    const FIX: &str = "give a non-negative specular exponent n (cloth: 6 to 15), e.g. 10";
-    let n = number(s, "exponent").map_err(|e| format!("{e}; {FIX}"))?;
-    if n < 0.0 {
-        return Err(format!("exponent {n} is negative; {FIX}"));
-    }
-    Ok(n)
+    non_negative(
+        s,
+        "exponent",
+        "give a non-negative specular exponent n (cloth: 6 to 15), e.g. 10",
+    )
 }
 
 /// Parses `--res NTI,NPI,NTO,NPO`: four whole numbers of cells, each at least 1, at most
@@ -838,12 +846,7 @@ pub fn parse_bounces(s: &str) -> Result<u32, String> {
 
 /// Parses a non-negative finite tolerance.
 pub fn parse_tolerance(s: &str) -> Result<f64, String> {
-    const FIX: &str = "give a non-negative number, e.g. 1e-6";
-    let x = number(s, "tolerance").map_err(|e| format!("{e}; {FIX}"))?;
-    if x < 0.0 {
-        return Err(format!("tolerance {x} is negative; {FIX}"));
-    }
-    Ok(x)
+    non_negative(s, "tolerance", "give a non-negative number, e.g. 1e-6")
 }
 
 /// Where the BRDF of `render` and `plot` comes from, and the model's options.
@@ -1125,12 +1128,11 @@ pub fn parse_ambient(s: &str) -> Result<f64, String> {
 
 /// Parses a non-negative finite irradiance.
 pub fn parse_irradiance(s: &str) -> Result<f64, String> {
-    const FIX: &str = "give a non-negative irradiance, e.g. 3.14159 (pi, the default)";
-    let x = number(s, "irradiance").map_err(|e| format!("{e}; {FIX}"))?;
-    if x < 0.0 {
-        return Err(format!("irradiance {x} is negative; {FIX}"));
-    }
-    Ok(x)
+    non_negative(
+        s,
+        "irradiance",
+        "give a non-negative irradiance, e.g. 3.14159 (pi, the default)",
+    )
 }
 
 /// Parses `--exposure X|auto`, X > 0.

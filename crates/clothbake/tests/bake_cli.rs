@@ -3,22 +3,12 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn fabric(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../tables")
-        .join(format!("{name}.json"))
-        .canonicalize()
-        .unwrap()
-        .to_string_lossy()
-        .into_owned()
-}
+mod common;
 
-/// A fresh, empty folder for one test.
+use common::fabric;
+
 fn fresh_dir(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("bake-cli-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::fresh_dir("bake-cli", name)
 }
 
 fn run_in(dir: &Path, args: &[&str]) -> Output {
