@@ -32,14 +32,8 @@ pub struct Accuracy {
 /// Random direction pairs, uniform in solid angle on the upper hemisphere (SplitMix64 from
 /// `seed`), strictly above the horizon.
 pub fn random_pairs(n: usize, seed: u64) -> Vec<(UnitVec3, UnitVec3)> {
-    let mut state = seed;
-    let mut next = move || {
-        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = clothbake_core::rng::Rng::new(seed);
+    let mut next = move || rng.next_f64();
     let mut dir = move || {
         let mu = 1e-6 + (1.0 - 1e-6) * next();
         UnitVec3::from_spherical(mu.acos(), std::f64::consts::TAU * next())

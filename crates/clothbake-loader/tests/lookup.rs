@@ -55,17 +55,8 @@ fn close(a: [f32; 3], b: [f32; 3], tol: f32) -> bool {
     (0..3).all(|k| (a[k] - b[k]).abs() <= tol * b[k].abs().max(1e-3))
 }
 
-/// A deterministic stream of uniforms in [0, 1) (SplitMix64).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+mod common;
+use common::Rng;
 
 #[test]
 fn cell_centres_give_the_stored_values() {
