@@ -11,11 +11,14 @@
 //!   (and, with `--bounces-2`, once with the secondary reflection).
 //! * `loader-accuracy`: the loader's interpolation error on the twill for several grids, into
 //!   the table of `docs/loader.md` (between its `loader-accuracy` markers).
+//! * `ir-accuracy`: the secondary reflection's analytic orders and two-level sampling settings
+//!   against a converged rule, into the table of `docs/interreflection.md`.
 
 use clothbake::bake::{bake, BakeOptions};
 use clothbake::golden::{bake_golden, golden_path, shipped_fabrics};
 mod ch5;
 mod figures;
+mod ir_accuracy;
 
 use clothbake_core::validate::{compare_with, direction_set, Report};
 use clothbake_core::{Caps, Fabric, FacetModel, Variant};
@@ -41,9 +44,10 @@ fn main() {
         "golden" => golden(),
         "bench-bake" => bench_bake(std::env::args().skip(2).any(|a| a == "--bounces-2")),
         "loader-accuracy" => loader_accuracy(),
+        "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask validate | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy"
+                "usage: cargo xtask validate | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy"
             );
             std::process::exit(2);
         }

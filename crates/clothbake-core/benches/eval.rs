@@ -1,7 +1,14 @@
 //! Criterion benchmarks of the direct model: the analytic path per (wi, wo) pair.
-//! The ray tracer's cost at 1% error is reported beside it by the `raytrace_1pct` group.
+//! The ray tracer's cost at 1% error is reported beside it by the `raytrace_1pct` group; the
+//! secondary reflection per pair, and against the two-level sampling, by `secondary` and
+//! `secondary_vs_sampling`.
 
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, SecondaryOptions, UnitVec3};
+use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
+use clothbake_core::validate::secondary_direction_set;
+use clothbake_core::{
+    AnalyticModel, Fabric, FacetModel, Kernel, RayTracer, SecondaryMethod, SecondaryOptions,
+    UnitVec3,
+};
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::path::Path;
@@ -84,5 +91,61 @@ fn secondary(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, analytic, raytrace_1pct, secondary);
+/// The analytic secondary reflection against the two-level sampling, side by side on the
+/// parallel-cylinder surface with the thesis's sec. 5.4 facets (rho_d 0.4, rho_s 0.7, n 10),
+/// over the direction set of `cargo xtask ir-accuracy` (whose table gives each setting's
+/// error): default and fast orders; sampling with 0.2 and 0.15 steps over |y| <= 3.
+fn secondary_vs_sampling(c: &mut Criterion) {
+    let json = r#"{"pattern": [[1]], "warp": {"radius": 1, "spacing": 2,
+        "material": {"albedo": 0.4, "specular": 0.7, "exponent": 10}},
+        "weft": {"radius": 1, "spacing": 2}}"#;
+    let m = AnalyticModel::new(
+        &Fabric::from_json_str(json, "parallel").unwrap(),
+        FacetModel::Huo,
+    );
+    let dirs = secondary_direction_set();
+    let analytic = |orders| SecondaryMethod::Analytic {
+        ranges: Ranges::Full,
+        orders,
+    };
+    let sampling = |step| {
+        SecondaryMethod::Sampling(Sampling {
+            first_level: 32,
+            d_alpha: step,
+            d_l: step,
+            l0: 3.0,
+            exact_solid_angle: true,
+        })
+    };
+    let mut g = c.benchmark_group("secondary_vs_sampling");
+    for (name, method, samples) in [
+        ("analytic_default", analytic(Orders::default()), 100),
+        ("analytic_fast", analytic(ORDERS_FAST), 100),
+        ("sampling_0.2", sampling(0.2), 10),
+        ("sampling_0.15", sampling(0.15), 10),
+    ] {
+        g.sample_size(samples);
+        let opts = SecondaryOptions {
+            method,
+            kernel: Kernel::Radiometric,
+        };
+        g.bench_function(name, |b| {
+            let mut k = 0;
+            b.iter(|| {
+                let (wi, wo) = dirs[k % dirs.len()];
+                k += 1;
+                black_box(m.eval_with(black_box(wi), black_box(wo), Some(&opts)))
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    analytic,
+    raytrace_1pct,
+    secondary,
+    secondary_vs_sampling
+);
 criterion_main!(benches);

@@ -47,56 +47,110 @@ impl FacetModel {
     }
 }
 
-impl Facet for FacetModel {
-    fn intensity(&self, m: &Material, n: Vec3, l: Vec3, e: Vec3) -> FacetIntensity {
-        let nl = n.dot(l);
-        let ne = n.dot(e);
+impl FacetModel {
+    /// [`Facet::intensity`] from the three cosines N.L, N.E and L.E of unit vectors alone, for
+    /// integrands that have them at hand (the secondary reflection's axial lines).
+    #[inline]
+    pub fn intensity_cos(&self, m: &Material, nl: f64, ne: f64, le: f64) -> FacetIntensity {
         if nl <= 0.0 || ne <= 0.0 {
             return FacetIntensity::default();
         }
-        match self {
-            FacetModel::Huo => {
-                let h = l + e;
-                let hl = h.length();
-                let nh = if hl > 0.0 {
-                    (n.dot(h) / hl).max(0.0)
-                } else {
-                    0.0
-                };
-                FacetIntensity {
-                    diffuse: nl,
-                    specular: m.specular * pow(nh, m.exponent),
-                }
-            }
-            FacetModel::Lewis => {
-                // R = 2 (N.L) N - L;  R.E = 2 (N.L)(N.E) - L.E
-                let re = (2.0 * nl * ne - l.dot(e)).max(0.0);
-                FacetIntensity {
-                    diffuse: nl,
-                    specular: m.specular * 0.5 * (m.exponent + 2.0) * pow(re, m.exponent) * nl,
-                }
-            }
+        FacetIntensity {
+            diffuse: nl,
+            specular: CosineFacet::new(*self, m).specular(nl, ne, le),
         }
     }
 }
 
-/// x^n for x >= 0: repeated multiplication for small integer n (several times faster than
-/// `powf`, which the hot loops of the secondary reflection feel), `powf` otherwise.
-#[inline]
-fn pow(x: f64, n: f64) -> f64 {
-    if n.fract() == 0.0 && (0.0..=64.0).contains(&n) {
-        // Square-and-multiply, inlined (the `powi` intrinsic is an out-of-line call).
-        let (mut acc, mut base, mut k) = (1.0, x, n as u32);
-        while k > 0 {
-            if k & 1 == 1 {
-                acc *= base;
-            }
-            base *= base;
-            k >>= 1;
+impl Facet for FacetModel {
+    fn intensity(&self, m: &Material, n: Vec3, l: Vec3, e: Vec3) -> FacetIntensity {
+        self.intensity_cos(m, n.dot(l), n.dot(e), l.dot(e))
+    }
+}
+
+/// The specular term of a facet model bound to one material, from cosines: the one place of the
+/// facet formulas. Huo (eq. 4.8): rho_s (N.H)^n with N.H = (N.L + N.E) / |L + E| and
+/// |L + E|^2 = 2 + 2 L.E. Lewis: rho_s (n + 2) / 2 (R.E)^n N.L with R.E = 2 (N.L)(N.E) - L.E.
+/// Built once per material so that loops evaluating it many times skip the set-up.
+#[derive(Clone, Copy, Debug)]
+pub struct CosineFacet {
+    model: FacetModel,
+    /// rho_s (Huo) or rho_s (n + 2) / 2 (Lewis).
+    scale: f64,
+    power: Power,
+}
+
+/// x^n: square-and-multiply for integer 0 <= n <= 64 (several times faster than `powf`, which
+/// the hot loops of the secondary reflection feel), `powf` otherwise.
+#[derive(Clone, Copy, Debug)]
+enum Power {
+    Int(u32),
+    Real(f64),
+}
+
+impl Power {
+    fn new(n: f64) -> Power {
+        if n.fract() == 0.0 && (0.0..=64.0).contains(&n) {
+            Power::Int(n as u32)
+        } else {
+            Power::Real(n)
         }
-        acc
-    } else {
-        x.powf(n)
+    }
+
+    #[inline(always)]
+    fn of(self, x: f64) -> f64 {
+        match self {
+            Power::Int(n) => {
+                let (mut acc, mut base, mut k) = (1.0, x, n);
+                while k > 0 {
+                    if k & 1 == 1 {
+                        acc *= base;
+                    }
+                    base *= base;
+                    k >>= 1;
+                }
+                acc
+            }
+            Power::Real(n) => x.powf(n),
+        }
+    }
+}
+
+impl CosineFacet {
+    /// The specular term of `model` for material `m`.
+    pub fn new(model: FacetModel, m: &Material) -> CosineFacet {
+        let scale = match model {
+            FacetModel::Huo => m.specular,
+            FacetModel::Lewis => m.specular * 0.5 * (m.exponent + 2.0),
+        };
+        CosineFacet {
+            model,
+            scale,
+            power: Power::new(m.exponent),
+        }
+    }
+
+    /// True when the specular term is zero everywhere (rho_s = 0).
+    pub fn is_zero(&self) -> bool {
+        self.scale == 0.0
+    }
+
+    /// Specular intensity for unit light, from N.L > 0 and N.E > 0 (the caller checks them: the
+    /// term is zero otherwise) and L.E.
+    #[inline(always)]
+    pub fn specular(&self, nl: f64, ne: f64, le: f64) -> f64 {
+        match self.model {
+            FacetModel::Huo => {
+                let hh = 2.0 + 2.0 * le;
+                let nh = if hh > 0.0 {
+                    ((nl + ne) / hh.sqrt()).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                self.scale * self.power.of(nh)
+            }
+            FacetModel::Lewis => self.scale * self.power.of((2.0 * nl * ne - le).max(0.0)) * nl,
+        }
     }
 }
 
@@ -114,6 +168,34 @@ mod tests {
         for f in [FacetModel::Huo, FacetModel::Lewis] {
             let i = f.intensity(&m, n, l, e);
             assert!((i.diffuse - 0.5).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn huo_half_vector_from_cosines_matches_the_explicit_half_vector() {
+        // N.H computed from the normalised vector L + E, independently of intensity_cos.
+        let m = Material {
+            albedo: [0.5; 3],
+            specular: 0.7,
+            exponent: 9.0,
+        };
+        for (n, l, e) in [
+            ((10.0, 30.0), (40.0, 200.0), (35.0, 10.0)),
+            ((0.0, 0.0), (60.0, 0.0), (60.0, 180.0)),
+            ((25.0, 90.0), (5.0, 45.0), (80.0, 300.0)),
+        ] {
+            let n = UnitVec3::from_degrees(n.0, n.1).get();
+            let l = UnitVec3::from_degrees(l.0, l.1).get();
+            let e = UnitVec3::from_degrees(e.0, e.1).get();
+            let h = l + e;
+            let nh = (n.dot(h) / h.length()).max(0.0);
+            let i = FacetModel::Huo.intensity(&m, n, l, e);
+            if n.dot(l) > 0.0 && n.dot(e) > 0.0 {
+                assert!((i.specular - 0.7 * nh.powi(9)).abs() < 1e-12);
+                assert!((i.diffuse - n.dot(l)).abs() < 1e-15);
+            } else {
+                assert_eq!(i, FacetIntensity::default());
+            }
         }
     }
 

@@ -20,6 +20,7 @@ pub mod reflect;
 pub mod rng;
 pub mod shadowing;
 pub mod symmetry;
+pub mod trig;
 pub mod validate;
 pub mod vec3;
 pub mod weave;

@@ -30,6 +30,26 @@ pub fn direction_set(n: usize, max_theta_deg: f64) -> Vec<Pair> {
         .collect()
 }
 
+/// The direction set of the secondary-reflection accuracy table and benchmarks
+/// (`cargo xtask ir-accuracy`, `cargo bench -p clothbake-core -- secondary`): 40 pairs of
+/// [`direction_set`] up to 85 degrees, and 4 grazing pairs whose light and eye run along the
+/// +Y threads (the axial lobes' hard case).
+pub fn secondary_direction_set() -> Vec<Pair> {
+    let mut v = direction_set(40, 85.0);
+    for ((ti, pi), (to, po)) in [
+        ((60.0, 90.0), (60.0, 270.0)),
+        ((80.0, 85.0), (70.0, 275.0)),
+        ((45.0, 80.0), (75.0, 260.0)),
+        ((85.0, 90.0), (85.0, 90.0)),
+    ] {
+        v.push((
+            UnitVec3::from_degrees(ti, pi),
+            UnitVec3::from_degrees(to, po),
+        ));
+    }
+    v
+}
+
 /// One compared direction pair (channel-mean totals).
 #[derive(Clone, Copy, Debug)]
 pub struct Comparison {

@@ -571,7 +571,10 @@ mod tests {
         assert_eq!(v["secondary"]["method"], "analytic");
         assert_eq!(v["secondary"]["kernel"], "radiometric");
         assert_eq!(v["secondary"]["ranges"], "full");
-        assert_eq!(v["secondary"]["orders"]["theta"], 8);
+        assert_eq!(
+            v["secondary"]["orders"]["theta"],
+            clothbake_core::interreflection::Orders::default().theta
+        );
         let o = BakeOptions {
             bounces: 2,
             secondary: SecondaryOptions {
