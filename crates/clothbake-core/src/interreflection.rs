@@ -238,6 +238,11 @@ fn shift_near(a: Arc, near: f64) -> Arc {
 /// the quartic's ill-conditioning. The physical root is the one whose points face each other,
 /// with P1 visible and P2 lit, and whose reflected ray from P1 actually travels toward P2.
 pub fn peak(pair: &Pair, s: &Setting) -> Option<(f64, f64)> {
+    peak_in(pair, s, s.vis1)
+}
+
+/// [`peak`] with theta_1 searched in `range` only (within C1's visible arc).
+fn peak_in(pair: &Pair, s: &Setting, range: Arc) -> Option<(f64, f64)> {
     let te = s.e.z.atan2(s.e.x);
     let tl = s.l.z.atan2(s.l.x);
     let t2 = |t1: f64| t1 + FRAC_PI_2 + 0.5 * (tl - te);
@@ -255,11 +260,12 @@ pub fn peak(pair: &Pair, s: &Setting) -> Option<(f64, f64)> {
         let (sa, ca) = (s2 * ce - c2 * se, c2 * ce + s2 * se);
         dz * ca - dx * sa
     };
-    let (lo, hi) = (s.vis1.lo, s.vis1.hi.min(PI));
+    let range = range.meet(s.vis1);
+    let (lo, hi) = (range.lo, range.hi.min(PI));
     if lo >= hi {
         return None;
     }
-    let n = 32;
+    let n = 24;
     let mut best = None;
     let mut prev = (lo, f(lo));
     for k in 1..=n {
@@ -707,7 +713,37 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
     if s.vis1.is_empty() || s.lit2.is_empty() {
         return Secondary::default();
     }
-    let pk = peak(pair, s);
+    let e = s.e;
+    // The panels of C1's visible arc between the kinks of the integrand where P_i sees a lit
+    // part of C2 (the support's ends are kinks): only they get nodes, and the maximum reflection
+    // point is searched there.
+    let lit_at = |t: f64| {
+        let b = pair.seen_arc(t);
+        normal(t).dot(e) > 0.0 && !b.meet(shift_near(s.lit2, 0.5 * (b.lo + b.hi))).is_empty()
+    };
+    let mut kinks = Vec::with_capacity(16);
+    theta_kinks(pair, s.lit2, s.vis1, &mut kinks);
+    let mut buf = [0.0f64; 20];
+    let n = cut_points(s.vis1.lo, s.vis1.hi, &kinks, &mut buf);
+    let mut live = [(0.0f64, 0.0f64); 20];
+    let mut n_live = 0;
+    for w in buf[..n].windows(2) {
+        if w[1] > w[0] && lit_at(0.5 * (w[0] + w[1])) {
+            live[n_live] = (w[0], w[1]);
+            n_live += 1;
+        }
+    }
+    if n_live == 0 {
+        return Secondary::default();
+    }
+    let support = Arc {
+        lo: live[0].0,
+        hi: live[n_live - 1].1,
+    };
+    let pk = match ranges {
+        Ranges::Full => peak_in(pair, s, support),
+        Ranges::Thesis { .. } => peak(pair, s),
+    };
     // Sharper lobes need more nodes across C2 and along the axis: scale the orders by
     // sqrt(n / 15) beyond n = 15 (the lobe width goes as 1 / sqrt(n)).
     let boost = (pair.m1.exponent.max(pair.m2.exponent) / 15.0)
@@ -789,7 +825,6 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
     if endless {
         axial_nodes(-FRAC_PI_2, FRAC_PI_2, centres, nu, &mut shared);
     }
-    let e = s.e;
     // J(theta) times (N_i . E) r1: the inner double integral over C2 for one point of C1.
     let inner = |t: f64| -> Parts {
         let mut acc = Parts::default();
@@ -861,9 +896,9 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
         acc.scaled(ne * pair.r1 * pair.r2)
     };
     let mut out = Parts::default();
-    let mut tcuts: Vec<f64> = pk.iter().map(|p| p.0).collect();
-    theta_kinks(pair, s.lit2, theta_range, &mut tcuts);
     if orders.tol > 0.0 {
+        let mut tcuts: Vec<f64> = pk.iter().map(|p| p.0).collect();
+        theta_kinks(pair, s.lit2, theta_range, &mut tcuts);
         // Adaptive G7/K15 along C1, split at the maximum reflection point. Where the arc starts
         // near the point of C1 closest to C2 and the cylinders (nearly) touch, a point there sees
         // C2 under almost a hemisphere and the integrand grows like a logarithm: the first panel
@@ -900,30 +935,37 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
             out.add_scaled(&part, 1.0);
         }
     } else {
-        // Only the panels between kinks where P_i sees a lit part of C2 (the support's ends are
-        // kinks), `nt` nodes shared in proportion to their lengths, each graded toward the
-        // maximum reflection point by the in-plane width of the lobes (the mirror direction
-        // turns twice as fast as the normal).
-        let mut buf = [0.0f64; 20];
-        let n = cut_points(theta_range.lo, theta_range.hi, &tcuts, &mut buf);
-        let pts = &buf[..n];
-        let lit_at = |t: f64| {
-            let b = pair.seen_arc(t);
-            normal(t).dot(e) > 0.0 && !b.meet(shift_near(s.lit2, 0.5 * (b.lo + b.hi))).is_empty()
-        };
-        let live: Vec<(f64, f64)> = pts
-            .windows(2)
-            .map(|w| (w[0], w[1]))
-            .filter(|&(a, b)| b > a && lit_at(0.5 * (a + b)))
-            .collect();
+        // The live panels (Full ranges: those found above; thesis ranges: their part inside
+        // theta_range), split at the maximum reflection point; `nt` nodes shared in proportion
+        // to their lengths, each graded toward that point by the in-plane width of the lobes
+        // (the mirror direction turns twice as fast as the normal).
+        let mut panels_t = [(0.0f64, 0.0f64); 21];
+        let mut m_t = 0;
+        for &(a, b) in &live[..n_live] {
+            let (a, b) = (a.max(theta_range.lo), b.min(theta_range.hi));
+            if b <= a {
+                continue;
+            }
+            match pk {
+                Some((t, _)) if t > a + 1e-9 * (b - a) && t < b - 1e-9 * (b - a) => {
+                    panels_t[m_t] = (a, t);
+                    panels_t[m_t + 1] = (t, b);
+                    m_t += 2;
+                }
+                _ => {
+                    panels_t[m_t] = (a, b);
+                    m_t += 1;
+                }
+            }
+        }
+        let live = &panels_t[..m_t];
         let total: f64 = live.iter().map(|(a, b)| b - a).sum();
-
         let n = pair.m1.exponent.max(pair.m2.exponent);
         let (c, w) = match pk {
             Some(p) => (p.0, 0.5 * lobe_width(pair.facet, n)),
             None => (0.0, 1e3),
         };
-        for (a, b) in live {
+        for &(a, b) in live {
             let m = share(nt as f64 * (b - a) / total).max(2);
             graded_panels(a, b, c, w, &[], m, m, |t, wt| out.add_scaled(&inner(t), wt));
         }
