@@ -1,16 +1,21 @@
 //! Export a fabric's BRDF into the file formats other renderers read.
 //!
 //! * [`rgl`]: the tensor-file `.bsdf` of the RGL material database (Dupuy & Jakob 2018), read by
-//!   Mitsuba 3's `measured` BSDF (RGB variants). Anisotropic: one slice per (theta, phi) of the
-//!   view direction.
+//!   Mitsuba 3's `measured` BSDF (RGB file: RGB variants; spectral file: spectral variants) and
+//!   pbrt-v4's `measured` material (spectral file). Anisotropic: one slice per (theta, phi) of
+//!   the view direction.
+//! * [`spectrum`]: the linear RGB-to-spectrum upsampling of the spectral file, and the CIE
+//!   projection it inverts.
 //! * [`merl`]: the 90 x 90 x 180 half/difference-angle binary of the MERL database. Isotropic
 //!   only: the cloth's BRDF is averaged over rotations about the normal.
 //!
 //! Both sample a [`Brdf`]: any function of (wi toward the light, wo toward the eye) returning f_r
-//! in 1/sr, RGB; [`model_brdf`] wraps the analytic model as the baker evaluates it.
+//! in 1/sr, RGB; [`model_brdf`] wraps the analytic model as the baker evaluates it (the binary
+//! wraps a baked table's lookup the same way for `export --table`).
 
 pub mod merl;
 pub mod rgl;
+pub mod spectrum;
 
 use clothbake_core::{AnalyticModel, SecondaryOptions, UnitVec3, Vec3};
 use clothbake_loader::{write_atomic, TableError};
