@@ -11,13 +11,11 @@
 //! (CI installs them, see .ci/run). With `CLOTHBAKE_FIGURES=DIR` the two images of each test
 //! are also written as PNG into DIR (docs/figures/ holds the committed ones).
 
-use clothbake::bake::{bake, BakeOptions};
-use clothbake::export::{model_brdf, rgl};
+use clothbake::export::{model_brdf, rgl, table_brdf};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Vec3};
-use clothbake_loader::{write_exr, Brdf, Options, Precision};
+use clothbake_tests::fixtures::{bake_and_open, coloured_twill};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::sync::atomic::AtomicBool;
 
 const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/python/mitsuba_render.py");
 const RES: usize = 48;
@@ -80,12 +78,7 @@ fn python(args: &[&str]) {
 
 /// The twill with a coloured albedo, so that the three channels differ.
 fn fabric() -> Fabric {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/twill.json");
-    let mut f = Fabric::from_path(&path).unwrap();
-    for g in [&mut f.warp, &mut f.weft] {
-        g.material.albedo = [0.6, 0.3, 0.12];
-    }
-    f
+    coloured_twill()
 }
 
 /// What one comparison found.
@@ -246,28 +239,8 @@ fn mitsuba_renders_the_export_of_a_baked_table_like_the_model() {
     }
     let dir = std::env::temp_dir().join(format!("clothbake-baked-table-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("twill.exr");
-    let table = bake(
-        &fabric(),
-        &BakeOptions::default(),
-        &|_| {},
-        &AtomicBool::new(false),
-    )
-    .unwrap()
-    .table;
-    write_exr(&path, &table, Precision::F16, true).unwrap();
-    let lookup = Brdf::open(
-        &path,
-        Options {
-            sampling: false,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let source = |wi: UnitVec3, wo: UnitVec3| {
-        let v = |u: UnitVec3| [u.x as f32, u.y as f32, u.z as f32];
-        lookup.eval(v(wi), v(wo)).map(f64::from)
-    };
+    let lookup = bake_and_open(&fabric(), &dir.join("twill.exr"));
+    let source = table_brdf(&lookup);
     let c = render_and_compare(
         "table",
         &source,

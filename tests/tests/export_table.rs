@@ -4,12 +4,9 @@
 //! within a few degrees of the horizon), so the luminance-weighted relative RMSE over all nodes
 //! must be small and most nodes close.
 
-use clothbake::bake::{bake, BakeOptions};
-use clothbake::export::{model_brdf, rgl};
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3};
-use clothbake_loader::{write_exr, Brdf, Options, Precision};
-use std::path::Path;
-use std::sync::atomic::AtomicBool;
+use clothbake::export::{model_brdf, rgl, table_brdf};
+use clothbake_core::{AnalyticModel, FacetModel};
+use clothbake_tests::fixtures::{bake_and_open, coloured_twill};
 
 fn rgb_values(fields: &[rgl::Field]) -> Vec<f32> {
     let f = fields
@@ -24,35 +21,11 @@ fn rgb_values(fields: &[rgl::Field]) -> Vec<f32> {
 
 #[test]
 fn the_export_of_a_baked_table_matches_the_export_of_the_model() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/twill.json");
-    let mut fabric = Fabric::from_path(&path).unwrap();
-    for g in [&mut fabric.warp, &mut fabric.weft] {
-        g.material.albedo = [0.6, 0.3, 0.12];
-    }
+    let fabric = coloured_twill();
     let dir = std::env::temp_dir().join(format!("clothbake-export-table-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let table_path = dir.join("twill.exr");
-    let table = bake(
-        &fabric,
-        &BakeOptions::default(),
-        &|_| {},
-        &AtomicBool::new(false),
-    )
-    .unwrap()
-    .table;
-    write_exr(&table_path, &table, Precision::F16, true).unwrap();
-    let lookup = Brdf::open(
-        &table_path,
-        Options {
-            sampling: false,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let from_table = |wi: UnitVec3, wo: UnitVec3| {
-        let v = |u: UnitVec3| [u.x as f32, u.y as f32, u.z as f32];
-        lookup.eval(v(wi), v(wo)).map(f64::from)
-    };
+    let lookup = bake_and_open(&fabric, &dir.join("twill.exr"));
+    let from_table = table_brdf(&lookup);
     let model = AnalyticModel::new(&fabric, FacetModel::Huo);
     let from_model = model_brdf(&model, None);
     // A coarser grid than the default keeps the test fast; the nodes are where they always are.

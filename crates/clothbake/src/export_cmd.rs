@@ -8,7 +8,7 @@ use crate::error::CliError;
 use crate::eval_cmd::apply_material;
 use clothbake::export::{self, merl, rgl, spectrum, Brdf};
 use clothbake_core::symmetry::{symmetries, Symmetry};
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3};
+use clothbake_core::{AnalyticModel, Fabric, FacetModel};
 use clothbake_loader::TableError;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -91,21 +91,11 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
                 meta.options_json,
                 meta.fabric_json
             );
-            let brdf = table_brdf(&lookup);
+            let brdf = export::table_brdf(&lookup);
             // No half-turn shortcut for a table: lookups are cheap, and the interpolated table
             // need not be exactly symmetric.
             write_all(args, &brdf, &source, false)
         }
-    }
-}
-
-/// f_r of a table through the loader's `eval` (zero at and below the horizon, as `Brdf` asks).
-fn table_brdf(
-    lookup: &clothbake_loader::Brdf,
-) -> impl Fn(UnitVec3, UnitVec3) -> [f64; 3] + Sync + '_ {
-    move |wi: UnitVec3, wo: UnitVec3| {
-        let v = |u: UnitVec3| [u.x as f32, u.y as f32, u.z as f32];
-        lookup.eval(v(wi), v(wo)).map(f64::from)
     }
 }
 

@@ -10,8 +10,8 @@
 //!   only: the cloth's BRDF is averaged over rotations about the normal.
 //!
 //! Both sample a [`Brdf`]: any function of (wi toward the light, wo toward the eye) returning f_r
-//! in 1/sr, RGB; [`model_brdf`] wraps the analytic model as the baker evaluates it (the binary
-//! wraps a baked table's lookup the same way for `export --table`).
+//! in 1/sr, RGB; [`model_brdf`] wraps the analytic model as the baker evaluates it,
+//! [`table_brdf`] a baked table's lookup.
 
 pub mod merl;
 pub mod rgl;
@@ -43,6 +43,17 @@ pub fn model_brdf<'a>(
             return [0.0; 3];
         }
         model.eval_with(wi, wo, secondary.as_ref()).brdf(wi)
+    }
+}
+
+/// A baked table's f_r through the loader's interpolated lookup (`Brdf::eval`, zero at and below
+/// the horizon): the source of `clothbake export --table`.
+pub fn table_brdf(
+    lookup: &clothbake_loader::Brdf,
+) -> impl Fn(UnitVec3, UnitVec3) -> [f64; 3] + Sync + '_ {
+    move |wi: UnitVec3, wo: UnitVec3| {
+        let v = |u: UnitVec3| [u.x as f32, u.y as f32, u.z as f32];
+        lookup.eval(v(wi), v(wo)).map(f64::from)
     }
 }
 
