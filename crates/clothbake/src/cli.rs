@@ -57,8 +57,10 @@ pub enum Command {
     Info(InfoArgs),
     /// Compare two baked tables of the same grid; exit 1 when they differ beyond the tolerance.
     Diff(DiffArgs),
-    /// Export a fabric's BRDF for other renderers: the RGL `.bsdf` of Mitsuba 3's `measured`
-    /// BSDF, or the isotropic MERL binary (averaged over rotations about the normal).
+    /// Export a fabric's BRDF (the model's or a baked table's) for other renderers: the RGL
+    /// `.bsdf` of Mitsuba 3's `measured` BSDF (RGB) or of pbrt-v4 and Mitsuba's spectral
+    /// variants (spectral), or the isotropic MERL binary (averaged over rotations about the
+    /// normal).
     Export(ExportArgs),
     /// Merge the shard files of a bake (`bake --shard K/N`) into the table (docs/cluster.md).
     Merge(MergeArgs),
