@@ -146,6 +146,8 @@ fn write_all(
     let pool = crate::bake_cmd::thread_pool(threads)?;
     let mut summary = String::new();
     let g = args.rgl_res.0;
+    // One evaluation of the slices serves both RGL files.
+    let mut slices = None;
     for (out, colour) in [
         (&args.rgl, rgl::Colour::Rgb),
         (&args.rgl_spectral, rgl::Colour::Spectral),
@@ -172,7 +174,8 @@ fn write_all(
             g.n_slice,
             g.n_slice
         );
-        let fields = pool.install(|| rgl::rgl_fields(brdf, &g, &description, colour));
+        let slices = slices.get_or_insert_with(|| pool.install(|| rgl::rgl_slices(brdf, &g)));
+        let fields = rgl::fields_of(slices, &description, colour);
         let bytes = rgl::tensor_file(&fields);
         export::write_file(out, &bytes, args.force)?;
         let _ = writeln!(

@@ -496,6 +496,26 @@ fn export_from_a_table_and_spectral_export() {
     }
     assert!(has(&rgb_bytes, "rgb") && !has(&rgb_bytes, "wavelengths"));
     assert!(has(&spec_bytes, "spectra") && has(&spec_bytes, "wavelengths"));
+    // The same bytes whatever the thread count.
+    let one = dir.join("t1_spec.bsdf");
+    let ok = clothbake(&[
+        "export",
+        "--table",
+        t,
+        "--rgl-spectral",
+        one.to_str().unwrap(),
+        "--rgl-res",
+        "3,4,5",
+        "--threads",
+        "1",
+        "-q",
+    ]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    assert!(std::fs::read(&one).unwrap() == spec_bytes);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

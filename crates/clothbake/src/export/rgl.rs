@@ -236,22 +236,48 @@ pub enum Colour {
     Spectral,
 }
 
-/// The fields of a `.bsdf` file for `brdf` on `grid`, in the order written: description,
-/// jacobian, theta_i, phi_i, ndf, sigma, vndf, luminance, then `rgb` or `wavelengths` and
-/// `spectra` (see [`Colour`]; the readers find fields by name). Deterministic: slices are
-/// evaluated in parallel on the current rayon pool and collected in order.
-pub fn rgl_fields(brdf: &Brdf, grid: &RglGrid, description: &str, colour: Colour) -> Vec<Field> {
+/// The evaluated tables of an RGL export: per view-direction node (j < n_phi, k < n_theta), the
+/// `rgb` slice (3 x n x n, channel-major) and the `luminance` slice (n x n). Shared by the RGB
+/// and the spectral file of one export.
+pub struct Slices {
+    grid: RglGrid,
+    slices: Vec<(Vec<f32>, Vec<f32>)>,
+}
+
+/// Evaluates `brdf` on every slice of `grid`. Deterministic: slices are evaluated in parallel on
+/// the current rayon pool and collected in order.
+pub fn rgl_slices(brdf: &Brdf, grid: &RglGrid) -> Slices {
     let (nt, np, n) = (grid.n_theta, grid.n_phi + 1, grid.n_slice);
     let thetas = grid.theta_nodes();
     let phis = grid.phi_nodes();
     // Slice (j, k) for j < n_phi; the node phi = pi repeats phi = -pi (copied, not re-evaluated).
-    let slices: Vec<(Vec<f32>, Vec<f32>)> = (0..(np - 1) * nt)
+    let slices = (0..(np - 1) * nt)
         .into_par_iter()
         .map(|s| {
             let (j, k) = (s / nt, s % nt);
             slice(brdf, UnitVec3::from_spherical(thetas[k], phis[j]), n)
         })
         .collect();
+    Slices {
+        grid: *grid,
+        slices,
+    }
+}
+
+/// The fields of a `.bsdf` file for `brdf` on `grid`: [`rgl_slices`] then [`fields_of`].
+pub fn rgl_fields(brdf: &Brdf, grid: &RglGrid, description: &str, colour: Colour) -> Vec<Field> {
+    fields_of(&rgl_slices(brdf, grid), description, colour)
+}
+
+/// The fields of a `.bsdf` file from evaluated slices, in the order written: description,
+/// jacobian, theta_i, phi_i, ndf, sigma, vndf, luminance, then `rgb` or `wavelengths` and
+/// `spectra` (see [`Colour`]; the readers find fields by name).
+pub fn fields_of(slices: &Slices, description: &str, colour: Colour) -> Vec<Field> {
+    let grid = &slices.grid;
+    let (nt, np, n) = (grid.n_theta, grid.n_phi + 1, grid.n_slice);
+    let thetas = grid.theta_nodes();
+    let phis = grid.phi_nodes();
+    let slices = &slices.slices;
     let slice_at = |j: usize, k: usize| &slices[(j % (np - 1)) * nt + k];
     let (npu, ntu, nu) = (np as u64, nt as u64, n as u64);
     let mut lum = Vec::with_capacity(np * nt * n * n);
