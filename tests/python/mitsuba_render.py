@@ -2,14 +2,17 @@
 """Render a flat rectangle with an RGL .bsdf in Mitsuba 3 (scalar_rgb), and say what each pixel sees.
 
 Usage:
-  python3 tests/python/mitsuba_render.py render FILE.bsdf OUTDIR [--res N] [--spp N]
-  python3 tests/python/mitsuba_render.py png OUTDIR FIGDIR
+  python3 tests/python/mitsuba_render.py render FILE.bsdf OUTDIR [--res N] [--spp N] [--variant V]
+  python3 tests/python/mitsuba_render.py png OUTDIR FIGDIR [PREFIX]
 
 render: the scene is Mitsuba's `rectangle` ([-1, 1]^2 in the z = 0 plane, normal +z) with the
 `measured` BSDF reading FILE.bsdf, lit by a `directional` emitter of irradiance E = 3 travelling
 along -LIGHT (LIGHT = the unit vector toward the light, printed), seen by a perspective camera
 from (0, -2.2, 2.4) looking at the origin, N x N pixels, box filter, `direct` integrator with
-emitter sampling only. Writes into OUTDIR:
+emitter sampling only. --variant: scalar_rgb (default; the RGB file) or scalar_spectral (the
+spectral file; the film then integrates the sampled wavelengths against the CIE 1931 curves and
+converts XYZ to linear sRGB, and the light's RGB irradiance becomes E times Mitsuba's normalised
+D65). Writes into OUTDIR:
   render.f32   the image, N*N*3 float32 little-endian, row-major from the top-left pixel, RGB
   pairs.f64    per pixel: the direction toward the light and toward the eye in the surface's local
                shading frame (Mitsuba's si.to_local, the frame the BSDF sees), 6 float64 each, taken
@@ -18,8 +21,8 @@ emitter sampling only. Writes into OUTDIR:
   scene.json   the numbers above (irradiance, light direction, resolution, spp, Mitsuba version)
 
 png: reads OUTDIR/render.f32 and OUTDIR/reference.f32 (the same layout, written by the Rust test
-tests/tests/export_mitsuba.rs) and writes FIGDIR/rgl_mitsuba.png and FIGDIR/rgl_reference.png,
-both with the same exposure (the reference's 99th percentile maps to 0.9) and the sRGB curve.
+tests/tests/export_mitsuba.rs) and writes FIGDIR/PREFIX_mitsuba.png and FIGDIR/PREFIX_reference.png
+(PREFIX: rgl unless given), both with the same exposure (the reference's 99th percentile maps to 0.9) and the sRGB curve.
 
 Needs: pip install mitsuba numpy
 """
@@ -36,10 +39,10 @@ LIGHT = LIGHT / np.linalg.norm(LIGHT)
 ORIGIN = [0.0, -2.2, 2.4]
 
 
-def render(bsdf_path, out, res, spp):
+def render(bsdf_path, out, res, spp, variant):
     import mitsuba as mi
 
-    mi.set_variant("scalar_rgb")
+    mi.set_variant(variant)
     scene = mi.load_dict(
         {
             "type": "scene",
@@ -100,13 +103,14 @@ def render(bsdf_path, out, res, spp):
                 "origin": ORIGIN,
                 "res": res,
                 "spp": spp,
+                "variant": variant,
                 "mitsuba": mi.__version__,
             },
             f,
         )
 
 
-def png(out, figdir):
+def png(out, figdir, prefix):
     import mitsuba as mi
 
     mi.set_variant("scalar_rgb")
@@ -117,7 +121,7 @@ def png(out, figdir):
     }
     scale = 0.9 / max(float(np.percentile(imgs["reference"], 99)), 1e-12)
     os.makedirs(figdir, exist_ok=True)
-    for name, file in [("render", "rgl_mitsuba.png"), ("reference", "rgl_reference.png")]:
+    for name, file in [("render", prefix + "_mitsuba.png"), ("reference", prefix + "_reference.png")]:
         bmp = mi.Bitmap(np.clip(imgs[name] * scale, 0, 1).astype(np.float32))
         bmp = bmp.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.UInt8, True)
         bmp.write(os.path.join(figdir, file))
@@ -125,19 +129,21 @@ def png(out, figdir):
 
 def main(argv):
     if len(argv) >= 3 and argv[0] == "render":
-        res, spp = 48, 16
+        res, spp, variant = 48, 16, "scalar_rgb"
         rest = argv[3:]
         while rest:
             if rest[0] == "--res":
                 res = int(rest[1])
             elif rest[0] == "--spp":
                 spp = int(rest[1])
+            elif rest[0] == "--variant":
+                variant = rest[1]
             else:
                 raise SystemExit(f"unknown option {rest[0]}; see --help")
             rest = rest[2:]
-        render(argv[1], argv[2], res, spp)
-    elif len(argv) == 3 and argv[0] == "png":
-        png(argv[1], argv[2])
+        render(argv[1], argv[2], res, spp, variant)
+    elif len(argv) in (3, 4) and argv[0] == "png":
+        png(argv[1], argv[2], argv[3] if len(argv) == 4 else "rgl")
     else:
         raise SystemExit(__doc__)
 

@@ -2,3 +2,4 @@
 //! (`tests/benches/`) and `cargo xtask loader-accuracy`.
 
 pub mod accuracy;
+pub mod fixtures;

@@ -1,21 +1,27 @@
-//! Proof by a real client: Mitsuba 3 (`scalar_rgb`, its `measured` BSDF) renders a flat
-//! rectangle with the RGL `.bsdf` we export, under a directional light seen by a perspective
-//! camera (tests/python/mitsuba_render.py). The same image is computed here from the analytic
-//! model alone: on a flat plane lit by a directional light of irradiance E, a pixel is
-//! E f_r(light, eye) cos(theta_light), with the two directions Mitsuba reports for the ray
-//! through the pixel's centre, in the surface frame its BSDF sees. Relative RMSE under 5%.
+//! Proof by a real client: Mitsuba 3 (its `measured` BSDF) renders a flat rectangle with the
+//! RGL `.bsdf` we export, under a directional light seen by a perspective camera
+//! (tests/python/mitsuba_render.py): the RGB file in `scalar_rgb`, the spectral file in
+//! `scalar_spectral`, and the RGB file exported from a baked table (through the loader) in
+//! `scalar_rgb`. The same image is computed here from the analytic model alone: on a flat plane
+//! lit by a directional light of irradiance E, a pixel is E f_r(light, eye) cos(theta_light),
+//! with the two directions Mitsuba reports for the ray through the pixel's centre, in the
+//! surface frame its BSDF sees. Relative RMSE under 5%.
 //!
 //! Skipped with a message when `python3` cannot import mitsuba and numpy, except under `CI`
-//! (CI installs them, see .ci/run). With `CLOTHBAKE_FIGURES=DIR` the two images are also
-//! written as PNG into DIR (docs/figures/ holds the committed ones).
+//! (CI installs them, see .ci/run). With `CLOTHBAKE_FIGURES=DIR` the two images of each test
+//! are also written as PNG into DIR (docs/figures/ holds the committed ones).
 
-use clothbake::export::{model_brdf, rgl};
+use clothbake::export::{model_brdf, rgl, table_brdf};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Vec3};
+use clothbake_tests::fixtures::{bake_and_open, coloured_twill};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/python/mitsuba_render.py");
 const RES: usize = 48;
+/// Samples per pixel of the spectral render: each carries 4 wavelengths, and the colour noise
+/// of wavelength sampling is several percent per pixel at the RGB render's 16.
+const SPECTRAL_SPP: u32 = 256;
 
 fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
@@ -72,26 +78,35 @@ fn python(args: &[&str]) {
 
 /// The twill with a coloured albedo, so that the three channels differ.
 fn fabric() -> Fabric {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/twill.json");
-    let mut f = Fabric::from_path(&path).unwrap();
-    for g in [&mut f.warp, &mut f.weft] {
-        g.material.albedo = [0.6, 0.3, 0.12];
-    }
-    f
+    coloured_twill()
 }
 
-#[test]
-fn mitsuba_renders_the_exported_bsdf_like_the_model() {
-    if !mitsuba_available() {
-        return;
-    }
+/// What one comparison found.
+struct Compared {
+    rel_rmse: f64,
+    worst: f64,
+    pixels: usize,
+    mitsuba: String,
+}
+
+/// Exports `source` (f_r, 1/sr, RGB) as `colour` on the default grid, renders it with Mitsuba's
+/// `variant`, and compares each inside pixel with E f_r_model(light, eye) cos(theta_light).
+/// Writes `<prefix>_mitsuba.png` and `<prefix>_reference.png` under CLOTHBAKE_FIGURES if set.
+fn render_and_compare(
+    tag: &str,
+    source: &(dyn Fn(UnitVec3, UnitVec3) -> [f64; 3] + Sync),
+    colour: rgl::Colour,
+    variant: &str,
+    spp: u32,
+    prefix: &str,
+) -> Compared {
     let dir: PathBuf =
-        std::env::temp_dir().join(format!("clothbake-mitsuba-{}", std::process::id()));
+        std::env::temp_dir().join(format!("clothbake-mitsuba-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let f = fabric();
     let model = AnalyticModel::new(&f, FacetModel::Huo);
     let brdf = model_brdf(&model, None);
-    let fields = rgl::rgl_fields(&brdf, &rgl::DEFAULT_GRID, "clothbake test: twill");
+    let fields = rgl::rgl_fields(source, &rgl::DEFAULT_GRID, "clothbake test: twill", colour);
     let bsdf = dir.join("twill.bsdf");
     clothbake::export::write_file(&bsdf, &rgl::tensor_file(&fields), true).unwrap();
 
@@ -103,7 +118,9 @@ fn mitsuba_renders_the_exported_bsdf_like_the_model() {
         "--res",
         &RES.to_string(),
         "--spp",
-        "16",
+        &spp.to_string(),
+        "--variant",
+        variant,
     ]);
     let scene: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("scene.json")).unwrap()).unwrap();
@@ -150,20 +167,88 @@ fn mitsuba_renders_the_exported_bsdf_like_the_model() {
         }
         n += 1;
     }
-    let rel_rmse = (se / sr).sqrt();
-    eprintln!(
-        "Mitsuba {} vs the model: relative RMSE {:.3}% over {n} pixels, worst pixel {:.2}%",
-        scene["mitsuba"],
-        100.0 * rel_rmse,
-        100.0 * worst
-    );
     assert!(n > RES * RES / 3, "the rectangle covers only {n} pixels");
-    assert!(rel_rmse < 0.05, "relative RMSE {rel_rmse}");
-
     if let Ok(figs) = std::env::var("CLOTHBAKE_FIGURES") {
         let bytes: Vec<u8> = reference.iter().flat_map(|v| v.to_le_bytes()).collect();
         std::fs::write(out.join("reference.f32"), bytes).unwrap();
-        python(&["png", out.to_str().unwrap(), &figs]);
+        python(&["png", out.to_str().unwrap(), &figs, prefix]);
     }
     std::fs::remove_dir_all(&dir).unwrap();
+    Compared {
+        rel_rmse: (se / sr).sqrt(),
+        worst,
+        pixels: n,
+        mitsuba: scene["mitsuba"].to_string(),
+    }
+}
+
+fn report(what: &str, c: &Compared) {
+    eprintln!(
+        "Mitsuba {} {what} vs the model: relative RMSE {:.3}% over {} pixels, worst pixel {:.2}%",
+        c.mitsuba,
+        100.0 * c.rel_rmse,
+        c.pixels,
+        100.0 * c.worst
+    );
+    assert!(c.rel_rmse < 0.05, "relative RMSE {}", c.rel_rmse);
+}
+
+#[test]
+fn mitsuba_renders_the_exported_bsdf_like_the_model() {
+    if !mitsuba_available() {
+        return;
+    }
+    let f = fabric();
+    let model = AnalyticModel::new(&f, FacetModel::Huo);
+    let c = render_and_compare(
+        "rgb",
+        &model_brdf(&model, None),
+        rgl::Colour::Rgb,
+        "scalar_rgb",
+        16,
+        "rgl",
+    );
+    report("scalar_rgb, RGB file", &c);
+}
+
+#[test]
+fn mitsuba_spectral_renders_the_spectral_bsdf_like_the_model() {
+    // The spectral file: Mitsuba samples wavelengths, interpolates `spectra` between our nodes,
+    // multiplies by its D65 light and integrates against the CIE curves into sRGB.
+    if !mitsuba_available() {
+        return;
+    }
+    let f = fabric();
+    let model = AnalyticModel::new(&f, FacetModel::Huo);
+    let c = render_and_compare(
+        "spectral",
+        &model_brdf(&model, None),
+        rgl::Colour::Spectral,
+        "scalar_spectral",
+        SPECTRAL_SPP,
+        "rgl_spectral",
+    );
+    report("scalar_spectral, spectral file", &c);
+}
+
+#[test]
+fn mitsuba_renders_the_export_of_a_baked_table_like_the_model() {
+    // The twill baked at the default grid (f16 EXR), exported through the loader's lookup.
+    if !mitsuba_available() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("clothbake-baked-table-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let lookup = bake_and_open(&fabric(), &dir.join("twill.exr"));
+    let source = table_brdf(&lookup);
+    let c = render_and_compare(
+        "table",
+        &source,
+        rgl::Colour::Rgb,
+        "scalar_rgb",
+        16,
+        "rgl_table",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    report("scalar_rgb, RGB file from the baked table", &c);
 }

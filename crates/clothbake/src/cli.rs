@@ -57,8 +57,10 @@ pub enum Command {
     Info(InfoArgs),
     /// Compare two baked tables of the same grid; exit 1 when they differ beyond the tolerance.
     Diff(DiffArgs),
-    /// Export a fabric's BRDF for other renderers: the RGL `.bsdf` of Mitsuba 3's `measured`
-    /// BSDF, or the isotropic MERL binary (averaged over rotations about the normal).
+    /// Export a fabric's BRDF (the model's or a baked table's) for other renderers: the RGL
+    /// `.bsdf` of Mitsuba 3's `measured` BSDF (RGB) or of pbrt-v4 and Mitsuba's spectral
+    /// variants (spectral), or the isotropic MERL binary (averaged over rotations about the
+    /// normal).
     Export(ExportArgs),
     /// Merge the shard files of a bake (`bake --shard K/N`) into the table (docs/cluster.md).
     Merge(MergeArgs),
@@ -253,13 +255,24 @@ pub struct InfoArgs {
                   anisotropy. See docs/export.md."
 )]
 pub struct ExportArgs {
-    /// Fabric description (JSON, see docs/fabric-format.md), e.g. tables/twill.json.
+    /// Export the analytic model of this fabric (JSON, see docs/fabric-format.md, or a WIF
+    /// draft), e.g. tables/twill.json. Give this or --table.
     #[arg(long, value_name = "FILE")]
-    pub weave: PathBuf,
+    pub weave: Option<PathBuf>,
 
-    /// Write the RGL material-database tensor file (RGB) that Mitsuba 3's `measured` BSDF reads.
+    /// Export a baked table instead (.exr or .bin), read with the loader's interpolation; the
+    /// model options do not apply. Give this or --weave.
+    #[arg(long, value_name = "T.exr|T.bin")]
+    pub table: Option<PathBuf>,
+
+    /// Write the RGL material-database tensor file (RGB) that Mitsuba 3's RGB variants read.
     #[arg(long, value_name = "OUT.bsdf")]
     pub rgl: Option<PathBuf>,
+
+    /// Write the spectral RGL tensor file (360-840 nm, upsampled from RGB) that pbrt-v4 and
+    /// Mitsuba 3's spectral variants read.
+    #[arg(long, value_name = "OUT.bsdf")]
+    pub rgl_spectral: Option<PathBuf>,
 
     /// Write the 90x90x180 MERL binary (isotropic: averaged over rotations about the normal).
     #[arg(long, value_name = "OUT.binary")]
@@ -273,13 +286,14 @@ pub struct ExportArgs {
     #[arg(long, value_name = "N", value_parser = parse_phi_samples, default_value = "16")]
     pub phi_samples: usize,
 
-    /// Facet reflection model: the thesis's Phong-like terms or Lewis's modified Phong.
-    #[arg(long, value_enum, default_value_t = FacetArg::Huo)]
-    pub facet: FacetArg,
+    /// Facet reflection model: the thesis's Phong-like terms or Lewis's modified Phong
+    /// [default: huo].
+    #[arg(long, value_enum)]
+    pub facet: Option<FacetArg>,
 
-    /// Analytic variant (see docs/model.md).
-    #[arg(long, value_enum, default_value_t = VariantArg::Refined)]
-    pub variant: VariantArg,
+    /// Analytic variant (see docs/model.md) [default: refined].
+    #[arg(long, value_enum)]
+    pub variant: Option<VariantArg>,
 
     /// Bounces and the secondary reflection's options.
     #[command(flatten)]

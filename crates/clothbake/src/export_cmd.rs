@@ -1,69 +1,192 @@
-//! `clothbake export`: the analytic model's BRDF as an RGL `.bsdf` (Mitsuba 3) and/or a MERL
-//! binary, each written atomically. Formats and conventions: `docs/export.md`.
+//! `clothbake export`: the BRDF of the analytic model (`--weave`) or of a baked table
+//! (`--table`, through the loader's lookup) as an RGL `.bsdf` (RGB for Mitsuba 3, spectral for
+//! pbrt-v4 and Mitsuba's spectral variants) and/or a MERL binary, each written atomically.
+//! Formats and conventions: `docs/export.md`.
 
 use crate::cli::ExportArgs;
 use crate::error::CliError;
 use crate::eval_cmd::apply_material;
-use clothbake::export::{self, merl, rgl};
+use clothbake::export::{self, merl, rgl, spectrum, Brdf};
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel};
 use clothbake_loader::TableError;
 use std::fmt::Write as _;
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Runs `clothbake export` and returns the summary for stdout (empty with --quiet).
 pub fn run(args: &ExportArgs) -> Result<String, CliError> {
-    if args.rgl.is_none() && args.merl.is_none() {
+    let outputs: Vec<&PathBuf> = [&args.rgl, &args.rgl_spectral, &args.merl]
+        .into_iter()
+        .flatten()
+        .collect();
+    if outputs.is_empty() {
         return Err(CliError::new(
             "nothing to export",
-            "give --rgl OUT.bsdf (Mitsuba 3) and/or --merl OUT.binary",
+            "give --rgl OUT.bsdf (Mitsuba 3), --rgl-spectral OUT.bsdf (pbrt-v4, Mitsuba 3 \
+             spectral) and/or --merl OUT.binary",
         ));
     }
-    if args.rgl.is_some() && args.rgl == args.merl {
-        return Err(CliError::new(
-            "--rgl and --merl name the same file",
-            "give each format its own output path",
-        ));
+    for (i, a) in outputs.iter().enumerate() {
+        if outputs[..i].contains(a) {
+            return Err(CliError::new(
+                format!("two outputs name the same file {}", a.display()),
+                "give each format its own output path",
+            ));
+        }
     }
-    let secondary = args.bounces.options()?;
-    let secondary = (args.bounces.bounces == 2).then_some(secondary);
-    let fabric = Fabric::from_path(&args.weave)?;
-    let fabric = apply_material(fabric, &args.material);
-    for out in [&args.rgl, &args.merl].into_iter().flatten() {
+    match (&args.weave, &args.table) {
+        (Some(_), Some(_)) => Err(CliError::new(
+            "--weave and --table both given",
+            "export either the model of a fabric (--weave FILE) or a baked table (--table T)",
+        )),
+        (None, None) => Err(CliError::new(
+            "nothing to export from",
+            "give --weave FILE (the analytic model of a fabric) or --table T.exr|T.bin (a baked \
+             table)",
+        )),
+        (Some(weave), None) => {
+            let secondary = args.bounces.options()?;
+            let secondary = (args.bounces.bounces == 2).then_some(secondary);
+            let fabric = apply_material(Fabric::from_path(weave)?, &args.material);
+            refuse_existing(args)?;
+            let facet = FacetModel::from(args.facet.unwrap_or(crate::cli::FacetArg::Huo));
+            let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);
+            let model = AnalyticModel::with_variant(&fabric, facet, variant.into());
+            let brdf = export::model_brdf(&model, secondary);
+            let source = format!(
+                "fabric {}; f_r cos(theta_light) of the analytic model (facet {}, variant {}, \
+                 bounces {})",
+                fabric.name,
+                facet_name(facet),
+                model.variant().name(),
+                args.bounces.bounces
+            );
+            // A fabric unchanged by a half turn has a BRDF unchanged by it: half the rotations.
+            let half_turn = symmetries(&fabric).contains(&Symmetry::Rotate180);
+            write_all(args, &brdf, &source, half_turn)
+        }
+        (None, Some(table)) => {
+            refuse_model_options(args)?;
+            let options = clothbake_loader::Options {
+                sampling: false,
+                ..Default::default()
+            };
+            let lookup = clothbake_loader::Brdf::open(table, options)?;
+            refuse_existing(args)?;
+            let meta = lookup.meta();
+            let g = meta.grid;
+            let name = Fabric::from_json_str(&meta.fabric_json, "table metadata")
+                .map_or_else(|_| "(unreadable fabric metadata)".to_string(), |f| f.name);
+            let source = format!(
+                "fabric {name}; f_r cos(theta_light) looked up (quadrilinear interpolation) in \
+                 the table {} ({}, {} x {} x {} x {} cells, bake options {}); the table's fabric \
+                 file: {}",
+                table.display(),
+                meta.tool,
+                g.n_theta_i,
+                g.n_phi_i,
+                g.n_theta_o,
+                g.n_phi_o,
+                meta.options_json,
+                meta.fabric_json
+            );
+            let brdf = export::table_brdf(&lookup);
+            // No half-turn shortcut for a table: lookups are cheap, and the interpolated table
+            // need not be exactly symmetric.
+            write_all(args, &brdf, &source, false)
+        }
+    }
+}
+
+/// An error for each model option given with --table (a table holds what it was baked with).
+fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
+    let m = &args.material;
+    let b = &args.bounces;
+    let given = [
+        ("--facet", args.facet.is_some()),
+        ("--variant", args.variant.is_some()),
+        ("--bounces", b.bounces != 1),
+        ("--secondary", b.secondary.is_some()),
+        ("--kernel", b.kernel.is_some()),
+        ("--albedo", m.albedo.is_some()),
+        ("--specular", m.specular.is_some()),
+        ("--exponent", m.exponent.is_some()),
+    ];
+    match given.iter().find(|(_, on)| *on) {
+        Some((flag, _)) => Err(CliError::new(
+            format!("{flag} applies to the model, not to a table"),
+            "drop it (a table holds what it was baked with), or export the model with --weave",
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Refuses to replace an existing output unless --force (before any work is done).
+fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
+    for out in [&args.rgl, &args.rgl_spectral, &args.merl]
+        .into_iter()
+        .flatten()
+    {
         if !args.force && std::fs::symlink_metadata(out).is_ok() {
             return Err(TableError::AlreadyExists { path: out.clone() }.into());
         }
     }
-    let facet = FacetModel::from(args.facet);
-    let model = AnalyticModel::with_variant(&fabric, facet, args.variant.into());
-    let brdf = export::model_brdf(&model, secondary);
+    Ok(())
+}
+
+/// Writes every requested file from `brdf`; `source` opens the RGL description.
+fn write_all(
+    args: &ExportArgs,
+    brdf: &Brdf,
+    source: &str,
+    half_turn: bool,
+) -> Result<String, CliError> {
     let threads = crate::bake_cmd::thread_count(args.threads);
     let pool = crate::bake_cmd::thread_pool(threads)?;
     let mut summary = String::new();
-    if let Some(out) = &args.rgl {
+    let g = args.rgl_res.0;
+    // One evaluation of the slices serves both RGL files.
+    let mut slices = None;
+    for (out, colour) in [
+        (&args.rgl, rgl::Colour::Rgb),
+        (&args.rgl_spectral, rgl::Colour::Spectral),
+    ] {
+        let Some(out) = out else { continue };
         let start = Instant::now();
-        let g = args.rgl_res.0;
+        let w = &spectrum::WAVELENGTHS;
+        let colour_words = match colour {
+            rgl::Colour::Rgb => "RGB (linear sRGB)".to_string(),
+            rgl::Colour::Spectral => format!(
+                "spectral, {} wavelengths {}-{} nm, linear upsampling of linear sRGB \
+                 (docs/export.md)",
+                w.len(),
+                w[0],
+                w[w.len() - 1]
+            ),
+        };
         let description = format!(
-            "clothbake {}: fabric {}; f_r cos(theta_light) of the analytic model (facet {}, \
-             variant {}, bounces {}); view-direction grid {} x {} (+1), slices {} x {}",
+            "clothbake {}: {source}; {colour_words}; view-direction grid {} x {} (+1), slices \
+             {} x {}",
             env!("CARGO_PKG_VERSION"),
-            fabric.name,
-            facet_name(facet),
-            model.variant().name(),
-            args.bounces.bounces,
             g.n_theta,
             g.n_phi,
             g.n_slice,
             g.n_slice
         );
-        let fields = pool.install(|| rgl::rgl_fields(&brdf, &g, &description));
+        let slices = slices.get_or_insert_with(|| pool.install(|| rgl::rgl_slices(brdf, &g)));
+        let fields = rgl::fields_of(slices, &description, colour);
         let bytes = rgl::tensor_file(&fields);
         export::write_file(out, &bytes, args.force)?;
         let _ = writeln!(
             summary,
-            "wrote {}: RGL tensor file (RGB), view grid {} x {} (+1), slices {} x {}, {:.1} MB, \
+            "wrote {}: RGL tensor file ({}), view grid {} x {} (+1), slices {} x {}, {:.1} MB, \
              {:.2} s",
             out.display(),
+            match colour {
+                rgl::Colour::Rgb => "RGB",
+                rgl::Colour::Spectral => "spectral",
+            },
             g.n_theta,
             g.n_phi,
             g.n_slice,
@@ -74,9 +197,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
     }
     if let Some(out) = &args.merl {
         let start = Instant::now();
-        // A fabric unchanged by a half turn has a BRDF unchanged by it: half the rotations.
-        let half_turn = symmetries(&fabric).contains(&Symmetry::Rotate180);
-        let table = pool.install(|| merl::merl_table(&brdf, args.phi_samples, half_turn));
+        let table = pool.install(|| merl::merl_table(brdf, args.phi_samples, half_turn));
         export::write_file(out, &merl::merl_bytes(&table), args.force)?;
         let a = table.anisotropy;
         let _ = writeln!(

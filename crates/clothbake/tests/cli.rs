@@ -415,6 +415,110 @@ fn export_writes_an_rgl_file_and_refuses_bad_requests() {
     std::fs::remove_file(&out).unwrap();
 }
 
+#[test]
+fn export_from_a_table_and_spectral_export() {
+    // A small baked table of the plain weave, exported through the loader: the RGL file's
+    // description carries the table's fabric file; the model options are refused with a table;
+    // --weave and --table are exclusive, and one is needed.
+    let w = table("plain");
+    let w = w.to_str().unwrap();
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-export-table");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let t = dir.join("plain.bin");
+    let t = t.to_str().unwrap();
+    let baked = clothbake(&["bake", "--weave", w, "-o", t, "--res", "4,8,4,8", "-q"]);
+    assert!(
+        baked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&baked.stderr)
+    );
+    let (rgb, spec) = (dir.join("t.bsdf"), dir.join("t_spec.bsdf"));
+    let (rgb, spec) = (rgb.to_str().unwrap(), spec.to_str().unwrap());
+    fails(
+        &clothbake(&["export", "--weave", w, "--table", t, "--rgl", rgb]),
+        &["--weave and --table", "either"],
+    );
+    fails(
+        &clothbake(&["export", "--rgl", rgb]),
+        &["--weave FILE", "--table"],
+    );
+    fails(
+        &clothbake(&["export", "--table", t, "--rgl", rgb, "--albedo", "0.5"]),
+        &["--albedo applies to the model", "--weave"],
+    );
+    fails(
+        &clothbake(&["export", "--table", t, "--rgl", rgb, "--bounces", "2"]),
+        &["--bounces applies to the model"],
+    );
+    fails(
+        &clothbake(&["export", "--table", t, "--rgl", rgb, "--rgl-spectral", rgb]),
+        &["same file", "own output path"],
+    );
+    let missing = dir.join("none.exr");
+    fails(
+        &clothbake(&["export", "--table", missing.to_str().unwrap(), "--rgl", rgb]),
+        &["none.exr"],
+    );
+    let ok = clothbake(&[
+        "export",
+        "--table",
+        t,
+        "--rgl",
+        rgb,
+        "--rgl-spectral",
+        spec,
+        "--rgl-res",
+        "3,4,5",
+    ]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let said = String::from_utf8_lossy(&ok.stdout);
+    assert!(
+        said.contains("(RGB)") && said.contains("(spectral)"),
+        "{said}"
+    );
+    let rgb_bytes = std::fs::read(rgb).unwrap();
+    let spec_bytes = std::fs::read(spec).unwrap();
+    let has = |b: &[u8], s: &str| b.windows(s.len()).any(|x| x == s.as_bytes());
+    let fabric_json = std::fs::read_to_string(table("plain")).unwrap();
+    let fabric: serde_json::Value = serde_json::from_str(&fabric_json).unwrap();
+    let name = fabric["name"].as_str().unwrap_or("plain");
+    for b in [&rgb_bytes, &spec_bytes] {
+        assert!(has(b, "looked up") && has(b, "plain.bin") && has(b, name));
+        assert!(
+            has(b, "\"pattern\""),
+            "the fabric file is in the description"
+        );
+    }
+    assert!(has(&rgb_bytes, "rgb") && !has(&rgb_bytes, "wavelengths"));
+    assert!(has(&spec_bytes, "spectra") && has(&spec_bytes, "wavelengths"));
+    // The same bytes whatever the thread count.
+    let one = dir.join("t1_spec.bsdf");
+    let ok = clothbake(&[
+        "export",
+        "--table",
+        t,
+        "--rgl-spectral",
+        one.to_str().unwrap(),
+        "--rgl-res",
+        "3,4,5",
+        "--threads",
+        "1",
+        "-q",
+    ]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    assert!(std::fs::read(&one).unwrap() == spec_bytes);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 fn draft(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../tables")

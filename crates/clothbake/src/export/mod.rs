@@ -1,16 +1,21 @@
 //! Export a fabric's BRDF into the file formats other renderers read.
 //!
 //! * [`rgl`]: the tensor-file `.bsdf` of the RGL material database (Dupuy & Jakob 2018), read by
-//!   Mitsuba 3's `measured` BSDF (RGB variants). Anisotropic: one slice per (theta, phi) of the
-//!   view direction.
+//!   Mitsuba 3's `measured` BSDF (RGB file: RGB variants; spectral file: spectral variants) and
+//!   pbrt-v4's `measured` material (spectral file). Anisotropic: one slice per (theta, phi) of
+//!   the view direction.
+//! * [`spectrum`]: the linear RGB-to-spectrum upsampling of the spectral file, and the CIE
+//!   projection it inverts.
 //! * [`merl`]: the 90 x 90 x 180 half/difference-angle binary of the MERL database. Isotropic
 //!   only: the cloth's BRDF is averaged over rotations about the normal.
 //!
 //! Both sample a [`Brdf`]: any function of (wi toward the light, wo toward the eye) returning f_r
-//! in 1/sr, RGB; [`model_brdf`] wraps the analytic model as the baker evaluates it.
+//! in 1/sr, RGB; [`model_brdf`] wraps the analytic model as the baker evaluates it,
+//! [`table_brdf`] a baked table's lookup.
 
 pub mod merl;
 pub mod rgl;
+pub mod spectrum;
 
 use clothbake_core::{AnalyticModel, SecondaryOptions, UnitVec3, Vec3};
 use clothbake_loader::{write_atomic, TableError};
@@ -38,6 +43,17 @@ pub fn model_brdf<'a>(
             return [0.0; 3];
         }
         model.eval_with(wi, wo, secondary.as_ref()).brdf(wi)
+    }
+}
+
+/// A baked table's f_r through the loader's interpolated lookup (`Brdf::eval`, zero at and below
+/// the horizon): the source of `clothbake export --table`.
+pub fn table_brdf(
+    lookup: &clothbake_loader::Brdf,
+) -> impl Fn(UnitVec3, UnitVec3) -> [f64; 3] + Sync + '_ {
+    move |wi: UnitVec3, wo: UnitVec3| {
+        let v = |u: UnitVec3| [u.x as f32, u.y as f32, u.z as f32];
+        lookup.eval(v(wi), v(wo)).map(f64::from)
     }
 }
 

@@ -1,6 +1,8 @@
 //! The RGL material database's tensor-file `.bsdf` (Dupuy & Jakob 2018, "An adaptive
-//! parameterization for efficient material acquisition and rendering"), RGB flavour, as Mitsuba
-//! 3's `measured` BSDF reads it. Layout and parameterisation: `docs/export.md`.
+//! parameterization for efficient material acquisition and rendering"), as Mitsuba 3's
+//! `measured` BSDF (RGB flavour; spectral flavour in its spectral variants) and pbrt-v4's
+//! `measured` material (spectral flavour only) read it. Layout and parameterisation:
+//! `docs/export.md`.
 //!
 //! The file is a `tensor_file`: a header naming fields (name, element type, shape, offset) and
 //! their little-endian data. The reader interpolates, for the view direction v (its
@@ -19,7 +21,7 @@
 //! n_phi, j <= n_phi (the last node repeats the first: no symmetry reduction, which both
 //! Mitsuba 3 and pbrt-v4 accept).
 
-use super::{luminance, reflect, Brdf};
+use super::{luminance, reflect, spectrum, Brdf};
 use clothbake_core::UnitVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -223,34 +225,69 @@ fn slice(brdf: &Brdf, v: UnitVec3, n: usize) -> (Vec<f32>, Vec<f32>) {
     (rgb, lum.iter().map(|&l| (l + floor) as f32).collect())
 }
 
-/// The fields of an RGB `.bsdf` file for `brdf` on `grid`, in the order written: description,
-/// jacobian, theta_i, phi_i, ndf, sigma, vndf, luminance, rgb. Deterministic: slices are
-/// evaluated in parallel on the current rayon pool and collected in order.
-pub fn rgl_fields(brdf: &Brdf, grid: &RglGrid, description: &str) -> Vec<Field> {
+/// How an RGL file carries colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Colour {
+    /// A `rgb` field [phi_i, theta_i, 3, n, n]: Mitsuba 3's RGB variants.
+    Rgb,
+    /// `wavelengths` [25] (nm) and `spectra` [phi_i, theta_i, 25, n, n], the `rgb` values
+    /// upsampled by [`spectrum::Upsampling`]: pbrt-v4 and Mitsuba 3's spectral variants. No
+    /// `rgb` field: Mitsuba's RGB variants refuse any file with `wavelengths`.
+    Spectral,
+}
+
+/// The evaluated tables of an RGL export: per view-direction node (j < n_phi, k < n_theta), the
+/// `rgb` slice (3 x n x n, channel-major) and the `luminance` slice (n x n). Shared by the RGB
+/// and the spectral file of one export.
+pub struct Slices {
+    grid: RglGrid,
+    slices: Vec<(Vec<f32>, Vec<f32>)>,
+}
+
+/// Evaluates `brdf` on every slice of `grid`. Deterministic: slices are evaluated in parallel on
+/// the current rayon pool and collected in order.
+pub fn rgl_slices(brdf: &Brdf, grid: &RglGrid) -> Slices {
     let (nt, np, n) = (grid.n_theta, grid.n_phi + 1, grid.n_slice);
     let thetas = grid.theta_nodes();
     let phis = grid.phi_nodes();
     // Slice (j, k) for j < n_phi; the node phi = pi repeats phi = -pi (copied, not re-evaluated).
-    let slices: Vec<(Vec<f32>, Vec<f32>)> = (0..(np - 1) * nt)
+    let slices = (0..(np - 1) * nt)
         .into_par_iter()
         .map(|s| {
             let (j, k) = (s / nt, s % nt);
             slice(brdf, UnitVec3::from_spherical(thetas[k], phis[j]), n)
         })
         .collect();
+    Slices {
+        grid: *grid,
+        slices,
+    }
+}
+
+/// The fields of a `.bsdf` file for `brdf` on `grid`: [`rgl_slices`] then [`fields_of`].
+pub fn rgl_fields(brdf: &Brdf, grid: &RglGrid, description: &str, colour: Colour) -> Vec<Field> {
+    fields_of(&rgl_slices(brdf, grid), description, colour)
+}
+
+/// The fields of a `.bsdf` file from evaluated slices, in the order written: description,
+/// jacobian, theta_i, phi_i, ndf, sigma, vndf, luminance, then `rgb` or `wavelengths` and
+/// `spectra` (see [`Colour`]; the readers find fields by name).
+pub fn fields_of(slices: &Slices, description: &str, colour: Colour) -> Vec<Field> {
+    let grid = &slices.grid;
+    let (nt, np, n) = (grid.n_theta, grid.n_phi + 1, grid.n_slice);
+    let thetas = grid.theta_nodes();
+    let phis = grid.phi_nodes();
+    let slices = &slices.slices;
     let slice_at = |j: usize, k: usize| &slices[(j % (np - 1)) * nt + k];
-    let mut rgb = Vec::with_capacity(np * nt * 3 * n * n);
+    let (npu, ntu, nu) = (np as u64, nt as u64, n as u64);
     let mut lum = Vec::with_capacity(np * nt * n * n);
     for j in 0..np {
         for k in 0..nt {
-            let (r, l) = slice_at(j, k);
-            rgb.extend_from_slice(r);
-            lum.extend_from_slice(l);
+            lum.extend_from_slice(&slice_at(j, k).1);
         }
     }
-    let (npu, ntu, nu) = (np as u64, nt as u64, n as u64);
     let f32s = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
-    vec![
+    let mut fields = vec![
         Field::bytes("description", description.as_bytes()),
         Field::bytes("jacobian", &[1]),
         Field::f32("theta_i", &[ntu], &f32s(&thetas)),
@@ -259,8 +296,46 @@ pub fn rgl_fields(brdf: &Brdf, grid: &RglGrid, description: &str) -> Vec<Field> 
         Field::f32("sigma", &[2, 2], &[0.25; 4]),
         Field::f32("vndf", &[npu, ntu, 2, 2], &vec![1.0; np * nt * 4]),
         Field::f32("luminance", &[npu, ntu, nu, nu], &lum),
-        Field::f32("rgb", &[npu, ntu, 3, nu, nu], &rgb),
-    ]
+    ];
+    match colour {
+        Colour::Rgb => {
+            let mut rgb = Vec::with_capacity(np * nt * 3 * n * n);
+            for j in 0..np {
+                for k in 0..nt {
+                    rgb.extend_from_slice(&slice_at(j, k).0);
+                }
+            }
+            fields.push(Field::f32("rgb", &[npu, ntu, 3, nu, nu], &rgb));
+        }
+        Colour::Spectral => {
+            let basis = spectrum::Upsampling::new();
+            let nw = spectrum::WAVELENGTHS.len();
+            let mut spectra = Vec::with_capacity(np * nt * nw * n * n);
+            for j in 0..np {
+                for k in 0..nt {
+                    let rgb = &slice_at(j, k).0;
+                    for b in basis.basis() {
+                        spectra.extend((0..n * n).map(|i| {
+                            (0..3)
+                                .map(|c| b[c] * f64::from(rgb[c * n * n + i]))
+                                .sum::<f64>() as f32
+                        }));
+                    }
+                }
+            }
+            fields.push(Field::f32(
+                "wavelengths",
+                &[nw as u64],
+                &f32s(&spectrum::WAVELENGTHS),
+            ));
+            fields.push(Field::f32(
+                "spectra",
+                &[npu, ntu, nw as u64, nu, nu],
+                &spectra,
+            ));
+        }
+    }
+    fields
 }
 
 #[cfg(test)]
@@ -320,7 +395,7 @@ mod tests {
             n_phi: 4,
             n_slice: 5,
         };
-        let fields = rgl_fields(&brdf, &g, "test");
+        let fields = rgl_fields(&brdf, &g, "test", Colour::Rgb);
         let rgb = &fields[8];
         assert_eq!(rgb.shape, vec![5, 3, 3, 5, 5]);
         let vals: Vec<f32> = rgb

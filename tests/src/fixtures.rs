@@ -1,0 +1,37 @@
+//! Inputs shared by the export tests.
+
+use clothbake::bake::{bake, BakeOptions};
+use clothbake_core::Fabric;
+use clothbake_loader::{write_exr, Brdf, Options, Precision};
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+/// The shipped twill (`tables/twill.json`) with the albedo (0.6, 0.3, 0.12) on both groups, so
+/// that the three channels differ.
+pub fn coloured_twill() -> Fabric {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/twill.json");
+    let mut f = Fabric::from_path(&path).expect("the shipped twill reads");
+    for g in [&mut f.warp, &mut f.weft] {
+        g.material.albedo = [0.6, 0.3, 0.12];
+    }
+    f
+}
+
+/// Bakes `fabric` with the default options (analytic model, default grid), writes the table to
+/// `path` as an f16 EXR and opens it for lookups (no sampling tables).
+pub fn bake_and_open(fabric: &Fabric, path: &Path) -> Brdf {
+    let table = bake(
+        fabric,
+        &BakeOptions::default(),
+        &|_| {},
+        &AtomicBool::new(false),
+    )
+    .expect("the bake succeeds")
+    .table;
+    write_exr(path, &table, Precision::F16, true).expect("the table is written");
+    let options = Options {
+        sampling: false,
+        ..Default::default()
+    };
+    Brdf::open(path, options).expect("the table reads back")
+}

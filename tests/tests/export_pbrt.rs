@@ -1,0 +1,89 @@
+//! pbrt-v4's `measured` material and the spectral RGL file. pbrt-v4 cannot be built here (see
+//! docs/export.md), so this is NOT a real-client proof: tests/python/rgl_check.py reads the
+//! file with its own numpy parser and checks every condition pbrt-v4's reader
+//! (`MeasuredBxDFData::Create`, src/pbrt/bxdfs.cpp) places on it, as found in pbrt-v4's public
+//! source: field names, types, ranks, matching extents, a full 2 pi azimuth range, increasing
+//! nodes, wavelengths covering the 360-830 nm pbrt samples. With Mitsuba installed it also
+//! projects every spectrum back to sRGB with Mitsuba's own CIE tables and compares with the RGB
+//! file of the same export.
+//!
+//! Skipped with a message when python3 cannot import numpy, except under `CI`.
+
+use clothbake::export::{model_brdf, rgl};
+use clothbake_core::{AnalyticModel, Fabric, FacetModel};
+use std::path::Path;
+use std::process::Command;
+
+const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/python/rgl_check.py");
+
+fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
+}
+
+fn imports(module: &str) -> bool {
+    let ok = Command::new("python3")
+        .args(["-c", &format!("import {module}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok {
+        assert!(!in_ci(), "CI is set, but python3 cannot import {module}");
+        eprintln!("skipped: python3 cannot import {module} (pip install {module})");
+    }
+    ok
+}
+
+fn check(args: &[&str]) -> serde_json::Value {
+    let out = Command::new("python3")
+        .arg(SCRIPT)
+        .args(args)
+        .output()
+        .expect("run python3");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "rgl_check.py {args:?} failed: {text}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(text.trim()).unwrap()
+}
+
+#[test]
+fn the_spectral_file_meets_pbrt_v4s_reader_and_projects_back_to_the_rgb_file() {
+    if !imports("numpy") {
+        return;
+    }
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/denim.wif");
+    let fabric = Fabric::from_path(&path).unwrap();
+    let model = AnalyticModel::new(&fabric, FacetModel::Huo);
+    let brdf = model_brdf(&model, None);
+    let grid = rgl::RglGrid {
+        n_theta: 6,
+        n_phi: 8,
+        n_slice: 12,
+    };
+    let dir = std::env::temp_dir().join(format!("clothbake-pbrt-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (spec, rgb) = (dir.join("denim_spec.bsdf"), dir.join("denim_rgb.bsdf"));
+    for (p, c) in [(&spec, rgl::Colour::Spectral), (&rgb, rgl::Colour::Rgb)] {
+        let fields = rgl::rgl_fields(&brdf, &grid, "clothbake test: denim", c);
+        clothbake::export::write_file(p, &rgl::tensor_file(&fields), true).unwrap();
+    }
+    let s = check(&["pbrt", spec.to_str().unwrap()]);
+    eprintln!("pbrt-v4 reader conditions: {s}");
+    assert_eq!(s["ok"], true);
+    assert_eq!(s["shape"], serde_json::json!([9, 6, 25, 12, 12]));
+    // The RGB file is not a pbrt-v4 file (no spectra): the check must say so.
+    let out = Command::new("python3")
+        .arg(SCRIPT)
+        .args(["pbrt", rgb.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("missing field spectra"));
+    if imports("mitsuba") {
+        let p = check(&["project", spec.to_str().unwrap(), rgb.to_str().unwrap()]);
+        eprintln!("spectra projected back with Mitsuba's CIE tables: {p}");
+        assert!(p["max_error_rel_to_max"].as_f64().unwrap() < 1e-4, "{p}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
