@@ -141,13 +141,18 @@ impl CosineFacet {
     pub fn specular(&self, nl: f64, ne: f64, le: f64) -> f64 {
         match self.model {
             FacetModel::Huo => {
+                // (N.H)^2 = (N.L + N.E)^2 / (2 + 2 L.E): an even integer exponent needs no
+                // square root.
                 let hh = 2.0 + 2.0 * le;
-                let nh = if hh > 0.0 {
-                    ((nl + ne) / hh.sqrt()).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                self.scale * self.power.of(nh)
+                if hh <= 0.0 {
+                    return 0.0;
+                }
+                let s = nl + ne;
+                let nh2 = (s * s / hh).min(1.0);
+                match self.power {
+                    Power::Int(n) if n % 2 == 0 => self.scale * Power::Int(n / 2).of(nh2),
+                    p => self.scale * p.of(nh2.sqrt()),
+                }
             }
             FacetModel::Lewis => self.scale * self.power.of((2.0 * nl * ne - le).max(0.0)) * nl,
         }
