@@ -33,13 +33,15 @@ unsafe fn atan2_4(y: __m128, x: __m128) -> __m128 {
     let hi = _mm_max_ps(ax, ay);
     let a = _mm_and_ps(_mm_div_ps(lo, hi), _mm_cmpgt_ps(hi, _mm_setzero_ps()));
     let s = _mm_mul_ps(a, a);
+    // Estrin's scheme (shorter dependency chain than Horner's):
+    // p = (c0 + c1 s) + s^2 (c2 + c3 s) + s^4 (c4 + c5 s).
     let c = ATAN_COEFFS;
-    let mut p = _mm_set1_ps(c[5]);
-    p = _mm_fmadd_ps(p, s, _mm_set1_ps(c[4]));
-    p = _mm_fmadd_ps(p, s, _mm_set1_ps(c[3]));
-    p = _mm_fmadd_ps(p, s, _mm_set1_ps(c[2]));
-    p = _mm_fmadd_ps(p, s, _mm_set1_ps(c[1]));
-    p = _mm_fmadd_ps(p, s, _mm_set1_ps(c[0]));
+    let k = |i: usize| _mm_set1_ps(c[i]);
+    let s2 = _mm_mul_ps(s, s);
+    let p01 = _mm_fmadd_ps(k(1), s, k(0));
+    let p23 = _mm_fmadd_ps(k(3), s, k(2));
+    let p45 = _mm_fmadd_ps(k(5), s, k(4));
+    let p = _mm_fmadd_ps(_mm_fmadd_ps(p45, s2, p23), s2, p01);
     let mut r = _mm_mul_ps(a, p);
     r = _mm_blendv_ps(
         r,
@@ -85,6 +87,27 @@ unsafe fn angles(wi: [f32; 3], wo: [f32; 3]) -> (__m128, bool) {
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
 unsafe fn blend<const HALF: bool, V>(nodes: &Nodes, v: &[V], ang: __m128) -> [f32; 3] {
+    gather::<HALF, V>(nodes, v, &corner(nodes, ang))
+}
+
+/// Where a lookup falls ([`crate::nodes::Corner`] in registers).
+#[derive(Clone, Copy)]
+struct Corner {
+    /// First lanes of the runs at the low and high `phi_i` columns.
+    base: [usize; 2],
+    /// Weight of run `r = 4 ia + 2 ib + ic`, lane `r`.
+    w: __m256,
+    /// `1 - t_po` in lanes 0..4, `t_po` in lanes 4..8.
+    d: __m256,
+}
+
+/// The corner of a lookup at `ang` (radians, as [`Nodes::corner`]).
+///
+/// # Safety
+/// The processor must have AVX2, FMA and F16C.
+#[inline]
+#[target_feature(enable = "avx2,fma,f16c")]
+unsafe fn corner(nodes: &Nodes, ang: __m128) -> Corner {
     // Spans of the four axes in one register, as nodes::polar_axis (lanes 0, 2) and
     // nodes::azimuth_axis (lanes 1, 3).
     let n = nodes.n;
@@ -122,33 +145,37 @@ unsafe fn blend<const HALF: bool, V>(nodes: &Nodes, v: &[V], ang: __m128) -> [f3
     let wc = _mm256_permutevar8x32_ps(t8, _mm256_setr_epi32(2, 6, 2, 6, 2, 6, 2, 6));
     let d = _mm256_permutevar8x32_ps(t8, _mm256_setr_epi32(3, 3, 3, 3, 7, 7, 7, 7));
     let w = _mm256_mul_ps(_mm256_mul_ps(wa, wb), wc);
+    Corner { base, w, d }
+}
+
+/// The blend of the 8 runs of a corner.
+///
+/// # Safety
+/// The processor must have AVX2, FMA and F16C; `V` is `u16` (half bits) when `HALF`, else
+/// `f32`.
+#[inline]
+#[target_feature(enable = "avx2,fma,f16c")]
+unsafe fn gather<const HALF: bool, V>(nodes: &Nodes, v: &[V], k: &Corner) -> [f32; 3] {
+    let Corner { base, w, d } = *k;
     let Some(p) = nodes.runs(v, base) else {
         return [0.0; 3];
     };
     // `runs` gives pointers valid for 8 reads of V (u16 halves when HALF).
-    let mut x = [_mm256_setzero_ps(); 8];
-    for (x, &p) in x.iter_mut().zip(&p) {
-        *x = if HALF {
-            _mm256_cvtph_ps(_mm_loadu_si128(p as *const __m128i))
+    let load = |r: usize| {
+        if HALF {
+            _mm256_cvtph_ps(_mm_loadu_si128(p[r] as *const __m128i))
         } else {
-            _mm256_loadu_ps(p as *const f32)
-        };
-    }
-    let bcast = [
-        _mm256_permutevar8x32_ps(w, _mm256_set1_epi32(0)),
-        _mm256_permutevar8x32_ps(w, _mm256_set1_epi32(1)),
-        _mm256_permutevar8x32_ps(w, _mm256_set1_epi32(2)),
-        _mm256_permutevar8x32_ps(w, _mm256_set1_epi32(3)),
-        _mm256_permutevar8x32_ps(w, _mm256_set1_epi32(4)),
-        _mm256_permutevar8x32_ps(w, _mm256_set1_epi32(5)),
-        _mm256_permutevar8x32_ps(w, _mm256_set1_epi32(6)),
-        _mm256_permutevar8x32_ps(w, _mm256_set1_epi32(7)),
-    ];
-    let a0 = _mm256_fmadd_ps(x[1], bcast[1], _mm256_mul_ps(x[0], bcast[0]));
-    let a1 = _mm256_fmadd_ps(x[3], bcast[3], _mm256_mul_ps(x[2], bcast[2]));
-    let a0 = _mm256_fmadd_ps(x[5], bcast[5], _mm256_fmadd_ps(x[4], bcast[4], a0));
-    let a1 = _mm256_fmadd_ps(x[7], bcast[7], _mm256_fmadd_ps(x[6], bcast[6], a1));
-    let acc = _mm256_mul_ps(_mm256_add_ps(a0, a1), d);
+            _mm256_loadu_ps(p[r] as *const f32)
+        }
+    };
+    // Run r's lane weights: w_r for the low phi_o node, times (1 - t_po, t_po) by D; the
+    // weights do not wait for the loads, and the sum is a tree (short chain after them).
+    let lane = |r: i32| _mm256_mul_ps(_mm256_permutevar8x32_ps(w, _mm256_set1_epi32(r)), d);
+    let y0 = _mm256_fmadd_ps(load(1), lane(1), _mm256_mul_ps(load(0), lane(0)));
+    let y1 = _mm256_fmadd_ps(load(3), lane(3), _mm256_mul_ps(load(2), lane(2)));
+    let y2 = _mm256_fmadd_ps(load(5), lane(5), _mm256_mul_ps(load(4), lane(4)));
+    let y3 = _mm256_fmadd_ps(load(7), lane(7), _mm256_mul_ps(load(6), lane(6)));
+    let acc = _mm256_add_ps(_mm256_add_ps(y0, y1), _mm256_add_ps(y2, y3));
     let rgb = _mm_add_ps(_mm256_castps256_ps128(acc), _mm256_extractf128_ps::<1>(acc));
     let mut out = [0f32; 4];
     _mm_storeu_ps(out.as_mut_ptr(), rgb); // 4 f32, unaligned
@@ -237,8 +264,40 @@ pub(crate) unsafe fn batch<const HALF: bool, V>(
     wo: &[[f32; 3]],
     out: &mut [[f32; 3]],
 ) {
-    for ((a, b), o) in wi.iter().zip(wo).zip(out.iter_mut()) {
-        *o = eval::<HALF, V>(nodes, v, reciprocal, *a, *b);
+    // `GROUP` pairs at a time: all corners before all gathers, so that the next pairs' angle
+    // arithmetic overlaps the loads of the first (same operations as `eval`: the same bits).
+    const GROUP: usize = 4;
+    let n = wi.len().min(wo.len()).min(out.len());
+    let (wi, wo, out) = (&wi[..n], &wo[..n], &mut out[..n]);
+    let mut chunks = out.chunks_exact_mut(GROUP);
+    for (j, o) in (&mut chunks).enumerate() {
+        let k = j * GROUP;
+        let ang: [(__m128, bool); GROUP] = [
+            angles(wi[k], wo[k]),
+            angles(wi[k + 1], wo[k + 1]),
+            angles(wi[k + 2], wo[k + 2]),
+            angles(wi[k + 3], wo[k + 3]),
+        ];
+        if !reciprocal && ang.iter().all(|a| a.1) {
+            let c = [
+                corner(nodes, ang[0].0),
+                corner(nodes, ang[1].0),
+                corner(nodes, ang[2].0),
+                corner(nodes, ang[3].0),
+            ];
+            for (o, c) in o.iter_mut().zip(&c) {
+                *o = gather::<HALF, V>(nodes, v, c);
+            }
+        } else {
+            for (i, o) in o.iter_mut().enumerate() {
+                *o = eval::<HALF, V>(nodes, v, reciprocal, wi[k + i], wo[k + i]);
+            }
+        }
+    }
+    let rest = chunks.into_remainder();
+    let k = n - rest.len();
+    for (i, o) in rest.iter_mut().enumerate() {
+        *o = eval::<HALF, V>(nodes, v, reciprocal, wi[k + i], wo[k + i]);
     }
 }
 
