@@ -20,19 +20,21 @@ pub(crate) fn available() -> bool {
         && is_x86_feature_detected!("f16c")
 }
 
-/// `atan2(y, x)` in four lanes, as [`crate::angles::atan2`] (0 for `(0, 0)`).
+/// `atan2(y, x)` in four lanes from `y^2`, `x^2` and the signs of `x` and `y` (masks), with
+/// the polynomial of [`crate::angles::atan2`]: `atan(a) = a P(a^2)` with `a^2 = min / max` of
+/// the squares. Starting from squares, the square root (of the ratio) runs beside the
+/// polynomial instead of before the division: a shorter dependency chain than `rho =
+/// sqrt(x^2 + y^2)` first. 0 for `(0, 0)`.
+///
 /// # Safety
 /// The processor must have AVX2, FMA and F16C.
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
-unsafe fn atan2_4(y: __m128, x: __m128) -> __m128 {
-    let sign = _mm_set1_ps(-0.0);
-    let ax = _mm_andnot_ps(sign, x);
-    let ay = _mm_andnot_ps(sign, y);
-    let lo = _mm_min_ps(ax, ay);
-    let hi = _mm_max_ps(ax, ay);
-    let a = _mm_and_ps(_mm_div_ps(lo, hi), _mm_cmpgt_ps(hi, _mm_setzero_ps()));
-    let s = _mm_mul_ps(a, a);
+unsafe fn atan2_sq(y2: __m128, x2: __m128, x_neg: __m128, y_neg: __m128) -> __m128 {
+    let lo = _mm_min_ps(x2, y2);
+    let hi = _mm_max_ps(x2, y2);
+    let s = _mm_and_ps(_mm_div_ps(lo, hi), _mm_cmpgt_ps(hi, _mm_setzero_ps()));
+    let a = _mm_sqrt_ps(s);
     // Estrin's scheme (shorter dependency chain than Horner's):
     // p = (c0 + c1 s) + s^2 (c2 + c3 s) + s^4 (c4 + c5 s).
     let c = ATAN_COEFFS;
@@ -46,38 +48,35 @@ unsafe fn atan2_4(y: __m128, x: __m128) -> __m128 {
     r = _mm_blendv_ps(
         r,
         _mm_sub_ps(_mm_set1_ps(std::f32::consts::FRAC_PI_2), r),
-        _mm_cmpgt_ps(ay, ax),
+        _mm_cmpgt_ps(y2, x2),
     );
-    r = _mm_blendv_ps(
-        r,
-        _mm_sub_ps(_mm_set1_ps(std::f32::consts::PI), r),
-        _mm_cmplt_ps(x, _mm_setzero_ps()),
-    );
-    _mm_xor_ps(r, _mm_and_ps(sign, _mm_cmplt_ps(y, _mm_setzero_ps())))
+    r = _mm_blendv_ps(r, _mm_sub_ps(_mm_set1_ps(std::f32::consts::PI), r), x_neg);
+    _mm_xor_ps(r, _mm_and_ps(_mm_set1_ps(-0.0), y_neg))
 }
 
 /// `[theta_i, phi_i, theta_o, phi_o]` of a pair, and whether the pair has a value (both above
 /// the horizon, nothing NaN).
+///
 /// # Safety
 /// The processor must have AVX2, FMA and F16C.
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
 unsafe fn angles(wi: [f32; 3], wo: [f32; 3]) -> (__m128, bool) {
+    // Lanes: theta_i = atan2(rho_i, z_i), phi_i = atan2(y_i, x_i), and the same for wo.
     let x = _mm_setr_ps(wi[2], wi[0], wo[2], wo[0]);
-    let yx = _mm_setr_ps(wi[0], wi[1], wo[0], wo[1]);
-    let yy = _mm_setr_ps(wi[1], 0.0, wo[1], 0.0);
-    // Lanes 0, 2: rho = sqrt(x^2 + y^2); lanes 1, 3: y itself (sqrt(y^2) would lose its sign).
-    let rho = _mm_sqrt_ps(_mm_fmadd_ps(yx, yx, _mm_mul_ps(yy, yy)));
-    let y = _mm_blend_ps::<0b1010>(rho, yx);
-    // Lanes 0 and 2 of x are the cosines: not above the horizon (or NaN) there, or NaN in any
-    // lane of x or y, means no value.
+    let a = _mm_setr_ps(wi[0], wi[1], wo[0], wo[1]);
+    let b = _mm_setr_ps(wi[1], 0.0, wo[1], 0.0);
+    let y2 = _mm_fmadd_ps(a, a, _mm_mul_ps(b, b)); // rho^2 (lanes 0, 2), y^2 (lanes 1, 3)
+    let zero = _mm_setzero_ps();
+    let azimuth = _mm_castsi128_ps(_mm_setr_epi32(0, -1, 0, -1));
+    let y_neg = _mm_and_ps(_mm_cmplt_ps(a, zero), azimuth); // rho >= 0
+                                                            // Lanes 0 and 2 of x are the cosines: not above the horizon (or NaN) there, or NaN in any
+                                                            // of the six components (all are in x or a), means no value.
     let below = _mm_cmp_ps::<_CMP_NGT_UQ>(x, _mm_set1_ps(HORIZON_COS));
-    let nan = _mm_cmpunord_ps(x, y);
-    let bad = _mm_movemask_ps(_mm_or_ps(
-        nan,
-        _mm_and_ps(below, _mm_castsi128_ps(_mm_setr_epi32(-1, 0, -1, 0))),
-    ));
-    (atan2_4(y, x), bad == 0)
+    let nan = _mm_cmpunord_ps(x, a);
+    let bad = _mm_movemask_ps(_mm_or_ps(nan, _mm_andnot_ps(azimuth, below)));
+    let ang = atan2_sq(y2, _mm_mul_ps(x, x), _mm_cmplt_ps(x, zero), y_neg);
+    (ang, bad == 0)
 }
 
 /// The quadrilinear blend at `ang` (radians, as [`Nodes::corner`]) of f16 (`HALF`) or f32
@@ -109,27 +108,29 @@ struct Corner {
 #[target_feature(enable = "avx2,fma,f16c")]
 unsafe fn corner(nodes: &Nodes, ang: __m128) -> Corner {
     // Spans of the four axes in one register, as nodes::polar_axis (lanes 0, 2) and
-    // nodes::azimuth_axis (lanes 1, 3).
+    // nodes::azimuth_axis (lanes 1, 3): s = c + min(c, 1/2) on polar axes (2c below the first
+    // centre, c + 1/2 above), c + n - 1/2 on azimuths; clamped to [0, cap] (NaN -> 0) with
+    // cap = n (hold the last ring) or 2n (the azimuth's range).
+    let k = &nodes.lanes;
+    let c = _mm_mul_ps(ang, _mm_loadu_ps(nodes.scale.as_ptr())); // 4 f32, unaligned loads
+    let off = _mm_blend_ps::<0b1010>(
+        _mm_min_ps(c, _mm_set1_ps(0.5)),
+        _mm_loadu_ps(k.offset.as_ptr()),
+    );
+    let s = _mm_add_ps(c, off);
+    let s = _mm_min_ps(
+        _mm_max_ps(s, _mm_setzero_ps()),
+        _mm_loadu_ps(k.cap.as_ptr()),
+    );
+    // 0 <= s <= cap: no overflow. lo <= top = cap - 1, t = s - lo in [0, 1]; azimuths beyond
+    // the last column wrap (polar lanes never exceed n - 1 there).
+    let ni = _mm_loadu_si128(k.n.as_ptr() as *const __m128i);
+    let top = _mm_loadu_si128(k.top.as_ptr() as *const __m128i);
+    let l1 = _mm_min_epi32(_mm_cvttps_epi32(s), top);
+    let t = _mm_sub_ps(s, _mm_cvtepi32_ps(l1));
+    let n1 = _mm_sub_epi32(ni, _mm_set1_epi32(1));
+    let lo = _mm_sub_epi32(l1, _mm_and_si128(ni, _mm_cmpgt_epi32(l1, n1)));
     let n = nodes.n;
-    let nf = _mm_setr_ps(n[0] as f32, n[1] as f32, n[2] as f32, n[3] as f32);
-    let ni = _mm_setr_epi32(n[0] as i32, n[1] as i32, n[2] as i32, n[3] as i32);
-    let c = _mm_mul_ps(ang, _mm_loadu_ps(nodes.scale.as_ptr())); // 4 f32, unaligned
-    let half = _mm_set1_ps(0.5);
-    let zero = _mm_setzero_ps();
-    let polar = _mm_blendv_ps(_mm_add_ps(c, half), _mm_add_ps(c, c), _mm_cmplt_ps(c, half));
-    let polar = _mm_min_ps(_mm_max_ps(polar, zero), nf); // NaN -> 0
-    let azimuth = _mm_max_ps(_mm_add_ps(c, _mm_sub_ps(nf, half)), zero); // NaN -> 0
-    let s = _mm_blend_ps::<0b1010>(polar, azimuth);
-    let one = _mm_set1_epi32(1);
-    let top = _mm_sub_epi32(ni, one);
-    let li = _mm_cvttps_epi32(s); // s >= 0; huge: i32::MIN, clamped below
-    let az = _mm_setr_epi32(0, -1, 0, -1);
-    let lp = _mm_min_epi32(li, top);
-    let lt = _mm_blendv_epi8(lp, li, az);
-    let t = _mm_min_ps(_mm_sub_ps(s, _mm_cvtepi32_ps(lt)), _mm_set1_ps(1.0));
-    let wrapped = _mm_sub_epi32(li, _mm_and_si128(ni, _mm_cmpgt_epi32(li, top)));
-    let lo = _mm_blendv_epi8(lp, wrapped, az);
-    let lo = _mm_max_epi32(_mm_min_epi32(lo, top), _mm_setzero_si128());
     let [s_ti, s_pi, s_to] = nodes.strides;
     let mut l = [0i32; 4];
     _mm_storeu_si128(l.as_mut_ptr() as *mut __m128i, lo); // 4 i32, unaligned
@@ -327,15 +328,17 @@ mod tests {
             }
         }
         assert!(worst < 1e-6, "worst {worst}");
-        let ys = [0.0, -0.0, 1.0, -1.0];
-        let xs = [0.0, -1.0, 0.0, 2.0];
+        // Signed zeros and axes, as the scalar atan2 (y = -0 is not negative there).
+        let ys = [0.0f32, -0.0, 1.0, -1.0];
+        let xs = [0.0f32, -1.0, 0.0, 2.0];
         let mut got = [0f32; 4];
+        // SAFETY: as above (SSE is baseline on x86-64).
         unsafe {
-            _mm_storeu_ps(
-                got.as_mut_ptr(),
-                atan2_4(_mm_loadu_ps(ys.as_ptr()), _mm_loadu_ps(xs.as_ptr())),
-            )
-        };
+            let sq = |v: [f32; 4]| _mm_setr_ps(v[0] * v[0], v[1] * v[1], v[2] * v[2], v[3] * v[3]);
+            let neg = |v: [f32; 4]| _mm_cmplt_ps(_mm_loadu_ps(v.as_ptr()), _mm_setzero_ps());
+            let r = atan2_sq(sq(ys), sq(xs), neg(xs), neg(ys));
+            _mm_storeu_ps(got.as_mut_ptr(), r);
+        }
         for k in 0..4 {
             assert!((got[k] - atan2(ys[k], xs[k])).abs() < 1e-6, "{k} {got:?}");
         }

@@ -189,25 +189,32 @@ impl Brdf {
         );
         let nodes = pad(&g, &value, f16);
         drop(samples);
+        let kernel = if nodes.lanes.exact {
+            Kernel::best()
+        } else {
+            Kernel::Portable
+        };
         Ok(Brdf {
             meta,
             nodes,
-            kernel: Kernel::best(),
+            kernel,
             reciprocal: options.reciprocal,
             sampler,
         })
     }
 
-    /// The same table looked up by `kernel`; `None` when this processor cannot run it.
+    /// The same table looked up by `kernel`; `None` when this processor cannot run it (or,
+    /// for [`Kernel::Avx2`], an axis has more than 2^22 cells).
     pub fn with_kernel(mut self, kernel: Kernel) -> Option<Brdf> {
-        kernel.is_available().then(|| {
+        let fits = kernel == Kernel::Portable || self.nodes.lanes.exact;
+        (fits && kernel.is_available()).then(|| {
             self.kernel = kernel;
             self
         })
     }
 
     /// The kernel running the lookups ([`Kernel::best`] unless chosen by
-    /// [`Brdf::with_kernel`]).
+    /// [`Brdf::with_kernel`], or an axis has more than 2^22 cells).
     pub fn kernel(&self) -> Kernel {
         self.kernel
     }

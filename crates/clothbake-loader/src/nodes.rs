@@ -63,6 +63,26 @@ pub(crate) struct Nodes {
     pub(crate) scale: [f32; 4],
     /// Cells on the four axes.
     pub(crate) n: [u32; 4],
+    /// Per-axis constants of the vector kernels' spans.
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    pub(crate) lanes: SpanLanes,
+}
+
+/// Constants of the spans of the four axes, one lane each (theta_i, phi_i, theta_o, phi_o):
+/// the AVX2 kernel's form of [`polar_axis`] and [`azimuth_axis`].
+#[derive(Clone, Debug)]
+pub(crate) struct SpanLanes {
+    /// `n - 1/2` on the azimuth lanes (added to the angle in cells); unused on polar lanes.
+    pub(crate) offset: [f32; 4],
+    /// Largest position: `n` (polar: hold the last ring), `2 n` (azimuth).
+    pub(crate) cap: [f32; 4],
+    /// Largest low index before the wrap: `cap - 1`.
+    pub(crate) top: [i32; 4],
+    /// Cells.
+    pub(crate) n: [i32; 4],
+    /// True when every axis has at most 2^22 cells, so that these constants and every
+    /// position in cells are exact in `f32` and `i32` (a larger axis uses the portable kernel).
+    pub(crate) exact: bool,
 }
 
 /// Where one lookup falls: the first lane of its first run and the blend weights.
@@ -115,6 +135,18 @@ impl Nodes {
             extent: s_ti + s_to + 2 * LANES,
             scale: [polar(nti), azimuth(npi), polar(nto), azimuth(npo)],
             n: [nti, npi, nto, npo],
+            lanes: SpanLanes {
+                offset: [0.0, npi as f32 - 0.5, 0.0, npo as f32 - 0.5],
+                cap: [nti as f32, 2.0 * npi as f32, nto as f32, 2.0 * npo as f32],
+                top: [
+                    nti as i32 - 1,
+                    2 * npi as i32 - 1,
+                    nto as i32 - 1,
+                    2 * npo as i32 - 1,
+                ],
+                n: [nti as i32, npi as i32, nto as i32, npo as i32],
+                exact: [nti, npi, nto, npo].iter().all(|&n| n <= 1 << 22),
+            },
         }
     }
 
@@ -133,15 +165,15 @@ impl Nodes {
     /// documentation).
     #[inline(always)]
     pub(crate) fn runs<V>(&self, v: &[V], base: [usize; 2]) -> Option<[*const V; 8]> {
-        let inside = |b: usize| matches!(b.checked_add(self.extent), Some(end) if end <= v.len());
-        if !(inside(base[0]) && inside(base[1])) {
-            return None;
+        match v.len().checked_sub(self.extent) {
+            Some(last) if base[0] <= last && base[1] <= last => {}
+            _ => return None,
         }
         let [s_ti, _, s_to] = self.strides;
         let p = v.as_ptr();
         let [b0, b1] = base;
-        // SAFETY: b + s_ti + s_to + 8 <= v.len() for both bases (checked above without
-        // overflow; every offset below is at most that sum), so each pointer lies inside `v`
+        // SAFETY: b + s_ti + s_to + 8 <= v.len() for both bases (checked above, as
+        // b <= v.len() - extent, without overflow; every offset below is at most that sum), so each pointer lies inside `v`
         // with at least 8 values after it.
         unsafe {
             Some([
