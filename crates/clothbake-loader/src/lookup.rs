@@ -42,6 +42,13 @@ pub fn above_horizon(w: [f32; 3]) -> bool {
     w[2] > HORIZON_COS
 }
 
+/// True when a pair has a value: both directions above the horizon, no component NaN.
+#[inline(always)]
+fn has_value(wi: [f32; 3], wo: [f32; 3]) -> bool {
+    let nan = wi.iter().chain(&wo).any(|x| x.is_nan());
+    !nan && above_horizon(wi) && above_horizon(wo)
+}
+
 /// How values are held in memory.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Memory {
@@ -384,13 +391,14 @@ impl Brdf {
 
     #[inline(always)]
     fn eval_in<V: Lane>(&self, v: &[V], wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        let nan = wi.iter().chain(&wo).any(|x| x.is_nan());
-        if nan || !(above_horizon(wi) && above_horizon(wo)) {
+        if !has_value(wi, wo) {
             return [0.0; 3];
         }
         self.blend_reciprocal(v, nodes::angles(wi, wo))
     }
 
+    /// The portable batch, one pair after the other (grouping pairs as the AVX2 kernel does
+    /// was measured slower here: SSE2 has too few registers for 4 corners).
     fn batch_in<V: Lane>(&self, v: &[V], wi: &[[f32; 3]], wo: &[[f32; 3]], out: &mut [[f32; 3]]) {
         for ((a, b), o) in wi.iter().zip(wo).zip(out.iter_mut()) {
             *o = self.eval_in(v, *a, *b);
