@@ -64,13 +64,13 @@ pub(crate) struct Nodes {
     /// Cells on the four axes.
     pub(crate) n: [u32; 4],
     /// Per-axis constants of the vector kernels' spans.
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     pub(crate) lanes: SpanLanes,
 }
 
 /// Constants of the spans of the four axes, one lane each (theta_i, phi_i, theta_o, phi_o):
 /// the AVX2 kernel's form of [`polar_axis`] and [`azimuth_axis`].
 #[derive(Clone, Debug)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))] // read by the AVX2 kernel only
 pub(crate) struct SpanLanes {
     /// `n - 1/2` on the azimuth lanes (added to the angle in cells); unused on polar lanes.
     pub(crate) offset: [f32; 4],
