@@ -1,12 +1,15 @@
 //! Criterion benchmarks of the render-time lookup on a default-size (32 x 64 x 32 x 64) table
 //! of synthetic values: one lookup (f16 and f32 storage, vector and degree entry points), the
-//! batched lookup per item, reciprocal lookups, `sample` and `pdf`. Direction pairs cycle
-//! through a fixed set of 64 random pairs (`warm`: the 16 nodes of each stay in the caches, as
+//! batched lookup per item, reciprocal lookups, `sample` and `pdf`; the default kernel (AVX2
+//! where the processor has it) and the portable one (`*_portable`). Direction pairs cycle
+//! through a fixed set of 64 random pairs (`warm`: the nodes of each stay in the caches, as
 //! for coherent rays) or of 1 << 20 (`random`: most of the 8 cache lines a lookup touches
 //! come from memory).
 //! The side-by-side comparison with the analytic model is `cargo bench -p clothbake-tests`.
 
-use clothbake_loader::{Brdf, Grid, Memory, Metadata, Options, Precision, StoredTable, Table};
+use clothbake_loader::{
+    Brdf, Grid, Kernel, Memory, Metadata, Options, Precision, StoredTable, Table,
+};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
 
@@ -56,9 +59,18 @@ fn lookup(c: &mut Criterion) {
     let half = brdf(Memory::AsStored, false);
     let wide = brdf(Memory::F32, false);
     let recip = brdf(Memory::AsStored, true);
+    let portable = |b: &Brdf| b.clone().with_kernel(Kernel::Portable).unwrap();
+    let (half_p, wide_p) = (portable(&half), portable(&wide));
     let (wi, wo) = pairs(WARM);
     let mut g = c.benchmark_group("lookup");
-    for (name, b) in [("f16", &half), ("f32", &wide), ("f16_reciprocal", &recip)] {
+    println!("default kernel: {:?}", half.kernel());
+    for (name, b) in [
+        ("f16", &half),
+        ("f32", &wide),
+        ("f16_reciprocal", &recip),
+        ("f16_portable", &half_p),
+        ("f32_portable", &wide_p),
+    ] {
         g.bench_function(format!("eval/{name}/warm"), |bench| {
             let mut k = 0;
             bench.iter(|| {
@@ -105,6 +117,9 @@ fn lookup(c: &mut Criterion) {
     });
     g.bench_function("eval_batch/f32/warm", |bench| {
         bench.iter(|| wide.eval_batch(black_box(&wi), black_box(&wo), &mut out))
+    });
+    g.bench_function("eval_batch/f16_portable/warm", |bench| {
+        bench.iter(|| half_p.eval_batch(black_box(&wi), black_box(&wo), &mut out))
     });
     let n = 4096;
     let mut out = vec![[0f32; 3]; n];

@@ -9,7 +9,7 @@
 use std::f32::consts::{FRAC_PI_2, PI};
 
 /// Coefficients `c_j` of `atan(a) ~ a * sum_j c_j a^(2j)` on `0 <= a <= 1`.
-const ATAN_COEFFS: [f32; 6] = [
+pub(crate) const ATAN_COEFFS: [f32; 6] = [
     0.999_977_2,
     -0.332_622_83,
     0.193_540_4,

@@ -7,8 +7,11 @@
 //! them ([`Brdf::sample`]); see `docs/loader.md`.
 
 pub mod angles;
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 pub mod format;
 pub mod lookup;
+mod nodes;
 pub mod sampling;
 pub mod stored;
 
@@ -17,5 +20,5 @@ pub use format::{
     write_binary, write_exr, Grid, Metadata, Precision, Table, TableError, FORMAT_VERSION,
 };
 pub use half::f16;
-pub use lookup::{Brdf, LengthMismatch, Memory, Options, Sample, HORIZON_COS};
+pub use lookup::{Brdf, Kernel, LengthMismatch, Memory, Options, Sample, HORIZON_COS};
 pub use stored::{Samples, StoredTable};

@@ -17,16 +17,21 @@
 //!   1-D linear weights.
 //!
 //! The pole nodes are precomputed at load time: the values are stored in a padded copy with
-//! one extra polar row (the pole) on each polar axis, so every lookup is the same branch-free
-//! gather of 16 nodes.
+//! one extra polar row (the pole) on each polar axis, 4 lanes a node and a copied wrap column
+//! on the `phi_o` axis (`crate::nodes`), so every lookup is the same branch-free gather of 8
+//! runs of two adjacent nodes. The code is chosen once per [`Brdf`] ([`Kernel`]): AVX2 + FMA +
+//! F16C when the processor has them, else portable Rust.
 
 use std::fmt;
 use std::path::Path;
 
 use crate::angles::{direction, theta_phi};
+#[cfg(target_arch = "x86_64")]
+use crate::avx2;
 use crate::format::{Grid, Metadata, Precision, Table, TableError};
+use crate::nodes::{self, Lane, Nodes, Values};
 use crate::sampling::Sampler;
-use crate::stored::{f16_to_f32, Samples, StoredTable};
+use crate::stored::{Samples, StoredTable};
 
 /// Directions with `cos theta` at or below this are on or below the horizon: zero.
 pub const HORIZON_COS: f32 = 1e-9;
@@ -35,6 +40,13 @@ pub const HORIZON_COS: f32 = 1e-9;
 #[inline(always)]
 pub fn above_horizon(w: [f32; 3]) -> bool {
     w[2] > HORIZON_COS
+}
+
+/// True when a pair has a value: both directions above the horizon, no component NaN.
+#[inline(always)]
+fn has_value(wi: [f32; 3], wo: [f32; 3]) -> bool {
+    let nan = wi.iter().chain(&wo).any(|x| x.is_nan());
+    !nan && above_horizon(wi) && above_horizon(wo)
 }
 
 /// How values are held in memory.
@@ -106,95 +118,47 @@ impl fmt::Display for LengthMismatch {
 
 impl std::error::Error for LengthMismatch {}
 
-/// Values of the padded table, at their precision (`u16` holds half-float bits).
-#[derive(Clone, Debug)]
-enum Store {
-    F16(Vec<u16>),
-    F32(Vec<f32>),
+/// The code that runs the lookups, chosen once when a [`Brdf`] is built.
+///
+/// Both follow the same rules with the same operations in each lane; the AVX2 kernel fuses
+/// multiply-adds and sums in another order, so the two agree to about 1e-5 relative (tested),
+/// not bit for bit. Each is deterministic: the same lookup gives the same bits every time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    /// Plain Rust (SSE2 on x86-64; any target).
+    Portable,
+    /// x86-64 with AVX2, FMA and F16C, detected at run time.
+    Avx2,
 }
 
-/// A value type the gather can widen to f32.
-trait Value: Copy {
-    fn widen(self) -> f32;
-}
+impl Kernel {
+    /// True when this processor can run the kernel.
+    pub fn is_available(self) -> bool {
+        match self {
+            Kernel::Portable => true,
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx2 => crate::avx2::available(),
+            #[cfg(not(target_arch = "x86_64"))]
+            Kernel::Avx2 => false,
+        }
+    }
 
-impl Value for u16 {
-    #[inline(always)]
-    fn widen(self) -> f32 {
-        f16_to_f32(self)
+    /// The fastest kernel this processor runs (the default of every [`Brdf`]).
+    pub fn best() -> Kernel {
+        if Kernel::Avx2.is_available() {
+            Kernel::Avx2
+        } else {
+            Kernel::Portable
+        }
     }
-}
-
-impl Value for f32 {
-    #[inline(always)]
-    fn widen(self) -> f32 {
-        self
-    }
-}
-
-/// Where one axis of a lookup falls: two node indices and the weight of the second.
-#[derive(Clone, Copy, Debug)]
-struct Span {
-    lo: usize,
-    hi: usize,
-    t: f32,
-}
-
-/// A polar axis of `n` cells, at `theta` radians: padded rows `lo` and `lo + 1` (row 0 is the
-/// pole, row `k + 1` the centre of cell `k`); see the module documentation.
-#[inline(always)]
-fn polar_span(theta: f32, n: u32, cells_per_rad: f32) -> Span {
-    let c = theta * cells_per_rad; // cell k's centre at k + 0.5
-    let s = if c < 0.5 { 2.0 * c } else { c + 0.5 };
-    let s = s.max(0.0).min(n as f32); // NaN -> 0; beyond the last centre: hold it
-    let lo = (s as u32).min(n - 1);
-    Span {
-        lo: lo as usize,
-        hi: lo as usize + 1,
-        t: s - lo as f32,
-    }
-}
-
-/// An azimuth axis of `n` cells, at `phi` radians in `[-2 pi, 4 pi)` (the vector path gives
-/// `[-pi, pi]`; [`Brdf::eval_deg`] wraps first): the two cells whose centres bracket `phi`,
-/// wrapping from cell `n - 1` to cell 0. No integer division: two conditional wraps.
-#[inline(always)]
-fn azimuth_span(phi: f32, n: u32, cells_per_rad: f32) -> Span {
-    let c = phi * cells_per_rad - 0.5;
-    // floor(c) without the `floorf` library call of baseline x86-64; NaN -> 0.
-    let mut lo = c as i32;
-    if (lo as f32) > c {
-        lo -= 1;
-    }
-    let t = c - lo as f32;
-    let t = if t >= 0.0 { t.min(1.0) } else { 0.0 }; // NaN -> 0
-    let n = n as i32;
-    if lo < 0 {
-        lo += n;
-    }
-    if lo < 0 {
-        lo += n;
-    }
-    if lo >= n {
-        lo -= n;
-    }
-    if lo >= n {
-        lo -= n;
-    }
-    let lo = lo.clamp(0, n - 1) as usize;
-    let hi = if lo + 1 == n as usize { 0 } else { lo + 1 };
-    Span { lo, hi, t }
 }
 
 /// A baked table ready for render-time lookups and importance sampling.
 #[derive(Clone, Debug)]
 pub struct Brdf {
     meta: Metadata,
-    store: Store,
-    /// Padded strides (in values) of theta_i, phi_i, theta_o rows; phi_o's is 3.
-    strides: [usize; 3],
-    /// Cells per radian of the polar (`90` degrees) and azimuth (`360` degrees) axes: i, o.
-    scale: [f32; 4],
+    nodes: Nodes,
+    kernel: Kernel,
     reciprocal: bool,
     sampler: Option<Sampler>,
 }
@@ -226,36 +190,40 @@ impl Brdf {
             [samples.get(c), samples.get(c + 1), samples.get(c + 2)]
         };
         let sampler = options.sampling.then(|| Sampler::new(&g, &value));
-        let padded = pad(&g, &value);
-        let store = match (&samples, options.memory) {
-            (Samples::F16(_), Memory::AsStored) => Store::F16(
-                padded
-                    .iter()
-                    .map(|&v| half::f16::from_f32(v).to_bits())
-                    .collect(),
-            ),
-            _ => Store::F32(padded),
-        };
+        let f16 = matches!(
+            (&samples, options.memory),
+            (Samples::F16(_), Memory::AsStored)
+        );
+        let nodes = pad(&g, &value, f16);
         drop(samples);
-        let (npi, nto, npo) = (g.n_phi_i as usize, g.n_theta_o as usize, g.n_phi_o as usize);
-        let s_to = 3 * npo;
-        let s_pi = s_to * (nto + 1);
-        let s_ti = s_pi * npi;
-        let polar = |n: u32| n as f32 / std::f32::consts::FRAC_PI_2;
-        let azimuth = |n: u32| n as f32 / std::f32::consts::TAU;
+        let kernel = if nodes.lanes.exact {
+            Kernel::best()
+        } else {
+            Kernel::Portable
+        };
         Ok(Brdf {
             meta,
-            store,
-            strides: [s_ti, s_pi, s_to],
-            scale: [
-                polar(g.n_theta_i),
-                azimuth(g.n_phi_i),
-                polar(g.n_theta_o),
-                azimuth(g.n_phi_o),
-            ],
+            nodes,
+            kernel,
             reciprocal: options.reciprocal,
             sampler,
         })
+    }
+
+    /// The same table looked up by `kernel`; `None` when this processor cannot run it (or,
+    /// for [`Kernel::Avx2`], an axis has more than 2^22 cells).
+    pub fn with_kernel(mut self, kernel: Kernel) -> Option<Brdf> {
+        let fits = kernel == Kernel::Portable || self.nodes.lanes.exact;
+        (fits && kernel.is_available()).then(|| {
+            self.kernel = kernel;
+            self
+        })
+    }
+
+    /// The kernel running the lookups ([`Kernel::best`] unless chosen by
+    /// [`Brdf::with_kernel`], or an axis has more than 2^22 cells).
+    pub fn kernel(&self) -> Kernel {
+        self.kernel
     }
 
     /// The table's metadata.
@@ -270,18 +238,19 @@ impl Brdf {
 
     /// The precision the values are held in.
     pub fn precision(&self) -> Precision {
-        match self.store {
-            Store::F16(_) => Precision::F16,
-            Store::F32(_) => Precision::F32,
+        match self.nodes.values {
+            Values::F16(_) => Precision::F16,
+            Values::F32(_) => Precision::F32,
         }
     }
 
     /// Bytes held by the values and the sampling CDFs.
     pub fn memory_bytes(&self) -> usize {
-        let values = match &self.store {
-            Store::F16(v) => 2 * v.len(),
-            Store::F32(v) => 4 * v.len(),
+        let lane = match self.nodes.values {
+            Values::F16(_) => 2,
+            Values::F32(_) => 4,
         };
+        let values = lane * self.nodes.len();
         values + self.sampler.as_ref().map_or(0, Sampler::memory_bytes)
     }
 
@@ -294,31 +263,51 @@ impl Brdf {
     /// the horizon (`z <= 1e-9`) or not a number. Symmetrised with [`Options::reciprocal`].
     #[inline]
     pub fn eval(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        match &self.store {
-            Store::F16(v) => self.eval_in(v, wi, wo),
-            Store::F32(v) => self.eval_in(v, wi, wo),
+        let (n, r) = (&self.nodes, self.reciprocal);
+        match (&n.values, self.kernel) {
+            // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C
+            // (`with_kernel`, `Kernel::best`); the values' type matches HALF.
+            #[cfg(target_arch = "x86_64")]
+            (Values::F16(v), Kernel::Avx2) => unsafe { avx2::eval::<true, u16>(n, v, r, wi, wo) },
+            #[cfg(target_arch = "x86_64")]
+            (Values::F32(v), Kernel::Avx2) => unsafe { avx2::eval::<false, f32>(n, v, r, wi, wo) },
+            (Values::F16(v), _) => self.eval_in(v, wi, wo),
+            (Values::F32(v), _) => self.eval_in(v, wi, wo),
         }
     }
 
     /// `f_r` at polar angles and azimuths in degrees (theta from +Z, phi from +X toward +Y),
     /// as the tables use; 0 unless `0 <= theta < 90` for both directions.
     pub fn eval_deg(&self, theta_i: f32, phi_i: f32, theta_o: f32, phi_o: f32) -> [f32; 3] {
-        let ok = |t: f32| (0.0..90.0).contains(&t) && t.to_radians().cos() > HORIZON_COS;
+        // Every f32 below 90 has cos(theta) > HORIZON_COS (tested), so no cosine is needed.
+        let ok = |t: f32| (0.0..90.0).contains(&t);
         if !(ok(theta_i) && ok(theta_o)) {
             return [0.0; 3];
         }
         let r = f32::to_radians;
         let wrap = |phi: f32| {
-            if phi.is_finite() {
+            if (0.0..360.0).contains(&phi) {
+                phi
+            } else if phi.is_finite() {
                 phi.rem_euclid(360.0)
             } else {
                 0.0
             }
         };
-        let (ti, pi, to, po) = (r(theta_i), r(wrap(phi_i)), r(theta_o), r(wrap(phi_o)));
-        match &self.store {
-            Store::F16(v) => self.blend_reciprocal(v, ti, pi, to, po),
-            Store::F32(v) => self.blend_reciprocal(v, ti, pi, to, po),
+        let ang = [r(theta_i), r(wrap(phi_i)), r(theta_o), r(wrap(phi_o))];
+        let (n, rc) = (&self.nodes, self.reciprocal);
+        match (&n.values, self.kernel) {
+            // SAFETY: as in `eval`.
+            #[cfg(target_arch = "x86_64")]
+            (Values::F16(v), Kernel::Avx2) => unsafe {
+                avx2::at_angles_of::<true, u16>(n, v, rc, ang)
+            },
+            #[cfg(target_arch = "x86_64")]
+            (Values::F32(v), Kernel::Avx2) => unsafe {
+                avx2::at_angles_of::<false, f32>(n, v, rc, ang)
+            },
+            (Values::F16(v), _) => self.blend_reciprocal(v, ang),
+            (Values::F32(v), _) => self.blend_reciprocal(v, ang),
         }
     }
 
@@ -337,9 +326,19 @@ impl Brdf {
                 out: out.len(),
             });
         }
-        match &self.store {
-            Store::F16(v) => self.batch_in(v, wi, wo, out),
-            Store::F32(v) => self.batch_in(v, wi, wo, out),
+        let (n, r) = (&self.nodes, self.reciprocal);
+        match (&n.values, self.kernel) {
+            // SAFETY: as in `eval`.
+            #[cfg(target_arch = "x86_64")]
+            (Values::F16(v), Kernel::Avx2) => unsafe {
+                avx2::batch::<true, u16>(n, v, r, wi, wo, out)
+            },
+            #[cfg(target_arch = "x86_64")]
+            (Values::F32(v), Kernel::Avx2) => unsafe {
+                avx2::batch::<false, f32>(n, v, r, wi, wo, out)
+            },
+            (Values::F16(v), _) => self.batch_in(v, wi, wo, out),
+            (Values::F32(v), _) => self.batch_in(v, wi, wo, out),
         }
         Ok(())
     }
@@ -391,78 +390,39 @@ impl Brdf {
     }
 
     #[inline(always)]
-    fn eval_in<V: Value>(&self, v: &[V], wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        if !(above_horizon(wi) && above_horizon(wo)) {
+    fn eval_in<V: Lane>(&self, v: &[V], wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        if !has_value(wi, wo) {
             return [0.0; 3];
         }
-        let (ti, pi) = theta_phi(wi);
-        let (to, po) = theta_phi(wo);
-        self.blend_reciprocal(v, ti, pi, to, po)
+        self.blend_reciprocal(v, nodes::angles(wi, wo))
     }
 
-    fn batch_in<V: Value>(&self, v: &[V], wi: &[[f32; 3]], wo: &[[f32; 3]], out: &mut [[f32; 3]]) {
+    /// The portable batch, one pair after the other (grouping pairs as the AVX2 kernel does
+    /// was measured slower here: SSE2 has too few registers for 4 corners).
+    fn batch_in<V: Lane>(&self, v: &[V], wi: &[[f32; 3]], wo: &[[f32; 3]], out: &mut [[f32; 3]]) {
         for ((a, b), o) in wi.iter().zip(wo).zip(out.iter_mut()) {
             *o = self.eval_in(v, *a, *b);
         }
     }
 
     #[inline(always)]
-    fn blend_reciprocal<V: Value>(&self, v: &[V], ti: f32, pi: f32, to: f32, po: f32) -> [f32; 3] {
-        let f = self.blend(v, ti, pi, to, po);
+    fn blend_reciprocal<V: Lane>(&self, v: &[V], ang: [f32; 4]) -> [f32; 3] {
+        let f = self.nodes.blend(v, ang);
         if !self.reciprocal {
             return f;
         }
-        let r = self.blend(v, to, po, ti, pi);
+        let r = self.nodes.blend(v, [ang[2], ang[3], ang[0], ang[1]]);
         [
             0.5 * (f[0] + r[0]),
             0.5 * (f[1] + r[1]),
             0.5 * (f[2] + r[2]),
         ]
     }
-
-    /// The quadrilinear blend of the 16 nodes around (theta_i, phi_i, theta_o, phi_o), radians.
-    #[inline(always)]
-    fn blend<V: Value>(&self, v: &[V], ti: f32, pi: f32, to: f32, po: f32) -> [f32; 3] {
-        let g = &self.meta.grid;
-        let [s_ti, s_pi, s_to] = self.strides;
-        let a = polar_span(ti, g.n_theta_i, self.scale[0]);
-        let b = azimuth_span(pi, g.n_phi_i, self.scale[1]);
-        let c = polar_span(to, g.n_theta_o, self.scale[2]);
-        let d = azimuth_span(po, g.n_phi_o, self.scale[3]);
-        let incident = [
-            (a.lo * s_ti + b.lo * s_pi, (1.0 - a.t) * (1.0 - b.t)),
-            (a.lo * s_ti + b.hi * s_pi, (1.0 - a.t) * b.t),
-            (a.hi * s_ti + b.lo * s_pi, a.t * (1.0 - b.t)),
-            (a.hi * s_ti + b.hi * s_pi, a.t * b.t),
-        ];
-        let outgoing = [
-            (c.lo * s_to + 3 * d.lo, (1.0 - c.t) * (1.0 - d.t)),
-            (c.lo * s_to + 3 * d.hi, (1.0 - c.t) * d.t),
-            (c.hi * s_to + 3 * d.lo, c.t * (1.0 - d.t)),
-            (c.hi * s_to + 3 * d.hi, c.t * d.t),
-        ];
-        let mut acc = [0f32; 3];
-        for (oi, wi) in incident {
-            let mut inner = [0f32; 3];
-            for (oo, wo) in outgoing {
-                let k = oi + oo;
-                let node = &v[k..k + 3];
-                inner[0] += node[0].widen() * wo;
-                inner[1] += node[1].widen() * wo;
-                inner[2] += node[2].widen() * wo;
-            }
-            acc[0] += inner[0] * wi;
-            acc[1] += inner[1] * wi;
-            acc[2] += inner[2] * wi;
-        }
-        acc
-    }
 }
 
-/// The padded values: rows `0..=n_theta_i` x `n_phi_i` x rows `0..=n_theta_o` x `n_phi_o`, RGB,
-/// where polar row 0 is the pole node (the mean over the azimuths of the first ring) and row
-/// `k + 1` is cell `k`.
-fn pad(g: &Grid, value: &dyn Fn(u32, u32, u32, u32) -> [f32; 3]) -> Vec<f32> {
+/// The padded node table ([`Nodes`]), where polar row 0 is the pole node (the mean over the
+/// azimuths of the first ring) and row `k + 1` is cell `k`; half floats when `f16`.
+fn pad(g: &Grid, value: &dyn Fn(u32, u32, u32, u32) -> [f32; 3], f16: bool) -> Nodes {
     let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
     // Mean of `value` over the listed azimuth pairs, in f64, in a fixed order.
     let mean = |pairs: &mut dyn Iterator<Item = [f32; 3]>| -> [f32; 3] {
@@ -484,21 +444,27 @@ fn pad(g: &Grid, value: &dyn Fn(u32, u32, u32, u32) -> [f32; 3]) -> Vec<f32> {
         .map(|(ti, pi)| mean(&mut (0..npo).map(|po| value(ti, pi, 0, po))))
         .collect();
     let pole_io = mean(&mut (0..npi).flat_map(|pi| (0..npo).map(move |po| value(0, pi, 0, po))));
-    let mut out = Vec::with_capacity(3 * ((nti + 1) * npi * (nto + 1) * npo) as usize);
-    for ri in 0..=nti {
-        for pi in 0..npi {
-            for ro in 0..=nto {
-                for po in 0..npo {
-                    let node = match (ri, ro) {
-                        (0, 0) => pole_io,
-                        (0, _) => pole_i[((ro - 1) * npo + po) as usize],
-                        (_, 0) => pole_o[((ri - 1) * npi + pi) as usize],
-                        _ => value(ri - 1, pi, ro - 1, po),
-                    };
-                    out.extend_from_slice(&node);
-                }
-            }
+    let node = |ri: u32, pi: u32, ro: u32, po: u32| match (ri, ro) {
+        (0, 0) => pole_io,
+        (0, _) => pole_i[((ro - 1) * npo + po) as usize],
+        (_, 0) => pole_o[((ri - 1) * npi + pi) as usize],
+        _ => value(ri - 1, pi, ro - 1, po),
+    };
+    Nodes::new(g, &node, f16)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::HORIZON_COS;
+
+    #[test]
+    fn every_f32_polar_angle_below_90_degrees_is_above_the_horizon() {
+        // The 100 000 largest f32 below 90; below those cos exceeds 0.008.
+        let mut t = 90f32;
+        for _ in 0..100_000 {
+            t = f32::from_bits(t.to_bits() - 1);
+            assert!(t.to_radians().cos() > HORIZON_COS, "{t}");
         }
+        assert!(t < 89.5); // below, cos > 0.008
     }
-    out
 }

@@ -1,0 +1,279 @@
+//! The lookup's node table: the grid padded for branch-free gathers, and the portable blend.
+//!
+//! Layout (in lanes, `V` = `u16` half-float bits or `f32`): polar rows `0..=n_theta_i` (row 0
+//! the pole node, row `k + 1` cell `k`) x `n_phi_i` azimuth columns x polar rows
+//! `0..=n_theta_o` x `n_phi_o + 1` azimuth columns (the last a copy of column 0) x 4 lanes
+//! (R, G, B, 0). A node is one 16-byte (f32) or 8-byte (f16) vector; the two `phi_o`
+//! neighbours of any lookup are adjacent, even across the wrap, so a lookup reads 8 *runs* of
+//! 8 lanes (2 nodes) instead of 16 scattered nodes. The `phi_i` axis has no copied column
+//! (it would cost another `1 / n_phi_i` of memory): its high neighbour is
+//! [`next_column`], wrapping to 0.
+//!
+//! Index safety: every axis gives a low index `lo <= n - 1` (clamped, NaN included). The
+//! polar axes use rows `lo` and `lo + 1 <= n` (rows `0..=n` exist), `phi_o` columns `lo`
+//! and `lo + 1 <= n` (the copied column `n` exists), `phi_i` columns `lo` and
+//! `next_column(lo) <= n - 1`. For each `phi_i` column `b` the lowest run starts at
+//! `base_b = lo_a s_ti + b s_pi + lo_c s_to + 4 lo_d` and the highest ends at
+//! `base_b + s_ti + s_to + 8`, at most `len`. [`Nodes::runs`] checks exactly those two ends
+//! once per lookup and then reads the 8 runs without further checks.
+
+use crate::angles::atan2;
+use crate::format::Grid;
+use crate::stored::f16_to_f32;
+
+/// Lanes per node: R, G, B and a zero pad.
+pub(crate) const LANES: usize = 4;
+
+/// Values of the padded table at their precision (`u16` holds half-float bits).
+#[derive(Clone, Debug)]
+pub(crate) enum Values {
+    F16(Vec<u16>),
+    F32(Vec<f32>),
+}
+
+/// A value type the portable gather widens to f32.
+pub(crate) trait Lane: Copy {
+    fn widen(self) -> f32;
+}
+
+impl Lane for u16 {
+    #[inline(always)]
+    fn widen(self) -> f32 {
+        f16_to_f32(self)
+    }
+}
+
+impl Lane for f32 {
+    #[inline(always)]
+    fn widen(self) -> f32 {
+        self
+    }
+}
+
+/// The padded table and the constants of its lookups.
+#[derive(Clone, Debug)]
+pub(crate) struct Nodes {
+    pub(crate) values: Values,
+    /// Strides (in lanes) of theta_i rows, phi_i columns and theta_o rows; phi_o's is 4.
+    pub(crate) strides: [usize; 3],
+    /// `s_ti + s_to + 8`: lanes from the start of a lookup's first run at one `phi_i` column
+    /// to the end of its last.
+    extent: usize,
+    /// Cells per radian of the four axes (theta_i, phi_i, theta_o, phi_o).
+    pub(crate) scale: [f32; 4],
+    /// Cells on the four axes.
+    pub(crate) n: [u32; 4],
+    /// Per-axis constants of the vector kernels' spans.
+    pub(crate) lanes: SpanLanes,
+}
+
+/// Constants of the spans of the four axes, one lane each (theta_i, phi_i, theta_o, phi_o):
+/// the AVX2 kernel's form of [`polar_axis`] and [`azimuth_axis`].
+#[derive(Clone, Debug)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))] // read by the AVX2 kernel only
+pub(crate) struct SpanLanes {
+    /// `n - 1/2` on the azimuth lanes (added to the angle in cells); unused on polar lanes.
+    pub(crate) offset: [f32; 4],
+    /// Largest position: `n` (polar: hold the last ring), `2 n` (azimuth).
+    pub(crate) cap: [f32; 4],
+    /// Largest low index before the wrap: `cap - 1`.
+    pub(crate) top: [i32; 4],
+    /// Cells.
+    pub(crate) n: [i32; 4],
+    /// True when every axis has at most 2^22 cells, so that these constants and every
+    /// position in cells are exact in `f32` and `i32` (a larger axis uses the portable kernel).
+    pub(crate) exact: bool,
+}
+
+/// Where one lookup falls: the first lane of its first run and the blend weights.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Corner {
+    /// First lanes of runs 0 and 2 (the low and high `phi_i` columns).
+    pub(crate) base: [usize; 2],
+    /// Weight of run `r = 4 ia + 2 ib + ic` (offset `ia s_ti + ib s_pi + ic s_to`): the
+    /// product of the theta_i, phi_i and theta_o weights.
+    pub(crate) w: [f32; 8],
+    /// Weight of the second phi_o node of each run.
+    pub(crate) t_po: f32,
+}
+
+impl Nodes {
+    /// The padded table of `g` from `node(polar row i, phi_i, polar row o, phi_o)` (rows as in
+    /// the module documentation), widened or narrowed by `f16`.
+    pub(crate) fn new(g: &Grid, node: &dyn Fn(u32, u32, u32, u32) -> [f32; 3], f16: bool) -> Nodes {
+        let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
+        let s_to = LANES * (npo as usize + 1);
+        let s_pi = s_to * (nto as usize + 1);
+        let s_ti = s_pi * npi as usize;
+        let len = s_ti * (nti as usize + 1);
+        let mut out = Vec::with_capacity(len);
+        for ri in 0..=nti {
+            for pi in 0..npi {
+                for ro in 0..=nto {
+                    for po in 0..=npo {
+                        let [r, g, b] = node(ri, pi, ro, po % npo);
+                        out.extend_from_slice(&[r, g, b, 0.0]);
+                    }
+                }
+            }
+        }
+        debug_assert_eq!(out.len(), len);
+        let values = if f16 {
+            Values::F16(
+                out.iter()
+                    .map(|&v| half::f16::from_f32(v).to_bits())
+                    .collect(),
+            )
+        } else {
+            Values::F32(out)
+        };
+        let polar = |n: u32| n as f32 / std::f32::consts::FRAC_PI_2;
+        let azimuth = |n: u32| n as f32 / std::f32::consts::TAU;
+        Nodes {
+            values,
+            strides: [s_ti, s_pi, s_to],
+            extent: s_ti + s_to + 2 * LANES,
+            scale: [polar(nti), azimuth(npi), polar(nto), azimuth(npo)],
+            n: [nti, npi, nto, npo],
+            lanes: SpanLanes {
+                offset: [0.0, npi as f32 - 0.5, 0.0, npo as f32 - 0.5],
+                cap: [nti as f32, 2.0 * npi as f32, nto as f32, 2.0 * npo as f32],
+                top: [
+                    nti as i32 - 1,
+                    2 * npi as i32 - 1,
+                    nto as i32 - 1,
+                    2 * npo as i32 - 1,
+                ],
+                n: [nti as i32, npi as i32, nto as i32, npo as i32],
+                exact: [nti, npi, nto, npo].iter().all(|&n| n <= 1 << 22),
+            },
+        }
+    }
+
+    /// Number of lanes held.
+    pub(crate) fn len(&self) -> usize {
+        match &self.values {
+            Values::F16(v) => v.len(),
+            Values::F32(v) => v.len(),
+        }
+    }
+
+    /// The first lanes of the 8 runs of a lookup whose runs at the low and high `phi_i`
+    /// columns start at lanes `base[0]` and `base[1]`: run `r = 4 ia + 2 ib + ic` at
+    /// `base[ib] + ia s_ti + ic s_to`, each valid for 8 reads of `v`; `None` when they would
+    /// not all lie inside `v` (never for a [`Corner`] of this table: see the module
+    /// documentation).
+    #[inline(always)]
+    pub(crate) fn runs<V>(&self, v: &[V], base: [usize; 2]) -> Option<[*const V; 8]> {
+        match v.len().checked_sub(self.extent) {
+            Some(last) if base[0] <= last && base[1] <= last => {}
+            _ => return None,
+        }
+        let [s_ti, _, s_to] = self.strides;
+        let p = v.as_ptr();
+        let [b0, b1] = base;
+        // SAFETY: b + s_ti + s_to + 8 <= v.len() for both bases (checked above, as
+        // b <= v.len() - extent, without overflow; every offset below is at most that sum), so each pointer lies inside `v`
+        // with at least 8 values after it.
+        unsafe {
+            Some([
+                p.add(b0),
+                p.add(b0 + s_to),
+                p.add(b1),
+                p.add(b1 + s_to),
+                p.add(b0 + s_ti),
+                p.add(b0 + s_ti + s_to),
+                p.add(b1 + s_ti),
+                p.add(b1 + s_ti + s_to),
+            ])
+        }
+    }
+
+    /// The corner of a lookup at angles `[theta_i, phi_i, theta_o, phi_o]`, radians (phi in
+    /// `[-pi, 2 pi)`), with the rules of the lookup module: see [`polar_axis`] and
+    /// [`azimuth_axis`].
+    #[inline(always)]
+    pub(crate) fn corner(&self, ang: [f32; 4]) -> Corner {
+        let (lo_a, ta) = polar_axis(ang[0] * self.scale[0], self.n[0]);
+        let (lo_b, tb) = azimuth_axis(ang[1] * self.scale[1], self.n[1]);
+        let (lo_c, tc) = polar_axis(ang[2] * self.scale[2], self.n[2]);
+        let (lo_d, td) = azimuth_axis(ang[3] * self.scale[3], self.n[3]);
+        let [s_ti, s_pi, s_to] = self.strides;
+        let common = lo_a as usize * s_ti + lo_c as usize * s_to + LANES * lo_d as usize;
+        let base = [
+            common + lo_b as usize * s_pi,
+            common + next_column(lo_b, self.n[1]) as usize * s_pi,
+        ];
+        let (wa, wb, wc) = ([1.0 - ta, ta], [1.0 - tb, tb], [1.0 - tc, tc]);
+        let w = std::array::from_fn(|r| wa[r >> 2] * wb[(r >> 1) & 1] * wc[r & 1]);
+        Corner { base, w, t_po: td }
+    }
+
+    /// The portable quadrilinear blend at `ang` (see [`Nodes::corner`]) of the values `v`.
+    #[inline(always)]
+    pub(crate) fn blend<V: Lane>(&self, v: &[V], ang: [f32; 4]) -> [f32; 3] {
+        let k = self.corner(ang);
+        let Some(runs) = self.runs(v, k.base) else {
+            return [0.0; 3];
+        };
+        let mut acc = [0f32; 8];
+        for (&p, w) in runs.iter().zip(k.w) {
+            // SAFETY: `runs` gives pointers valid for 8 reads.
+            let run = unsafe { &*(p as *const [V; 8]) };
+            for (a, x) in acc.iter_mut().zip(run) {
+                *a += x.widen() * w;
+            }
+        }
+        let (u, t) = (1.0 - k.t_po, k.t_po);
+        [
+            acc[0] * u + acc[4] * t,
+            acc[1] * u + acc[5] * t,
+            acc[2] * u + acc[6] * t,
+        ]
+    }
+}
+
+/// The polar axis at `c` = angle in cells (cell `k`'s centre at `k + 0.5`) of `n` cells: the
+/// padded row `lo <= n - 1` and the weight of row `lo + 1`. Below the first centre the blend
+/// is with the pole row 0; beyond the last centre the last row is held; NaN gives row 0.
+#[inline(always)]
+pub(crate) fn polar_axis(c: f32, n: u32) -> (u32, f32) {
+    let s = if c < 0.5 { 2.0 * c } else { c + 0.5 };
+    let s = s.max(0.0).min(n as f32); // NaN -> 0
+    let lo = (s as u32).min(n - 1);
+    (lo, s - lo as f32)
+}
+
+/// The azimuth axis at `c` = angle in cells of `n` cells, `c` in `[-n/2, n)`: the column
+/// `lo <= n - 1` and the weight of column `lo + 1` (column `n` repeats column 0: between the
+/// last centre and the first, cells `n - 1` and 0 are blended). No division: shifted by `n`
+/// to be positive, truncated, one conditional wrap; NaN gives column 0 and anything outside
+/// the range some column of the table.
+#[inline(always)]
+pub(crate) fn azimuth_axis(c: f32, n: u32) -> (u32, f32) {
+    let s = (c + (n as f32 - 0.5)).max(0.0); // NaN -> 0
+    let lo = s as u32; // s >= 0: truncation is floor; saturates
+    let t = (s - lo as f32).min(1.0);
+    let lo = if lo >= n { lo - n } else { lo };
+    (lo.min(n - 1), t)
+}
+
+/// The `phi_i` column after `lo` of `n`, periodic.
+#[inline(always)]
+pub(crate) fn next_column(lo: u32, n: u32) -> u32 {
+    if lo + 1 >= n {
+        0
+    } else {
+        lo + 1
+    }
+}
+
+/// Polar angles and azimuths `[theta_i, phi_i, theta_o, phi_o]` (radians) of two directions,
+/// portable (the fast [`atan2`] four times).
+#[inline(always)]
+pub(crate) fn angles(wi: [f32; 3], wo: [f32; 3]) -> [f32; 4] {
+    let rho = |w: [f32; 3]| (w[0] * w[0] + w[1] * w[1]).sqrt();
+    let y = [rho(wi), wi[1], rho(wo), wo[1]];
+    let x = [wi[2], wi[0], wo[2], wo[0]];
+    std::array::from_fn(|k| atan2(y[k], x[k]))
+}
