@@ -178,17 +178,21 @@ mod tests {
 
     #[test]
     fn huo_half_vector_from_cosines_matches_the_explicit_half_vector() {
-        // N.H computed from the normalised vector L + E, independently of intensity_cos.
-        let m = Material {
-            albedo: [0.5; 3],
-            specular: 0.7,
-            exponent: 9.0,
-        };
-        for (n, l, e) in [
-            ((10.0, 30.0), (40.0, 200.0), (35.0, 10.0)),
-            ((0.0, 0.0), (60.0, 0.0), (60.0, 180.0)),
-            ((25.0, 90.0), (5.0, 45.0), (80.0, 300.0)),
-        ] {
+        // N.H computed from the normalised vector L + E, independently of intensity_cos; an odd
+        // exponent (square root of (N.H)^2), an even one (none) and a real one (powf).
+        for (exponent, (n, l, e)) in [9.0, 10.0, 7.5].into_iter().flat_map(|x| {
+            [
+                ((10.0, 30.0), (40.0, 200.0), (35.0, 10.0)),
+                ((0.0, 0.0), (60.0, 0.0), (60.0, 180.0)),
+                ((25.0, 90.0), (5.0, 45.0), (80.0, 300.0)),
+            ]
+            .map(|d| (x, d))
+        }) {
+            let m = Material {
+                albedo: [0.5; 3],
+                specular: 0.7,
+                exponent,
+            };
             let n = UnitVec3::from_degrees(n.0, n.1).get();
             let l = UnitVec3::from_degrees(l.0, l.1).get();
             let e = UnitVec3::from_degrees(e.0, e.1).get();
@@ -196,7 +200,7 @@ mod tests {
             let nh = (n.dot(h) / h.length()).max(0.0);
             let i = FacetModel::Huo.intensity(&m, n, l, e);
             if n.dot(l) > 0.0 && n.dot(e) > 0.0 {
-                assert!((i.specular - 0.7 * nh.powi(9)).abs() < 1e-12);
+                assert!((i.specular - 0.7 * nh.powf(exponent)).abs() < 1e-12);
                 assert!((i.diffuse - n.dot(l)).abs() < 1e-15);
             } else {
                 assert_eq!(i, FacetIntensity::default());
