@@ -5,6 +5,7 @@
 //! scales with the diffuse albedo (returned without the albedo) and a specular part (white).
 
 use crate::fabric::Material;
+use crate::lanes::Real;
 use crate::vec3::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -98,15 +99,15 @@ impl Power {
     }
 
     #[inline(always)]
-    fn of(self, x: f64) -> f64 {
+    fn of<T: Real>(self, x: T) -> T {
         match self {
             Power::Int(n) => {
-                let (mut acc, mut base, mut k) = (1.0, x, n);
+                let (mut acc, mut base, mut k) = (T::splat(1.0), x, n);
                 while k > 0 {
                     if k & 1 == 1 {
-                        acc *= base;
+                        acc = acc * base;
                     }
-                    base *= base;
+                    base = base * base;
                     k >>= 1;
                 }
                 acc
@@ -136,25 +137,29 @@ impl CosineFacet {
     }
 
     /// Specular intensity for unit light, from N.L > 0 and N.E > 0 (the caller checks them: the
-    /// term is zero otherwise) and L.E.
+    /// term is zero otherwise) and L.E; for one value (`f64`) or two lanes
+    /// ([`crate::lanes::F64x2`]) alike.
     #[inline(always)]
-    pub fn specular(&self, nl: f64, ne: f64, le: f64) -> f64 {
+    pub fn specular<T: Real>(&self, nl: T, ne: T, le: T) -> T {
+        let scale = T::splat(self.scale);
         match self.model {
             FacetModel::Huo => {
                 // (N.H)^2 = (N.L + N.E)^2 / (2 + 2 L.E): an even integer exponent needs no
-                // square root.
-                let hh = 2.0 + 2.0 * le;
-                if hh <= 0.0 {
-                    return 0.0;
-                }
+                // square root. |L + E| = 0 (L = -E) gives 0.
+                let two = T::splat(2.0);
+                let hh = two + two * le;
                 let s = nl + ne;
-                let nh2 = (s * s / hh).min(1.0);
-                match self.power {
-                    Power::Int(n) if n % 2 == 0 => self.scale * Power::Int(n / 2).of(nh2),
-                    p => self.scale * p.of(nh2.sqrt()),
-                }
+                let nh2 = (s * s / hh.max(T::splat(f64::MIN_POSITIVE))).min(T::splat(1.0));
+                let v = match self.power {
+                    Power::Int(n) if n % 2 == 0 => scale * Power::Int(n / 2).of(nh2),
+                    p => scale * p.of(nh2.sqrt()),
+                };
+                v.where_positive(hh)
             }
-            FacetModel::Lewis => self.scale * self.power.of((2.0 * nl * ne - le).max(0.0)) * nl,
+            FacetModel::Lewis => {
+                let re = (T::splat(2.0) * nl * ne - le).max(T::splat(0.0));
+                scale * self.power.of(re) * nl
+            }
         }
     }
 }

@@ -35,6 +35,7 @@
 use crate::arc::Arc;
 use crate::fabric::Material;
 use crate::facet::{CosineFacet, Facet, FacetModel};
+use crate::lanes::{F64x2, Real};
 use crate::trig::sin_cos;
 use crate::vec3::Vec3;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -647,23 +648,58 @@ fn line_integral(
     let (mut ss, mut sd, mut ds) = (0.0, 0.0, 0.0);
     let (f1, f2) = facets;
     if !(f1.is_zero() && f2.is_zero()) {
-        for &(su, cu, wt) in nodes {
-            let nli = cu * ln.a; // N_i . w (> 0)
-            let nej = cu * ln.c; // N_j . (-w) (> 0)
-            let we = cu * ln.pe + su * ey; // w . E
-            let wl = cu * ln.pl + su * ly; // w . L
-                                           // At P_i light arrives along w and leaves toward E; at P_j it arrives from L and
-                                           // leaves along -w. Both cosines of each are positive on the line (N_i . E and
-                                           // N_j . L are checked by the caller).
-            let si = f1.specular(nli, ln.ne, we);
-            let sj = f2.specular(ln.nl, nej, -wl);
-            let k = if thesis { wt * cu * nli } else { wt * cu };
-            ss += k * si * sj;
-            sd += k * nli * sj;
-            ds += k * si * ln.nl;
+        // Two nodes at a time in two lanes, the odd one alone: the same terms either way.
+        let pairs = nodes.chunks_exact(2);
+        let rest = pairs.remainder();
+        let zero = F64x2::splat(0.0);
+        let (mut ss2, mut sd2, mut ds2) = (zero, zero, zero);
+        for p in pairs {
+            let lane = |k: fn(&(f64, f64, f64)) -> f64| F64x2::new(k(&p[0]), k(&p[1]));
+            let (a, b, c) = node_terms(
+                ln,
+                facets,
+                (ey, ly),
+                thesis,
+                (lane(|n| n.0), lane(|n| n.1), lane(|n| n.2)),
+            );
+            ss2 = ss2 + a;
+            sd2 = sd2 + b;
+            ds2 = ds2 + c;
+        }
+        let sum = |v: F64x2| v.lanes()[0] + v.lanes()[1];
+        (ss, sd, ds) = (sum(ss2), sum(sd2), sum(ds2));
+        for &(su, cu, wt) in rest {
+            let (a, b, c) = node_terms(ln, facets, (ey, ly), thesis, (su, cu, wt));
+            ss += a;
+            sd += b;
+            ds += c;
         }
     }
     Parts([g * ss, g * sd, g * ds, dd])
+}
+
+/// One axial node's contributions `(ss, sd, ds)` to [`line_integral`] (before the line's
+/// factor), for one node or two lanes of nodes: `(sin u, cos u, weight)`, `(E_y, L_y)`.
+#[inline(always)]
+fn node_terms<T: Real>(
+    ln: &Line,
+    (f1, f2): (CosineFacet, CosineFacet),
+    (ey, ly): (f64, f64),
+    thesis: bool,
+    (su, cu, wt): (T, T, T),
+) -> (T, T, T) {
+    let s = T::splat;
+    let nli = cu * s(ln.a); // N_i . w (> 0)
+    let nej = cu * s(ln.c); // N_j . (-w) (> 0)
+    let we = cu * s(ln.pe) + su * s(ey); // w . E
+    let wl = cu * s(ln.pl) + su * s(ly); // w . L
+                                         // At P_i light arrives along w and leaves toward E; at P_j it arrives from L and leaves
+                                         // along -w. Both cosines of each are positive on the line (N_i . E and N_j . L are checked
+                                         // by the caller).
+    let si = f1.specular(nli, s(ln.ne), we);
+    let sj = f2.specular(s(ln.nl), nej, s(0.0) - wl);
+    let k = if thesis { wt * cu * nli } else { wt * cu };
+    (k * si * sj, k * nli * sj, k * si * s(ln.nl))
 }
 
 /// Angles of C1 where the arc of C2 that P_i sees and that is lit changes which bound limits it:

@@ -13,6 +13,7 @@ pub mod fabric;
 pub mod facet;
 pub mod geometry;
 pub mod interreflection;
+pub mod lanes;
 pub mod pathtrace;
 pub mod quad;
 pub mod raytrace;
