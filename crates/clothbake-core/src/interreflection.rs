@@ -288,7 +288,8 @@ fn peak_in(pair: &Pair, s: &Setting, range: Arc) -> Option<(f64, f64)> {
             let p2 = pair.p2(b2, 0.0);
             let v = p2 - p1;
             let dir = 2.0 * t1 - te;
-            let travels = v.x * dir.cos() + v.z * dir.sin() > 0.0;
+            let (sd, cd) = sin_cos(dir);
+            let travels = v.x * cd + v.z * sd > 0.0;
             let faces = normal(t1).dot(v) > 0.0 && normal(b2).dot(-v) > 0.0;
             let b2l = shift_near(Arc { lo: b2, hi: b2 }, 0.5 * (s.lit2.lo + s.lit2.hi)).lo;
             // (with a margin, so that a peak on the lit arc's end is taken on both sides of a mirror
