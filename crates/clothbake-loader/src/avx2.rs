@@ -24,27 +24,20 @@ pub(crate) fn available() -> bool {
         && is_x86_feature_detected!("f16c")
 }
 
-/// Positions in cells (see [`crate::nodes::SpanLanes::k1`]) of the angles `atan2(y, x)` in
-/// four lanes, from `y^2`, `x^2` and the signs of `x` and `y` (masks), before clamping: the
-/// polynomial of [`crate::angles::atan2`], `atan(a) = a P(a^2)` with `a^2 = min / max` of the
-/// squares, but with the octant fix-ups and the map to cells folded into one fused
-/// multiply-add per candidate: `atan2 = off + sign atan(a)` where `off` (0, pi/2, pi, with
-/// signs) and `sign` come from the masks beside the division, and the coefficients are
-/// pre-multiplied by the cells per radian. Starting from squares, the square root (of the
-/// ratio) runs beside the polynomial instead of before the division. 0 cells from the
-/// origin for `(0, 0)`.
+/// The [`Octant`] parts of `atan2(y, x)` in four lanes, from `y^2`, `x^2` and the signs of
+/// `x` and `y` (masks): the polynomial of [`crate::angles::atan2`], `atan(a) = a P(a^2)` with
+/// `a^2 = min / max` of the squares, but with the octant fix-ups folded into `atan2 = off +
+/// sign atan(a)`, where `off` (0, pi/2, pi, with signs) and `sign` come from the masks beside
+/// the division; [`cells`] then maps to cells in one fused multiply-add per candidate, the
+/// coefficients pre-multiplied by the cells per radian. Starting from squares, the square root
+/// (of the ratio) runs beside the polynomial instead of before the division. `(0, 0)` gives
+/// the angle 0.
 ///
 /// # Safety
 /// The processor must have AVX2, FMA and F16C.
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
-unsafe fn atan2_cells(
-    k: &SpanLanes,
-    y2: __m128,
-    x2: __m128,
-    x_neg: __m128,
-    y_neg: __m128,
-) -> __m128 {
+unsafe fn atan2_cells(y2: __m128, x2: __m128, x_neg: __m128, y_neg: __m128) -> Octant {
     let lo = _mm_min_ps(x2, y2);
     let hi = _mm_max_ps(x2, y2);
     let s = _mm_and_ps(_mm_div_ps(lo, hi), _mm_cmpgt_ps(hi, _mm_setzero_ps()));
@@ -62,10 +55,44 @@ unsafe fn atan2_cells(
     let y_sign = _mm_and_ps(y_neg, neg0);
     let off = _mm_xor_ps(off, y_sign);
     let sign = _mm_and_ps(_mm_xor_ps(_mm_xor_ps(swap, x_neg), y_neg), neg0);
+    let a = _mm_xor_ps(_mm_sqrt_ps(s), sign);
+    Octant { s, a, off }
+}
+
+/// The parts of four `atan2` before the map to cells: `atan2 = off + a P(s)`, `a` signed.
+#[derive(Clone, Copy)]
+struct Octant {
+    s: __m128,
+    a: __m128,
+    off: __m128,
+}
+
+/// The octant parts of the swapped pair (`[theta_o, phi_o, theta_i, phi_i]`): the same
+/// lanes, swapped, so the same bits as computing them from `(wo, wi)`.
+///
+/// # Safety
+/// The processor must have AVX2, FMA and F16C.
+#[inline]
+#[target_feature(enable = "avx2,fma,f16c")]
+unsafe fn swap_octant(o: Octant) -> Octant {
+    Octant {
+        s: swap(o.s),
+        a: swap(o.a),
+        off: swap(o.off),
+    }
+}
+
+/// Positions in cells of the angles `off + a P(s)` (see [`atan2_cells`]), before clamping.
+///
+/// # Safety
+/// The processor must have AVX2, FMA and F16C.
+#[inline]
+#[target_feature(enable = "avx2,fma,f16c")]
+unsafe fn cells(k: &SpanLanes, o: Octant) -> __m128 {
+    let Octant { s, a, off } = o;
     let ld = |v: &[f32; 4]| _mm_loadu_ps(v.as_ptr()); // 4 f32, unaligned
     let b1 = _mm_fmadd_ps(off, ld(&k.k1), ld(&k.b1));
     let b2 = _mm_fmadd_ps(off, ld(&k.k2), ld(&k.b2));
-    let a = _mm_xor_ps(_mm_sqrt_ps(s), sign);
     // Estrin's scheme (shorter dependency chain than Horner's), both scalings:
     // p = (c0 + c1 s) + s^2 (c2 + c3 s) + s^4 (c4 + c5 s).
     let s2 = _mm_mul_ps(s, s);
@@ -89,6 +116,18 @@ unsafe fn atan2_cells(
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
 unsafe fn positions(nodes: &Nodes, wi: [f32; 3], wo: [f32; 3]) -> (__m128, bool) {
+    let (o, ok) = octant(wi, wo);
+    (cells(&nodes.lanes, o), ok)
+}
+
+/// The octant parts of the four angles of a pair (see [`positions`]) and whether it has a
+/// value.
+///
+/// # Safety
+/// The processor must have AVX2, FMA and F16C.
+#[inline]
+#[target_feature(enable = "avx2,fma,f16c")]
+unsafe fn octant(wi: [f32; 3], wo: [f32; 3]) -> (Octant, bool) {
     // Lanes: theta_i = atan2(rho_i, z_i), phi_i = atan2(y_i, x_i), and the same for wo.
     let x = _mm_setr_ps(wi[2], wi[0], wo[2], wo[0]);
     let a = _mm_setr_ps(wi[0], wi[1], wo[0], wo[1]);
@@ -102,14 +141,8 @@ unsafe fn positions(nodes: &Nodes, wi: [f32; 3], wo: [f32; 3]) -> (__m128, bool)
     let below = _mm_cmp_ps::<_CMP_NGT_UQ>(x, _mm_set1_ps(HORIZON_COS));
     let nan = _mm_cmpunord_ps(x, a);
     let bad = _mm_movemask_ps(_mm_or_ps(nan, _mm_andnot_ps(azimuth, below)));
-    let s = atan2_cells(
-        &nodes.lanes,
-        y2,
-        _mm_mul_ps(x, x),
-        _mm_cmplt_ps(x, zero),
-        y_neg,
-    );
-    (s, bad == 0)
+    let o = atan2_cells(y2, _mm_mul_ps(x, x), _mm_cmplt_ps(x, zero), y_neg);
+    (o, bad == 0)
 }
 
 /// Positions in cells (before clamping) of angles `[theta_i, phi_i, theta_o, phi_o]`
@@ -272,13 +305,13 @@ unsafe fn eval_reciprocal<const HALF: bool, V>(
     wi: [f32; 3],
     wo: [f32; 3],
 ) -> [f32; 3] {
-    let (pos, ok) = positions(nodes, wi, wo);
+    let (o, ok) = octant(wi, wo);
     if !ok {
         return [0.0; 3];
     }
-    let f = blend::<HALF, V>(nodes, v, pos);
-    // The swapped pair's positions (the axes' scales differ: positions do not swap).
-    let r = blend::<HALF, V>(nodes, v, positions(nodes, wo, wi).0);
+    let f = blend::<HALF, V>(nodes, v, cells(&nodes.lanes, o));
+    // The swapped pair: its octant parts swap, its positions do not (the axes' scales differ).
+    let r = blend::<HALF, V>(nodes, v, cells(&nodes.lanes, swap_octant(o)));
     mean(f, r)
 }
 
