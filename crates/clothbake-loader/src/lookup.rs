@@ -271,9 +271,16 @@ impl Brdf {
             (Values::F16(v), Kernel::Avx2) => unsafe { avx2::eval::<true, u16>(n, v, r, wi, wo) },
             #[cfg(target_arch = "x86_64")]
             (Values::F32(v), Kernel::Avx2) => unsafe { avx2::eval::<false, f32>(n, v, r, wi, wo) },
-            (Values::F16(v), _) => self.eval_in(v, wi, wo),
-            (Values::F32(v), _) => self.eval_in(v, wi, wo),
+            (Values::F16(v), _) => self.eval_portable(v, wi, wo),
+            (Values::F32(v), _) => self.eval_portable(v, wi, wo),
         }
+    }
+
+    /// The portable single lookup, out of line: inlined, its registers would be saved and
+    /// restored on every [`Brdf::eval`], whatever the kernel.
+    #[inline(never)]
+    fn eval_portable<V: Lane>(&self, v: &[V], wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        self.eval_in(v, wi, wo)
     }
 
     /// `f_r` at polar angles and azimuths in degrees (theta from +Z, phi from +X toward +Y),

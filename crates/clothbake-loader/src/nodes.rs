@@ -17,7 +17,7 @@
 //! `base_b + s_ti + s_to + 8`, at most `len`. [`Nodes::runs`] checks exactly those two ends
 //! once per lookup and then reads the 8 runs without further checks.
 
-use crate::angles::atan2;
+use crate::angles::{atan2, ATAN_COEFFS};
 use crate::format::Grid;
 use crate::stored::f16_to_f32;
 
@@ -72,8 +72,21 @@ pub(crate) struct Nodes {
 #[derive(Clone, Debug)]
 #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))] // read by the AVX2 kernel only
 pub(crate) struct SpanLanes {
-    /// `n - 1/2` on the azimuth lanes (added to the angle in cells); unused on polar lanes.
-    pub(crate) offset: [f32; 4],
+    /// Position in cells of an angle `a`: `min(a k1 + b1, a k2 + b2)` per lane. Polar lanes:
+    /// `k1 = 2 scale, b1 = 0` and `k2 = scale, b2 = 1/2` (the `2c` or `c + 1/2` of
+    /// [`polar_axis`]); azimuth lanes: `k1 = k2 = scale`, `b1 = b2 = n - 1/2`.
+    pub(crate) k1: [f32; 4],
+    /// See [`SpanLanes::k1`].
+    pub(crate) b1: [f32; 4],
+    /// See [`SpanLanes::k1`].
+    pub(crate) k2: [f32; 4],
+    /// See [`SpanLanes::k1`].
+    pub(crate) b2: [f32; 4],
+    /// The `atan` coefficients ([`crate::angles::ATAN_COEFFS`]) times `k1` (`[j]` for `c_j`),
+    /// so that the polynomial gives the angle in cells directly.
+    pub(crate) c1: [[f32; 4]; 6],
+    /// The `atan` coefficients times `k2`.
+    pub(crate) c2: [[f32; 4]; 6],
     /// Largest position: `n` (polar: hold the last ring), `2 n` (azimuth).
     pub(crate) cap: [f32; 4],
     /// Largest low index before the wrap: `cap - 1`.
@@ -83,6 +96,44 @@ pub(crate) struct SpanLanes {
     /// True when every axis has at most 2^22 cells, so that these constants and every
     /// position in cells are exact in `f32` and `i32` (a larger axis uses the portable kernel).
     pub(crate) exact: bool,
+}
+
+impl SpanLanes {
+    /// The constants of axes of `n` cells (theta_i, phi_i, theta_o, phi_o) and `scale` cells
+    /// per radian.
+    fn new(n: [u32; 4], scale: [f32; 4]) -> SpanLanes {
+        let polar = |k: usize| k.is_multiple_of(2);
+        let lanes = |f: &dyn Fn(usize) -> f32| -> [f32; 4] { std::array::from_fn(f) };
+        let k1 = lanes(&|k| if polar(k) { 2.0 * scale[k] } else { scale[k] });
+        let k2 = scale;
+        let b1 = lanes(&|k| if polar(k) { 0.0 } else { n[k] as f32 - 0.5 });
+        let b2 = lanes(&|k| if polar(k) { 0.5 } else { n[k] as f32 - 0.5 });
+        let coef = |m: [f32; 4]| std::array::from_fn(|j| m.map(|m| ATAN_COEFFS[j] * m));
+        SpanLanes {
+            k1,
+            b1,
+            k2,
+            b2,
+            c1: coef(k1),
+            c2: coef(k2),
+            cap: lanes(&|k| {
+                if polar(k) {
+                    n[k] as f32
+                } else {
+                    2.0 * n[k] as f32
+                }
+            }),
+            top: std::array::from_fn(|k| {
+                if polar(k) {
+                    n[k] as i32 - 1
+                } else {
+                    2 * n[k] as i32 - 1
+                }
+            }),
+            n: n.map(|n| n as i32),
+            exact: n.iter().all(|&n| n <= 1 << 22),
+        }
+    }
 }
 
 /// Where one lookup falls: the first lane of its first run and the blend weights.
@@ -129,24 +180,14 @@ impl Nodes {
         };
         let polar = |n: u32| n as f32 / std::f32::consts::FRAC_PI_2;
         let azimuth = |n: u32| n as f32 / std::f32::consts::TAU;
+        let scale = [polar(nti), azimuth(npi), polar(nto), azimuth(npo)];
         Nodes {
             values,
             strides: [s_ti, s_pi, s_to],
             extent: s_ti + s_to + 2 * LANES,
-            scale: [polar(nti), azimuth(npi), polar(nto), azimuth(npo)],
+            scale,
             n: [nti, npi, nto, npo],
-            lanes: SpanLanes {
-                offset: [0.0, npi as f32 - 0.5, 0.0, npo as f32 - 0.5],
-                cap: [nti as f32, 2.0 * npi as f32, nto as f32, 2.0 * npo as f32],
-                top: [
-                    nti as i32 - 1,
-                    2 * npi as i32 - 1,
-                    nto as i32 - 1,
-                    2 * npo as i32 - 1,
-                ],
-                n: [nti as i32, npi as i32, nto as i32, npo as i32],
-                exact: [nti, npi, nto, npo].iter().all(|&n| n <= 1 << 22),
-            },
+            lanes: SpanLanes::new([nti, npi, nto, npo], scale),
         }
     }
 
