@@ -404,7 +404,7 @@ pub const ORDERS_FAST: Orders = Orders {
 impl Default for Orders {
     fn default() -> Self {
         Orders {
-            theta: 12,
+            theta: 11,
             tol: 0.0,
             beta: 5,
             axial: 3,
