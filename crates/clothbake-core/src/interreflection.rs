@@ -36,7 +36,7 @@ use crate::arc::Arc;
 use crate::fabric::Material;
 use crate::facet::{CosineFacet, Facet, FacetModel};
 use crate::lanes::{F64x2, Real};
-use crate::trig::sin_cos;
+use crate::trig::{round_nearest, sin_cos};
 use crate::vec3::Vec3;
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -150,6 +150,18 @@ impl Pair {
         self.seen_arc_from(t).0
     }
 
+    /// The part of [`Pair::seen_arc`] that is also in the lit arc `lit` of C2 (shifted by 2 pi
+    /// next to it), with the nearest point's angle and the distance of [`Pair::seen_arc_from`]:
+    /// where the patches of C2 that light P_i lie.
+    fn lit_seen_arc(&self, t: f64, lit: Arc) -> (Arc, f64, f64) {
+        let (arc, gamma, dist) = self.seen_arc_from(t);
+        (
+            arc.meet(shift_near(lit, 0.5 * (arc.lo + arc.hi))),
+            gamma,
+            dist,
+        )
+    }
+
     /// [`Pair::seen_arc`], with the angle gamma of the point of C2 nearest P_i (in
     /// (-pi/2, 3pi/2]) and the distance |P_i - O_2|.
     fn seen_arc_from(&self, t: f64) -> (Arc, f64, f64) {
@@ -231,9 +243,7 @@ fn wrap(a: f64) -> f64 {
 /// The 2-pi shift of `a` whose middle is closest to `near`.
 fn shift_near(a: Arc, near: f64) -> Arc {
     let mid = 0.5 * (a.lo + a.hi);
-    // Nearest integer by the 1.5 * 2^52 shift (no `round` library call on baseline x86-64).
-    const SHIFT: f64 = 6_755_399_441_055_744.0;
-    let k = (((near - mid) / (2.0 * PI) + SHIFT) - SHIFT) * 2.0 * PI;
+    let k = round_nearest((near - mid) / (2.0 * PI)) * 2.0 * PI;
     Arc {
         lo: a.lo + k,
         hi: a.hi + k,
@@ -763,10 +773,7 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
     // The panels of C1's visible arc between the kinks of the integrand where P_i sees a lit
     // part of C2 (the support's ends are kinks): only they get nodes, and the maximum reflection
     // point is searched there.
-    let lit_at = |t: f64| {
-        let b = pair.seen_arc(t);
-        normal(t).dot(e) > 0.0 && !b.meet(shift_near(s.lit2, 0.5 * (b.lo + b.hi))).is_empty()
-    };
+    let lit_at = |t: f64| normal(t).dot(e) > 0.0 && !pair.lit_seen_arc(t, s.lit2).0.is_empty();
     let mut kinks = Vec::with_capacity(16);
     theta_kinks(pair, s.lit2, s.vis1, &mut kinks);
     let mut buf = [0.0f64; 20];
@@ -879,8 +886,7 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
         if ne <= 0.0 {
             return acc;
         }
-        let (mut barc, gamma, dist) = pair.seen_arc_from(t);
-        barc = barc.meet(shift_near(s.lit2, 0.5 * (barc.lo + barc.hi)));
+        let (mut barc, gamma, dist) = pair.lit_seen_arc(t, s.lit2);
         if let Some(bw) = beta_window {
             barc = barc.meet(shift_near(bw, 0.5 * (barc.lo + barc.hi)));
         }
@@ -943,8 +949,9 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
     };
     let mut out = Parts::default();
     if orders.tol > 0.0 {
-        let mut tcuts: Vec<f64> = pk.iter().map(|p| p.0).collect();
-        theta_kinks(pair, s.lit2, theta_range, &mut tcuts);
+        // The kinks found over C1's visible arc (cut_points keeps those inside theta_range).
+        let mut tcuts = kinks.clone();
+        tcuts.extend(pk.map(|p| p.0));
         // Adaptive G7/K15 along C1, split at the maximum reflection point. Where the arc starts
         // near the point of C1 closest to C2 and the cylinders (nearly) touch, a point there sees
         // C2 under almost a hemisphere and the integrand grows like a logarithm: the first panel
@@ -1135,8 +1142,7 @@ pub fn two_level_sampling(pair: &Pair, s: &Setting, p: Sampling) -> Secondary {
         let t = ep.1 + w.clamp(-1.0, 1.0).asin();
         let pi_ = pair.p1(t);
         let ni = normal(t);
-        let mut barc = pair.seen_arc(t);
-        barc = barc.meet(shift_near(s.lit2, 0.5 * (barc.lo + barc.hi)));
+        let barc = pair.lit_seen_arc(t, s.lit2).0;
         if barc.is_empty() {
             continue;
         }

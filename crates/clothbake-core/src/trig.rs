@@ -40,10 +40,7 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     if x.is_nan() || x.abs() > 1e6 {
         return x.sin_cos();
     }
-    // Round to the nearest integer by the 1.5 * 2^52 shift (no `round` library call on
-    // baseline x86-64).
-    const SHIFT: f64 = 6_755_399_441_055_744.0;
-    let kf = (x * std::f64::consts::FRAC_2_PI + SHIFT) - SHIFT;
+    let kf = round_nearest(x * std::f64::consts::FRAC_2_PI);
     let r = (x - kf * PI_2_HI) - kf * PI_2_LO;
     let z = r * r;
     // Alternating series by Horner in z.
@@ -61,6 +58,14 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
         2 => (-s, -c),
         _ => (-c, s),
     }
+}
+
+/// The integer nearest `x` (ties to even) for |x| < 2^51, by the 1.5 * 2^52 shift: no `round`
+/// library call on baseline x86-64.
+#[inline(always)]
+pub fn round_nearest(x: f64) -> f64 {
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    (x + SHIFT) - SHIFT
 }
 
 #[cfg(test)]
@@ -85,5 +90,13 @@ mod tests {
         }
         let (s, c) = sin_cos(f64::NAN);
         assert!(s.is_nan() && c.is_nan());
+    }
+
+    #[test]
+    fn round_nearest_matches_the_standard_library_off_ties() {
+        for x in [-3.7, -2.2, -0.4, 0.0, 0.49, 1.5000001, 12345.6] {
+            assert_eq!(round_nearest(x), x.round(), "{x}");
+        }
+        assert_eq!(round_nearest(2.5), 2.0);
     }
 }
