@@ -245,14 +245,20 @@ unsafe fn gather<const HALF: bool, V>(nodes: &Nodes, v: &[V], k: &Corner) -> [f3
             _mm256_loadu_ps(p[r] as *const f32)
         }
     };
-    // Run r's lane weights: w_r for the low phi_o node, times (1 - t_po, t_po) by D; the
-    // weights do not wait for the loads, and the sum is a tree (short chain after them).
-    let lane = |r: i32| _mm256_mul_ps(_mm256_permutevar8x32_ps(w, _mm256_set1_epi32(r)), d);
+    // Run r weighs w_r (a broadcast from memory: a load, not a shuffle); (1 - t_po, t_po) by
+    // D is common to all runs and applied once to the sum; the weights do not wait for the
+    // loads, and the sum is a tree (short chain after them).
+    let mut wr = [0f32; 8];
+    _mm256_storeu_ps(wr.as_mut_ptr(), w); // 8 f32, unaligned
+    let lane = |r: usize| _mm256_broadcast_ss(&wr[r]);
     let y0 = _mm256_fmadd_ps(load(1), lane(1), _mm256_mul_ps(load(0), lane(0)));
     let y1 = _mm256_fmadd_ps(load(3), lane(3), _mm256_mul_ps(load(2), lane(2)));
     let y2 = _mm256_fmadd_ps(load(5), lane(5), _mm256_mul_ps(load(4), lane(4)));
     let y3 = _mm256_fmadd_ps(load(7), lane(7), _mm256_mul_ps(load(6), lane(6)));
-    let acc = _mm256_add_ps(_mm256_add_ps(y0, y1), _mm256_add_ps(y2, y3));
+    let acc = _mm256_mul_ps(
+        _mm256_add_ps(_mm256_add_ps(y0, y1), _mm256_add_ps(y2, y3)),
+        d,
+    );
     let rgb = _mm_add_ps(_mm256_castps256_ps128(acc), _mm256_extractf128_ps::<1>(acc));
     let mut out = [0f32; 4];
     _mm_storeu_ps(out.as_mut_ptr(), rgb); // 4 f32, unaligned
