@@ -546,16 +546,35 @@ struct Lobe {
     width: f64,
 }
 
-/// Gauss-Legendre panels over [u0, u1] cut at the lobe centres inside it, each panel graded
-/// toward its nearest lobe ([`graded_panels`]; a panel between two centres is halved, each half
-/// graded toward its own end).
-fn axial_nodes(u0: f64, u1: f64, lobes: [Lobe; 2], order: usize, out: &mut AxialNodes) {
+/// Gauss-Legendre panels over [u0, u1] cut at the lobe centres inside it (a panel between two
+/// centres is halved). With `graded`, each panel is graded toward its nearest lobe
+/// ([`graded_panels`]; each half toward its own end): endless lines, whose range runs to
+/// u = +-pi/2 where cos u and the lobes' tails vanish. Lines of finite extent get plain panels:
+/// there the grading leaves the far part of an end panel, where the diffuse-specular parts still
+/// matter, with too few nodes (on the twill, the worst error of I_2 at the default orders drops
+/// from 16% to 5%, the mean from 0.64% to 0.58%), and it costs two more trigonometric calls a
+/// node.
+fn axial_nodes(
+    u0: f64,
+    u1: f64,
+    lobes: [Lobe; 2],
+    order: usize,
+    graded: bool,
+    out: &mut AxialNodes,
+) {
     out.clear();
     let mut push = |a: f64, b: f64, l: Lobe| {
-        graded_panels(a, b, l.centre, l.width, &[], order, order, |u, w| {
+        let mut node = |u: f64, w: f64| {
             let (s, c) = sin_cos(u);
             out.push((s, c, w));
-        })
+        };
+        if graded {
+            graded_panels(a, b, l.centre, l.width, &[], order, order, node)
+        } else {
+            for &(x, wt) in crate::quad::gl_rule(order) {
+                node(a + (b - a) * 0.5 * (x + 1.0), 0.5 * wt * (b - a));
+            }
+        }
     };
     let inside = |l: &Lobe| l.centre > u0 && l.centre < u1;
     let mut pts = [(u0, None), (0.0, None), (0.0, None), (u1, None)];
@@ -601,19 +620,44 @@ fn lobe_width(facet: FacetModel, n: f64) -> f64 {
     (w / n.max(1e-3).sqrt()).min(4.0)
 }
 
+/// The end of a line's range in u = atan(q), q = y / D, with its sine and cosine from q
+/// (q / sqrt(1 + q^2) and 1 / sqrt(1 + q^2): no trigonometric call).
+#[derive(Clone, Copy, Debug)]
+struct AxialEnd {
+    u: f64,
+    sin: f64,
+    cos: f64,
+}
+
+impl AxialEnd {
+    fn of(q: f64) -> AxialEnd {
+        if !q.is_finite() {
+            // q = +-inf (an endless side): u = +-pi/2; NaN stays NaN.
+            return AxialEnd {
+                u: q.atan(),
+                sin: q.signum(),
+                cos: 0.0,
+            };
+        }
+        let r = 1.0 / (1.0 + q * q).sqrt();
+        AxialEnd {
+            u: q.atan(),
+            sin: q * r,
+            cos: r,
+        }
+    }
+}
+
 /// Integral of cos^2 u over [u0, u1]: (u + sin u cos u) / 2.
-fn int_cos2(u0: f64, u1: f64) -> f64 {
-    let f = |u: f64| 0.5 * (u + u.sin() * u.cos());
-    f(u1) - f(u0)
+fn int_cos2(a: AxialEnd, b: AxialEnd) -> f64 {
+    let f = |e: AxialEnd| 0.5 * (e.u + e.sin * e.cos);
+    f(b) - f(a)
 }
 
 /// Integral of cos^3 u over [u0, u1]: sin u - sin^3 u / 3.
-fn int_cos3(u0: f64, u1: f64) -> f64 {
-    let f = |u: f64| {
-        let s = u.sin();
-        s - s * s * s / 3.0
-    };
-    f(u1) - f(u0)
+fn int_cos3(a: AxialEnd, b: AxialEnd) -> f64 {
+    let f = |e: AxialEnd| e.sin - e.sin * e.sin * e.sin / 3.0;
+    f(b) - f(a)
 }
 
 /// What one generator line of C2 (fixed beta) needs for a point P_i of C1, with
@@ -865,18 +909,18 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
     // Endless lines share one rule; lines of finite extent get their own (per line).
     let endless = ylo == f64::NEG_INFINITY && yhi == f64::INFINITY;
     // The integral of the diffuse-diffuse part's cos^2 u (radiometric) or cos^3 u (thesis).
-    let cos_power = |u0: f64, u1: f64| match pair.kernel {
-        Kernel::Radiometric => int_cos2(u0, u1),
-        Kernel::Thesis => int_cos3(u0, u1),
+    let cos_power = |a: AxialEnd, b: AxialEnd| match pair.kernel {
+        Kernel::Radiometric => int_cos2(a, b),
+        Kernel::Thesis => int_cos3(a, b),
     };
-    let whole = cos_power(-FRAC_PI_2, FRAC_PI_2);
+    let whole = cos_power(AxialEnd::of(f64::NEG_INFINITY), AxialEnd::of(f64::INFINITY));
     let facets = (
         CosineFacet::new(pair.facet, &pair.m1),
         CosineFacet::new(pair.facet, &pair.m2),
     );
     let mut shared = AxialNodes::new();
     if endless {
-        axial_nodes(-FRAC_PI_2, FRAC_PI_2, centres, nu, &mut shared);
+        axial_nodes(-FRAC_PI_2, FRAC_PI_2, centres, nu, true, &mut shared);
     }
     // J(theta) times (N_i . E) r1: the inner double integral over C2 for one point of C1.
     let inner = |t: f64| -> Parts {
@@ -938,9 +982,9 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
                 let (cos_int, nodes) = if endless {
                     (whole, &shared)
                 } else {
-                    let u = ((ylo / d).atan(), (yhi / d).atan());
-                    axial_nodes(u.0, u.1, centres, nu, &mut own);
-                    (cos_power(u.0, u.1), &own)
+                    let (a, b) = (AxialEnd::of(ylo / d), AxialEnd::of(yhi / d));
+                    axial_nodes(a.u, b.u, centres, nu, false, &mut own);
+                    (cos_power(a, b), &own)
                 };
                 acc.add_scaled(&line_integral(pair, s, &ln, facets, cos_int, nodes), wb);
             },
