@@ -564,15 +564,26 @@ fn axial_nodes(
 ) {
     out.clear();
     let mut push = |a: f64, b: f64, l: Lobe| {
-        let mut node = |u: f64, w: f64| {
-            let (s, c) = sin_cos(u);
-            out.push((s, c, w));
-        };
         if graded {
-            graded_panels(a, b, l.centre, l.width, &[], order, order, node)
+            graded_panels(a, b, l.centre, l.width, &[], order, order, |u, w| {
+                let (s, c) = sin_cos(u);
+                out.push((s, c, w));
+            })
         } else {
-            for &(x, wt) in crate::quad::gl_rule(order) {
-                node(a + (b - a) * 0.5 * (x + 1.0), 0.5 * wt * (b - a));
+            // Nodes m -+ h x in pairs, by the angle-addition formulas from the sines and
+            // cosines of m and h x: one trigonometric call a pair (and the centre's).
+            let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+            let (sm, cm) = sin_cos(m);
+            let rule = crate::quad::gl_rule(order);
+            let half = rule.len() / 2;
+            if rule.len() % 2 == 1 {
+                out.push((sm, cm, rule[half].1 * h));
+            }
+            for &(x, wt) in &rule[rule.len() - half..] {
+                let (sd, cd) = sin_cos(h * x);
+                let w = wt * h;
+                out.push((sm * cd - cm * sd, cm * cd + sm * sd, w));
+                out.push((sm * cd + cm * sd, cm * cd - sm * sd, w));
             }
         }
     };
@@ -947,7 +958,7 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
         // of width ~ the gap between P_i and C2.
         let gap = (dist - pair.r2).max(0.0) / pair.r2;
         let bcuts = [pk.map_or(f64::NAN, |p| near(p.1))];
-        let mut own = AxialNodes::new();
+        let mut own = AxialNodes::with_capacity(if endless { 0 } else { 4 * nu + 4 });
         graded_panels(
             barc.lo,
             barc.hi,
