@@ -1,10 +1,17 @@
-//! Inputs shared by the export tests.
+//! Inputs and scratch folders shared by the integration tests.
 
 use clothbake::bake::{bake, BakeOptions};
 use clothbake_core::Fabric;
 use clothbake_loader::{write_exr, Brdf, Options, Precision};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
+
+/// The folder `clothbake-<name>-<process id>` in the system's temporary directory, created.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("clothbake-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
 
 /// The shipped twill (`tables/twill.json`) with the albedo (0.6, 0.3, 0.12) on both groups, so
 /// that the three channels differ.

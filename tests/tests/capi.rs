@@ -6,6 +6,7 @@
 use clothbake::bake::{bake, BakeOptions};
 use clothbake_core::Fabric;
 use clothbake_loader::{write_exr, Brdf, Grid, Options, Precision};
+use clothbake_tests::fixtures::temp_dir;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -38,7 +39,7 @@ fn v3(v: [f32; 3]) -> String {
 
 #[test]
 fn the_c_program_agrees_with_the_rust_loader() {
-    let dir = tempfile_dir();
+    let dir = temp_dir("capi-test");
     let grid = Grid {
         n_theta_i: 8,
         n_phi_i: 16,
@@ -129,11 +130,4 @@ fn the_c_program_agrees_with_the_rust_loader() {
         "{stdout}"
     );
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// A fresh folder under the target directory's temporary space.
-fn tempfile_dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("clothbake-capi-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }

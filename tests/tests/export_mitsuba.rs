@@ -13,8 +13,8 @@
 
 use clothbake::export::{model_brdf, rgl, table_brdf};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Vec3};
-use clothbake_tests::fixtures::{bake_and_open, coloured_twill};
-use std::path::{Path, PathBuf};
+use clothbake_tests::fixtures::{bake_and_open, coloured_twill, temp_dir};
+use std::path::Path;
 use std::process::Command;
 
 const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/python/mitsuba_render.py");
@@ -100,9 +100,7 @@ fn render_and_compare(
     spp: u32,
     prefix: &str,
 ) -> Compared {
-    let dir: PathBuf =
-        std::env::temp_dir().join(format!("clothbake-mitsuba-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir(&format!("mitsuba-{tag}"));
     let f = fabric();
     let model = AnalyticModel::new(&f, FacetModel::Huo);
     let brdf = model_brdf(&model, None);
@@ -237,8 +235,7 @@ fn mitsuba_renders_the_export_of_a_baked_table_like_the_model() {
     if !mitsuba_available() {
         return;
     }
-    let dir = std::env::temp_dir().join(format!("clothbake-baked-table-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("baked-table");
     let lookup = bake_and_open(&fabric(), &dir.join("twill.exr"));
     let source = table_brdf(&lookup);
     let c = render_and_compare(

@@ -11,6 +11,7 @@
 
 use clothbake::export::{model_brdf, rgl};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel};
+use clothbake_tests::fixtures::temp_dir;
 use std::path::Path;
 use std::process::Command;
 
@@ -61,8 +62,7 @@ fn the_spectral_file_meets_pbrt_v4s_reader_and_projects_back_to_the_rgb_file() {
         n_phi: 8,
         n_slice: 12,
     };
-    let dir = std::env::temp_dir().join(format!("clothbake-pbrt-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("pbrt");
     let (spec, rgb) = (dir.join("denim_spec.bsdf"), dir.join("denim_rgb.bsdf"));
     for (p, c) in [(&spec, rgl::Colour::Spectral), (&rgb, rgl::Colour::Rgb)] {
         let fields = rgl::rgl_fields(&brdf, &grid, "clothbake test: denim", c);

@@ -6,7 +6,7 @@
 
 use clothbake::export::{model_brdf, rgl, table_brdf};
 use clothbake_core::{AnalyticModel, FacetModel};
-use clothbake_tests::fixtures::{bake_and_open, coloured_twill};
+use clothbake_tests::fixtures::{bake_and_open, coloured_twill, temp_dir};
 
 fn rgb_values(fields: &[rgl::Field]) -> Vec<f32> {
     let f = fields
@@ -22,8 +22,7 @@ fn rgb_values(fields: &[rgl::Field]) -> Vec<f32> {
 #[test]
 fn the_export_of_a_baked_table_matches_the_export_of_the_model() {
     let fabric = coloured_twill();
-    let dir = std::env::temp_dir().join(format!("clothbake-export-table-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("export-table");
     let lookup = bake_and_open(&fabric, &dir.join("twill.exr"));
     let from_table = table_brdf(&lookup);
     let model = AnalyticModel::new(&fabric, FacetModel::Huo);

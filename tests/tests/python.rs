@@ -7,6 +7,7 @@
 //! Mitsuba rendering tests inside skip themselves when `mitsuba` is not installed (`.ci/run`
 //! installs all three from PyPI).
 
+use clothbake_tests::fixtures::temp_dir;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -56,7 +57,7 @@ fn build_extension() -> PathBuf {
 
 /// A folder holding the `clothbake` package as a wheel would install it.
 fn stage(lib: &Path) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("clothbake-py-test-{}", std::process::id()));
+    let dir = temp_dir("py-test");
     let pkg = dir.join("clothbake");
     std::fs::create_dir_all(&pkg).unwrap();
     let src = root().join("crates/clothbake-py/python/clothbake");
