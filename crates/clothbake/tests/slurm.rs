@@ -70,7 +70,10 @@ fn slurm_job_array_bakes_and_merges_the_same_table() {
         .arg(&fabric)
         .arg(&docs)
         .env("PATH", &path)
-        .env("TMPDIR", env!("CARGO_TARGET_TMPDIR"))
+        // The system's temporary directory, not the target's: munged refuses a socket below a
+        // folder that others cannot search, as a checkout inside a `mktemp -d` folder (mode
+        // 700) is. The script makes its own folder there and removes it on exit.
+        .env("TMPDIR", std::env::temp_dir())
         .output()
         .expect("run tests/slurm.sh");
     let text = format!(
