@@ -20,7 +20,9 @@ use clothbake_core::{
 };
 use std::fmt::Write as _;
 
-fn pf(n: f64, rho_s: f64) -> Fabric {
+/// The parallel-cylinder surface of thesis sec. 5.4 (r 1, d 2, rho_d 0.4) with specular
+/// `rho_s` and exponent `n`: the surface of `ch5`, `figures` and `ir-accuracy`.
+pub(crate) fn pf(n: f64, rho_s: f64) -> Fabric {
     let json = format!(
         r#"{{"name": "parallel cylinders", "pattern": [[1]],
             "warp": {{"radius": 1, "spacing": 2, "material": {{"albedo": 0.4, "specular": {rho_s}, "exponent": {n}}}}},

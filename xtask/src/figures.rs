@@ -113,12 +113,7 @@ fn cloth(root: &Path, dir: &Path, bounces: u32, size: u32, aa: u32, name: &str) 
 }
 
 fn parallel(n: f64) -> Fabric {
-    let json = format!(
-        r#"{{"name": "parallel cylinders", "pattern": [[1]],
-            "warp": {{"radius": 1, "spacing": 2, "material": {{"albedo": 0.4, "specular": 0.7, "exponent": {n}}}}},
-            "weft": {{"radius": 1, "spacing": 2}}}}"#
-    );
-    Fabric::from_json_str(&json, "figures").expect("valid")
+    crate::ch5::pf(n, 0.7)
 }
 
 fn disks(dir: &Path, size: u32) {

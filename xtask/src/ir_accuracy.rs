@@ -21,20 +21,23 @@ const REFERENCE: Orders = Orders {
     axial: 24,
 };
 
+/// A two-level sampling setting: first-level samples, angular and axial step, axial half-length,
+/// exact (Siegel & Howell) or eq. 5.16 solid angles.
+fn sampling(first: usize, step: f64, l0: f64, exact: bool) -> SecondaryMethod {
+    SecondaryMethod::Sampling(Sampling {
+        first_level: first,
+        d_alpha: step,
+        d_l: step,
+        l0,
+        exact_solid_angle: exact,
+    })
+}
+
 /// The methods of the table: name and method.
 fn methods() -> Vec<(String, SecondaryMethod)> {
     let analytic = |o: Orders| SecondaryMethod::Analytic {
         ranges: Ranges::Full,
         orders: o,
-    };
-    let sampling = |first: usize, step: f64, l0: f64| {
-        SecondaryMethod::Sampling(Sampling {
-            first_level: first,
-            d_alpha: step,
-            d_l: step,
-            l0,
-            exact_solid_angle: true,
-        })
     };
     let fast = clothbake_core::interreflection::ORDERS_FAST;
     vec![
@@ -45,29 +48,139 @@ fn methods() -> Vec<(String, SecondaryMethod)> {
         ("analytic, fast orders".into(), analytic(fast)),
         (
             "sampling 32, 0.2, l0 1.5 (thesis)".into(),
-            sampling(32, 0.2, 1.5),
+            sampling(32, 0.2, 1.5, true),
         ),
-        ("sampling 32, 0.2, l0 3".into(), sampling(32, 0.2, 3.0)),
-        ("sampling 32, 0.15, l0 3".into(), sampling(32, 0.15, 3.0)),
-        ("sampling 64, 0.1, l0 3".into(), sampling(64, 0.1, 3.0)),
+        (
+            "sampling 32, 0.2, l0 3".into(),
+            sampling(32, 0.2, 3.0, true),
+        ),
+        (
+            "sampling 32, 0.15, l0 3".into(),
+            sampling(32, 0.15, 3.0, true),
+        ),
+        (
+            "sampling 24, 0.17, l0 3".into(),
+            sampling(24, 0.17, 3.0, true),
+        ),
+        (
+            "sampling 28, 0.15, l0 3, eq. 5.16".into(),
+            sampling(28, 0.15, 3.0, false),
+        ),
+        (
+            "sampling 64, 0.1, l0 3".into(),
+            sampling(64, 0.1, 3.0, true),
+        ),
     ]
 }
 
-/// The parallel-cylinder surface with the sec. 5.4 facets (rho_d 0.4, rho_s 0.7, exponent n).
-fn parallel(n: f64) -> Fabric {
-    let json = format!(
-        r#"{{"pattern": [[1]], "warp": {{"radius": 1, "spacing": 2,
-            "material": {{"albedo": 0.4, "specular": 0.7, "exponent": {n}}}}},
-            "weft": {{"radius": 1, "spacing": 2}}}}"#
-    );
-    Fabric::from_json_str(&json, "parallel").expect("a valid fabric")
+/// Mean and worst relative error of `got` against `reference` (pairs whose reference I_2 is
+/// above 1e-9), and the worst error relative to I_1.
+fn errors(got: &[(f64, f64)], reference: &[(f64, f64)]) -> (f64, f64, f64) {
+    let (mut sum, mut count, mut worst, mut worst_i1) = (0.0, 0, 0.0f64, 0.0f64);
+    for ((g, _), (r, i1)) in got.iter().zip(reference) {
+        if *r > 1e-9 {
+            let e = (g - r).abs() / r;
+            sum += e;
+            count += 1;
+            worst = worst.max(e);
+            worst_i1 = worst_i1.max((g - r).abs() / i1.max(1e-12));
+        }
+    }
+    (sum / count.max(1) as f64, worst, worst_i1)
+}
+
+/// `(I_2, I_1)` (channel 0) of `method` over the direction set.
+fn eval(m: &AnalyticModel, method: SecondaryMethod) -> Vec<(f64, f64)> {
+    let opts = SecondaryOptions {
+        method,
+        kernel: Kernel::Radiometric,
+    };
+    secondary_direction_set()
+        .par_iter()
+        .map(|&(wi, wo)| {
+            let r = m.eval_with(wi, wo, Some(&opts));
+            (r.secondary.expect("asked for").total()[0], r.direct()[0])
+        })
+        .collect()
+}
+
+fn reference(m: &AnalyticModel) -> Vec<(f64, f64)> {
+    eval(
+        m,
+        SecondaryMethod::Analytic {
+            ranges: Ranges::Full,
+            orders: REFERENCE,
+        },
+    )
+}
+
+/// `cargo xtask ir-accuracy --scan`: the mean and worst error of the two-level sampling over a
+/// grid of settings (first-level samples, step, both solid angles; l0 3) and of the analytic
+/// solution over a grid of orders, on the surface of the criterion comparison (parallel, n 10)
+/// and on the twill. A setting's cost grows with its patches (first-level samples / step^2):
+/// the sampling settings of `secondary_vs_sampling` are the cheapest at or under 2% mean error
+/// here. Prints only.
+pub fn scan(root: &Path) {
+    let surfaces = [
+        ("parallel, n 10", crate::ch5::pf(10.0, 0.7)),
+        (
+            "twill",
+            Fabric::from_path(&root.join("tables/twill.json")).expect("the shipped twill"),
+        ),
+    ];
+    for (name, fabric) in surfaces {
+        let m = AnalyticModel::new(&fabric, FacetModel::Huo);
+        let reference = reference(&m);
+        println!("\n{name}\n\n| method | patches / 1000 | mean error | worst error |");
+        println!("|---|---|---|---|");
+        let row = |label: String, cost: String, method| {
+            let (mean, worst, _) = errors(&eval(&m, method), &reference);
+            println!(
+                "| {label} | {cost} | {:.2}% | {:.2}% |",
+                100.0 * mean,
+                100.0 * worst
+            );
+        };
+        for exact in [true, false] {
+            for first in [8, 12, 16, 20, 24, 28, 32, 40, 48] {
+                for step in [0.12, 0.15, 0.17, 0.2, 0.25, 0.3] {
+                    let label = format!(
+                        "sampling {first}, {step}, l0 3{}",
+                        if exact { "" } else { ", eq. 5.16" }
+                    );
+                    let cost = format!("{:.2}", first as f64 / (step * step) / 1000.0);
+                    row(label, cost, sampling(first, step, 3.0, exact));
+                }
+            }
+        }
+        for theta in [4, 5, 6, 7, 8, 11] {
+            for beta in [2, 3, 4, 5] {
+                for axial in [2, 3] {
+                    let o = Orders {
+                        theta,
+                        tol: 0.0,
+                        beta,
+                        axial,
+                    };
+                    let method = SecondaryMethod::Analytic {
+                        ranges: Ranges::Full,
+                        orders: o,
+                    };
+                    row(
+                        format!("analytic {theta}, {beta}, {axial}"),
+                        "".into(),
+                        method,
+                    );
+                }
+            }
+        }
+    }
 }
 
 pub fn run(root: &Path) {
-    let dirs = secondary_direction_set();
     let mut surfaces: Vec<(String, Fabric)> = [1.0, 10.0, 50.0]
         .iter()
-        .map(|&n| (format!("parallel, n {n}"), parallel(n)))
+        .map(|&n| (format!("parallel, n {n}"), crate::ch5::pf(n, 0.7)))
         .collect();
     surfaces.push((
         "twill (tables/twill.json)".into(),
@@ -82,39 +195,14 @@ pub fn run(root: &Path) {
     writeln!(table, "|---|---|---|---|---|").unwrap();
     for (name, fabric) in &surfaces {
         let m = AnalyticModel::new(fabric, FacetModel::Huo);
-        let opts = |method| SecondaryOptions {
-            method,
-            kernel: Kernel::Radiometric,
-        };
-        let eval = |method: SecondaryMethod| -> Vec<(f64, f64)> {
-            dirs.par_iter()
-                .map(|&(wi, wo)| {
-                    let r = m.eval_with(wi, wo, Some(&opts(method)));
-                    (r.secondary.expect("asked for").total()[0], r.direct()[0])
-                })
-                .collect()
-        };
-        let reference = eval(SecondaryMethod::Analytic {
-            ranges: Ranges::Full,
-            orders: REFERENCE,
-        });
+        let reference = reference(&m);
         for (label, method) in methods() {
-            let got = eval(method);
-            let (mut sum, mut count, mut worst, mut worst_i1) = (0.0, 0, 0.0f64, 0.0f64);
-            for ((g, _), (r, i1)) in got.iter().zip(&reference) {
-                if *r > 1e-9 {
-                    let e = (g - r).abs() / r;
-                    sum += e;
-                    count += 1;
-                    worst = worst.max(e);
-                    worst_i1 = worst_i1.max((g - r).abs() / i1.max(1e-12));
-                }
-            }
+            let (mean, worst, worst_i1) = errors(&eval(&m, method), &reference);
             let pct = |x: f64| format!("{:.2}%", 100.0 * x);
             writeln!(
                 table,
                 "| {name} | {label} | {} | {} | {} |",
-                pct(sum / count.max(1) as f64),
+                pct(mean),
                 pct(worst),
                 pct(worst_i1)
             )

@@ -12,7 +12,8 @@
 //! * `loader-accuracy`: the loader's interpolation error on the twill for several grids, into
 //!   the table of `docs/loader.md` (between its `loader-accuracy` markers).
 //! * `ir-accuracy`: the secondary reflection's analytic orders and two-level sampling settings
-//!   against a converged rule, into the table of `docs/interreflection.md`.
+//!   against a converged rule, into the table of `docs/interreflection.md`; with `--scan`, a grid
+//!   of sampling settings and analytic orders on the benchmark's surface (printed only).
 
 use clothbake::bake::{bake, BakeOptions};
 use clothbake::golden::{bake_golden, golden_path, shipped_fabrics};
@@ -44,10 +45,13 @@ fn main() {
         "golden" => golden(),
         "bench-bake" => bench_bake(std::env::args().skip(2).any(|a| a == "--bounces-2")),
         "loader-accuracy" => loader_accuracy(),
+        "ir-accuracy" if std::env::args().skip(2).any(|a| a == "--scan") => {
+            ir_accuracy::scan(&root())
+        }
         "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask validate | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy"
+                "usage: cargo xtask validate | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
             );
             std::process::exit(2);
         }

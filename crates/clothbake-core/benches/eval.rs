@@ -91,54 +91,84 @@ fn secondary(c: &mut Criterion) {
     }
 }
 
-/// The analytic secondary reflection against the two-level sampling, side by side on the
-/// parallel-cylinder surface with the thesis's sec. 5.4 facets (rho_d 0.4, rho_s 0.7, n 10),
-/// over the direction set of `cargo xtask ir-accuracy` (whose table gives each setting's
-/// error): default and fast orders; sampling with 0.2 and 0.15 steps over |y| <= 3.
+/// The analytic secondary reflection against the two-level sampling, side by side over the
+/// direction set of `cargo xtask ir-accuracy` (whose table gives each setting's error), with
+/// the thesis's sec. 5.4 facets (rho_d 0.4, rho_s 0.7, n 10) on the parallel-cylinder surface,
+/// and on the twill: default and fast orders, and the floor of the analytic rule (one node
+/// asked for everywhere: what the per-pair and per-point work costs whatever the orders); the
+/// sampling with exact solid angles (the thesis's) and with eq. 5.16, all over |y| <= 3, at the
+/// cheapest settings at or under 2% mean error of `cargo xtask ir-accuracy --scan` (and, on the
+/// parallel surface, at steps 0.2 and 0.15 with 32 first-level samples).
 fn secondary_vs_sampling(c: &mut Criterion) {
     let json = r#"{"pattern": [[1]], "warp": {"radius": 1, "spacing": 2,
         "material": {"albedo": 0.4, "specular": 0.7, "exponent": 10}},
         "weft": {"radius": 1, "spacing": 2}}"#;
-    let m = AnalyticModel::new(
-        &Fabric::from_json_str(json, "parallel").unwrap(),
-        FacetModel::Huo,
-    );
-    let dirs = secondary_direction_set();
+    let parallel = Fabric::from_json_str(json, "parallel").unwrap();
     let analytic = |orders| SecondaryMethod::Analytic {
         ranges: Ranges::Full,
         orders,
     };
-    let sampling = |step| {
+    let sampling = |first_level, step, exact_solid_angle| {
         SecondaryMethod::Sampling(Sampling {
-            first_level: 32,
+            first_level,
             d_alpha: step,
             d_l: step,
             l0: 3.0,
-            exact_solid_angle: true,
+            exact_solid_angle,
         })
     };
-    let mut g = c.benchmark_group("secondary_vs_sampling");
-    for (name, method, samples) in [
+    let floor = Orders {
+        theta: 1,
+        tol: 0.0,
+        beta: 1,
+        axial: 1,
+    };
+    let analytic_rows = [
         ("analytic_default", analytic(Orders::default()), 100),
         ("analytic_fast", analytic(ORDERS_FAST), 100),
-        ("sampling_0.2", sampling(0.2), 10),
-        ("sampling_0.15", sampling(0.15), 10),
-    ] {
-        g.sample_size(samples);
-        let opts = SecondaryOptions {
-            method,
-            kernel: Kernel::Radiometric,
-        };
-        g.bench_function(name, |b| {
-            let mut k = 0;
-            b.iter(|| {
-                let (wi, wo) = dirs[k % dirs.len()];
-                k += 1;
-                black_box(m.eval_with(black_box(wi), black_box(wo), Some(&opts)))
-            })
-        });
+        ("analytic_floor", analytic(floor), 100),
+    ];
+    let surfaces = [
+        (
+            "secondary_vs_sampling",
+            parallel,
+            vec![
+                ("sampling_0.2", sampling(32, 0.2, true), 10),
+                ("sampling_0.15", sampling(32, 0.15, true), 10),
+                ("sampling_24_0.17", sampling(24, 0.17, true), 10),
+                ("sampling_eq516_28_0.15", sampling(28, 0.15, false), 10),
+            ],
+        ),
+        (
+            "secondary_vs_sampling_twill",
+            twill(),
+            vec![
+                ("sampling_12_0.2", sampling(12, 0.2, true), 10),
+                ("sampling_eq516_16_0.2", sampling(16, 0.2, false), 10),
+            ],
+        ),
+    ];
+    let dirs = secondary_direction_set();
+    for (group, fabric, rows) in surfaces {
+        let m = AnalyticModel::new(&fabric, FacetModel::Huo);
+        let mut g = c.benchmark_group(group);
+        for (name, method, samples) in analytic_rows.iter().cloned().chain(rows) {
+            g.sample_size(samples);
+            let opts = SecondaryOptions {
+                method,
+                kernel: Kernel::Radiometric,
+            };
+            g.bench_function(name, |b| {
+                let mut k = 0;
+                b.iter(|| {
+                    let (wi, wo) = dirs[k % dirs.len()];
+                    k += 1;
+                    black_box(m.eval_with(black_box(wi), black_box(wo), Some(&opts)))
+                })
+            });
+        }
+        g.finish();
     }
-    g.finish();
 }
 
 criterion_group!(

@@ -401,11 +401,11 @@ pub struct Orders {
     pub axial: usize,
 }
 
-/// Cheaper orders for percent-level accuracy (about 2% mean error of I_2 on the table of
+/// Cheaper orders for percent-level accuracy (under 2% mean error of I_2 on the table of
 /// `docs/interreflection.md`): the analytic side of the comparison with the two-level
 /// sampling at equal accuracy.
 pub const ORDERS_FAST: Orders = Orders {
-    theta: 6,
+    theta: 7,
     tol: 0.0,
     beta: 3,
     axial: 3,
