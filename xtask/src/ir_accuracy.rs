@@ -117,7 +117,7 @@ fn reference(m: &AnalyticModel) -> Vec<(f64, f64)> {
 /// `cargo xtask ir-accuracy --scan`: the mean and worst error of the two-level sampling over a
 /// grid of settings (first-level samples, step, both solid angles; l0 3) and of the analytic
 /// solution over a grid of orders, on the surface of the criterion comparison (parallel, n 10)
-/// and on the twill. A setting's cost grows with its patches (first-level samples / step^2):
+/// and on the twill. A setting's cost grows with its patches, about first-level samples / step^2:
 /// the sampling settings of `secondary_vs_sampling` are the cheapest at or under 2% mean error
 /// here. Prints only.
 pub fn scan(root: &Path) {
@@ -131,7 +131,7 @@ pub fn scan(root: &Path) {
     for (name, fabric) in surfaces {
         let m = AnalyticModel::new(&fabric, FacetModel::Huo);
         let reference = reference(&m);
-        println!("\n{name}\n\n| method | patches / 1000 | mean error | worst error |");
+        println!("\n{name}\n\n| method | first-level samples / step^2 / 1000 | mean error | worst error |");
         println!("|---|---|---|---|");
         let row = |label: String, cost: String, method| {
             let (mean, worst, _) = errors(&eval(&m, method), &reference);
