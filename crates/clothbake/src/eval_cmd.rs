@@ -17,10 +17,21 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
         ));
     }
     let opts = args.bounces.options()?;
-    if args.method == Method::Raytrace && args.bounces.secondary.is_some() {
+    let b = &args.bounces;
+    let solution = [
+        ("--secondary", b.secondary.is_some()),
+        ("--orders", b.orders.is_some()),
+        ("--sampling", b.sampling.is_some()),
+    ];
+    if let (Method::Raytrace, Some((flag, _))) =
+        (args.method, solution.iter().find(|(_, given)| *given))
+    {
         return Err(CliError::new(
-            "--secondary chooses the analytic model's solution; with --method raytrace the path tracer computes I_2",
-            "drop --secondary or use --method analytic",
+            format!(
+                "{flag} sets the analytic model's solution of I_2; with --method raytrace the \
+                 path tracer computes I_2"
+            ),
+            format!("drop {flag} or use --method analytic"),
         ));
     }
     let kernel = opts.kernel;

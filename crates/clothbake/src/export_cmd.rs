@@ -109,6 +109,8 @@ fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
         ("--bounces", b.bounces != 1),
         ("--secondary", b.secondary.is_some()),
         ("--kernel", b.kernel.is_some()),
+        ("--orders", b.orders.is_some()),
+        ("--sampling", b.sampling.is_some()),
         ("--albedo", m.albedo.is_some()),
         ("--specular", m.specular.is_some()),
         ("--exponent", m.exponent.is_some()),

@@ -66,12 +66,15 @@ fn check_model_only(b: &BrdfArgs) -> Result<(), CliError> {
     let model_only = b.bounces.bounces != 1
         || b.bounces.secondary.is_some()
         || b.bounces.kernel.is_some()
+        || b.bounces.orders.is_some()
+        || b.bounces.sampling.is_some()
         || b.component != ComponentArg::Total
         || b.material != Default::default();
     if model_only {
         return Err(CliError::new(
-            "--bounces, --secondary, --kernel, --component and the material overrides apply \
-             only to the model (--weave); a table already holds its BRDF",
+            "--bounces, --secondary, --kernel, --orders, --sampling, --component and the \
+             material overrides apply only to the model (--weave); a table already holds its \
+             BRDF",
             "drop them, or bake a table with those options",
         ));
     }

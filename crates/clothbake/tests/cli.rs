@@ -437,6 +437,10 @@ fn orders_and_sampling_flags_set_the_secondary_reflection() {
             &["--sampling", "--secondary raytrace"],
         ),
         (
+            &["--bounces", "2", "--method", "raytrace", "--orders", "fast"],
+            &["--orders", "path tracer", "--method analytic"],
+        ),
+        (
             &["--bounces", "2", "--orders", "0,5,3"],
             &["THETA 0", "1 to 64"],
         ),
@@ -568,6 +572,12 @@ fn export_from_a_table_and_spectral_export() {
         &clothbake(&["export", "--table", t, "--rgl", rgb, "--bounces", "2"]),
         &["--bounces applies to the model"],
     );
+    for flag in [["--orders", "fast"], ["--sampling", "32,0.2,1.5,exact"]] {
+        fails(
+            &clothbake(&[&["export", "--table", t, "--rgl", rgb][..], &flag].concat()),
+            &[&format!("{} applies to the model", flag[0])],
+        );
+    }
     fails(
         &clothbake(&["export", "--table", t, "--rgl", rgb, "--rgl-spectral", rgb]),
         &["same file", "own output path"],

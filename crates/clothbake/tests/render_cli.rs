@@ -127,6 +127,18 @@ fn render_and_plot_refuse_bad_requests_with_one_line() {
         ]),
         &["only to the model"],
     );
+    fails(
+        &clothbake(&[
+            "render",
+            "--table",
+            t.to_str().unwrap(),
+            "--orders",
+            "fast",
+            "-o",
+            o,
+        ]),
+        &["--orders", "only to the model"],
+    );
     let missing = temp("missing.exr");
     fails(
         &clothbake(&["render", "--table", missing.to_str().unwrap(), "-o", o]),
