@@ -631,12 +631,24 @@ pub struct BounceArgs {
 }
 
 impl BounceArgs {
+    /// The first of --secondary, --kernel, --orders and --sampling given, if any: the flags
+    /// that set the secondary reflection (what --bounces 2 needs, and a table refuses).
+    pub fn secondary_flag(&self) -> Option<&'static str> {
+        [
+            ("--secondary", self.secondary.is_some()),
+            ("--kernel", self.kernel.is_some()),
+            ("--orders", self.orders.is_some()),
+            ("--sampling", self.sampling.is_some()),
+        ]
+        .into_iter()
+        .find_map(|(flag, given)| given.then_some(flag))
+    }
+
     /// The secondary-reflection options (also for --bounces 1, where they are unused); an
     /// error when --secondary, --kernel, --orders or --sampling is given without --bounces 2,
     /// --orders with the sampling or --sampling with the analytic solution.
     pub fn options(&self) -> Result<SecondaryOptions, CliError> {
-        let tuned = self.orders.is_some() || self.sampling.is_some();
-        if self.bounces == 1 && (self.secondary.is_some() || self.kernel.is_some() || tuned) {
+        if self.bounces == 1 && self.secondary_flag().is_some() {
             return Err(CliError::new(
                 "--secondary, --kernel, --orders and --sampling apply only to the secondary \
                  reflection",
@@ -689,17 +701,21 @@ pub fn parse_orders(s: &str) -> Result<Orders, String> {
             parts.len()
         ));
     };
-    let order = |p: &str, name: &str, max: usize| match p.parse::<usize>() {
-        Ok(x) if (1..=max).contains(&x) => Ok(x),
-        Ok(x) => Err(format!("{name} {x} is outside 1 to {max}; {FIX}")),
-        Err(_) => Err(format!("{name} `{p}` is not a whole number; {FIX}")),
-    };
     Ok(Orders {
-        theta: order(t, "THETA", 64)?,
+        theta: whole_in(t, "THETA", 64, FIX)?,
         tol: 0.0,
-        beta: order(b, "BETA", 64)?,
-        axial: order(a, "AXIAL", 16)?,
+        beta: whole_in(b, "BETA", 64, FIX)?,
+        axial: whole_in(a, "AXIAL", 16, FIX)?,
     })
+}
+
+/// A whole number from 1 to `max` named `name`, or the error with `fix`.
+fn whole_in(p: &str, name: &str, max: usize, fix: &str) -> Result<usize, String> {
+    match p.parse::<usize>() {
+        Ok(x) if (1..=max).contains(&x) => Ok(x),
+        Ok(x) => Err(format!("{name} {x} is outside 1 to {max}; {fix}")),
+        Err(_) => Err(format!("{name} `{p}` is not a whole number; {fix}")),
+    }
 }
 
 /// Parses `--sampling N,STEP,L0,exact|area`: N first-level samples (1 to 10000), a step in
@@ -714,11 +730,7 @@ pub fn parse_sampling(s: &str) -> Result<Sampling, String> {
             parts.len()
         ));
     };
-    let first_level = match n.parse::<usize>() {
-        Ok(x) if (1..=10_000).contains(&x) => x,
-        Ok(x) => return Err(format!("N {x} is outside 1 to 10000; {FIX}")),
-        Err(_) => return Err(format!("N `{n}` is not a whole number; {FIX}")),
-    };
+    let first_level = whole_in(n, "N", 10_000, FIX)?;
     let within = |p: &str, name: &str, max: f64| {
         let x = number(p, name).map_err(|e| format!("{e}; {FIX}"))?;
         if x > 0.0 && x <= max {

@@ -104,19 +104,16 @@ fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
     let m = &args.material;
     let b = &args.bounces;
     let given = [
-        ("--facet", args.facet.is_some()),
-        ("--variant", args.variant.is_some()),
-        ("--bounces", b.bounces != 1),
-        ("--secondary", b.secondary.is_some()),
-        ("--kernel", b.kernel.is_some()),
-        ("--orders", b.orders.is_some()),
-        ("--sampling", b.sampling.is_some()),
-        ("--albedo", m.albedo.is_some()),
-        ("--specular", m.specular.is_some()),
-        ("--exponent", m.exponent.is_some()),
+        args.facet.is_some().then_some("--facet"),
+        args.variant.is_some().then_some("--variant"),
+        (b.bounces != 1).then_some("--bounces"),
+        b.secondary_flag(),
+        m.albedo.is_some().then_some("--albedo"),
+        m.specular.is_some().then_some("--specular"),
+        m.exponent.is_some().then_some("--exponent"),
     ];
-    match given.iter().find(|(_, on)| *on) {
-        Some((flag, _)) => Err(CliError::new(
+    match given.into_iter().flatten().next() {
+        Some(flag) => Err(CliError::new(
             format!("{flag} applies to the model, not to a table"),
             "drop it (a table holds what it was baked with), or export the model with --weave",
         )),

@@ -64,10 +64,7 @@ fn table_shader(path: &Path) -> Result<Box<dyn Shader>, CliError> {
 /// Options that only apply to the model, given with --table.
 fn check_model_only(b: &BrdfArgs) -> Result<(), CliError> {
     let model_only = b.bounces.bounces != 1
-        || b.bounces.secondary.is_some()
-        || b.bounces.kernel.is_some()
-        || b.bounces.orders.is_some()
-        || b.bounces.sampling.is_some()
+        || b.bounces.secondary_flag().is_some()
         || b.component != ComponentArg::Total
         || b.material != Default::default();
     if model_only {
