@@ -934,6 +934,13 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
     if endless {
         axial_nodes(-FRAC_PI_2, FRAC_PI_2, centres, nu, true, &mut shared);
     }
+    // The rule of a line of finite extent, rebuilt for every line: one buffer for the call
+    // (`inner` runs one point at a time, so the borrow never overlaps).
+    let own_rule = std::cell::RefCell::new(AxialNodes::with_capacity(if endless {
+        0
+    } else {
+        4 * nu + 4
+    }));
     // J(theta) times (N_i . E) r1: the inner double integral over C2 for one point of C1.
     let inner = |t: f64| -> Parts {
         let mut acc = Parts::default();
@@ -959,7 +966,7 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
         // of width ~ the gap between P_i and C2.
         let gap = (dist - pair.r2).max(0.0) / pair.r2;
         let bcuts = [pk.map_or(f64::NAN, |p| near(p.1))];
-        let mut own = AxialNodes::with_capacity(if endless { 0 } else { 4 * nu + 4 });
+        let mut own = own_rule.borrow_mut();
         graded_panels(
             barc.lo,
             barc.hi,
@@ -996,7 +1003,7 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
                 } else {
                     let (a, b) = (AxialEnd::of(ylo / d), AxialEnd::of(yhi / d));
                     axial_nodes(a.u, b.u, centres, nu, false, &mut own);
-                    (cos_power(a, b), &own)
+                    (cos_power(a, b), &*own)
                 };
                 acc.add_scaled(&line_integral(pair, s, &ln, facets, cos_int, nodes), wb);
             },
