@@ -112,10 +112,6 @@ fn cloth(root: &Path, dir: &Path, bounces: u32, size: u32, aa: u32, name: &str) 
     eprintln!("{name}: {:.1} s", start.elapsed().as_secs_f64());
 }
 
-fn parallel(n: f64) -> Fabric {
-    crate::ch5::pf(n, 0.7)
-}
-
 fn disks(dir: &Path, size: u32) {
     let start = Instant::now();
     let t = 75f64.to_radians();
@@ -134,7 +130,7 @@ fn disks(dir: &Path, size: u32) {
             .iter()
             .map(|&n| {
                 let s = ModelShader::new(
-                    &parallel(n),
+                    &crate::ch5::pf(n, 0.7),
                     FacetModel::Huo,
                     Variant::Refined,
                     Some(SecondaryOptions::default()),

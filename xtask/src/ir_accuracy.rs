@@ -21,16 +21,21 @@ const REFERENCE: Orders = Orders {
     axial: 24,
 };
 
-/// A two-level sampling setting: first-level samples, angular and axial step, axial half-length,
-/// exact (Siegel & Howell) or eq. 5.16 solid angles.
-fn sampling(first: usize, step: f64, l0: f64, exact: bool) -> SecondaryMethod {
-    SecondaryMethod::Sampling(Sampling {
+/// A two-level sampling setting and its label: first-level samples, angular and axial step,
+/// axial half-length, exact (Siegel & Howell) or eq. 5.16 solid angles.
+fn sampling(first: usize, step: f64, l0: f64, exact: bool) -> (String, SecondaryMethod) {
+    let label = format!(
+        "sampling {first}, {step}, l0 {l0}{}",
+        if exact { "" } else { ", eq. 5.16" }
+    );
+    let method = SecondaryMethod::Sampling(Sampling {
         first_level: first,
         d_alpha: step,
         d_l: step,
         l0,
         exact_solid_angle: exact,
-    })
+    });
+    (label, method)
 }
 
 /// The methods of the table: name and method.
@@ -40,37 +45,26 @@ fn methods() -> Vec<(String, SecondaryMethod)> {
         orders: o,
     };
     let fast = clothbake_core::interreflection::ORDERS_FAST;
-    vec![
+    let (thesis, thesis_method) = sampling(32, 0.2, 1.5, true);
+    let mut rows = vec![
         (
             "analytic, default orders".into(),
             analytic(Orders::default()),
         ),
         ("analytic, fast orders".into(), analytic(fast)),
-        (
-            "sampling 32, 0.2, l0 1.5 (thesis)".into(),
-            sampling(32, 0.2, 1.5, true),
-        ),
-        (
-            "sampling 32, 0.2, l0 3".into(),
-            sampling(32, 0.2, 3.0, true),
-        ),
-        (
-            "sampling 32, 0.15, l0 3".into(),
-            sampling(32, 0.15, 3.0, true),
-        ),
-        (
-            "sampling 24, 0.17, l0 3".into(),
-            sampling(24, 0.17, 3.0, true),
-        ),
-        (
-            "sampling 28, 0.15, l0 3, eq. 5.16".into(),
-            sampling(28, 0.15, 3.0, false),
-        ),
-        (
-            "sampling 64, 0.1, l0 3".into(),
-            sampling(64, 0.1, 3.0, true),
-        ),
-    ]
+        (format!("{thesis} (thesis)"), thesis_method),
+    ];
+    rows.extend(
+        [
+            (32, 0.2, true),
+            (32, 0.15, true),
+            (24, 0.17, true),
+            (28, 0.15, false),
+            (64, 0.1, true),
+        ]
+        .map(|(first, step, exact)| sampling(first, step, 3.0, exact)),
+    );
+    rows
 }
 
 /// Mean and worst relative error of `got` against `reference` (pairs whose reference I_2 is
@@ -144,12 +138,9 @@ pub fn scan(root: &Path) {
         for exact in [true, false] {
             for first in [8, 12, 16, 20, 24, 28, 32, 40, 48] {
                 for step in [0.12, 0.15, 0.17, 0.2, 0.25, 0.3] {
-                    let label = format!(
-                        "sampling {first}, {step}, l0 3{}",
-                        if exact { "" } else { ", eq. 5.16" }
-                    );
+                    let (label, method) = sampling(first, step, 3.0, exact);
                     let cost = format!("{:.2}", first as f64 / (step * step) / 1000.0);
-                    row(label, cost, sampling(first, step, 3.0, exact));
+                    row(label, cost, method);
                 }
             }
         }

@@ -13,7 +13,8 @@
 //!   the table of `docs/loader.md` (between its `loader-accuracy` markers).
 //! * `ir-accuracy`: the secondary reflection's analytic orders and two-level sampling settings
 //!   against a converged rule, into the table of `docs/interreflection.md`; with `--scan`, a grid
-//!   of sampling settings and analytic orders on the benchmark's surface (printed only).
+//!   of sampling settings and analytic orders on the benchmark's surfaces, the parallel
+//!   cylinders and the twill (printed only).
 
 use clothbake::bake::{bake, BakeOptions};
 use clothbake::golden::{bake_golden, golden_path, shipped_fabrics};
