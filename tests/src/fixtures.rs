@@ -17,11 +17,13 @@ pub fn temp_dir(name: &str) -> PathBuf {
 /// that the three channels differ.
 pub fn coloured_twill() -> Fabric {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/twill.json");
-    let mut f = Fabric::from_path(&path).expect("the shipped twill reads");
-    for g in [&mut f.warp, &mut f.weft] {
-        g.material.albedo = [0.6, 0.3, 0.12];
-    }
-    f
+    Fabric::from_path(&path)
+        .expect("the shipped twill reads")
+        .with_groups(
+            |_, g| g.material.albedo = [0.6, 0.3, 0.12],
+            &clothbake_core::PlainNaming("twill"),
+        )
+        .expect("albedos in [0, 1]")
 }
 
 /// Bakes `fabric` with the default options (analytic model, default grid), writes the table to

@@ -92,8 +92,8 @@ fn shipped_tables_load_and_build_their_geometry() {
     } in SHIPPED
     {
         let f = load(name);
-        assert_eq!(f.name, name);
-        assert_eq!((f.weave.n_warp(), f.weave.n_weft()), (nw, nf), "{name}");
+        assert_eq!(f.name(), name);
+        assert_eq!((f.weave().n_warp(), f.weave().n_weft()), (nw, nf), "{name}");
         let geo = Geometry::new(&f);
         assert!(!geo.segments.is_empty(), "{name}");
         assert!(
@@ -134,8 +134,8 @@ fn shipped_tables_use_the_thesis_material() {
     );
     for Shipped { name, .. } in SHIPPED {
         let f = load(name);
-        assert_eq!(f.warp.material, thesis, "{name}");
-        assert_eq!(f.weft.material, thesis, "{name}");
+        assert_eq!(f.warp().material, thesis, "{name}");
+        assert_eq!(f.weft().material, thesis, "{name}");
         // Written out explicitly in the file, not left to the defaults.
         let text = std::fs::read_to_string(tables_dir().join(format!("{name}.json"))).unwrap();
         let v: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -164,7 +164,7 @@ fn weaves_are_what_their_names_say() {
         ("twill31", 3, 1),
         ("satin5", 4, 1),
     ] {
-        let w = load(name).weave;
+        let w = load(name).weave().clone();
         for (g, want) in [(Group::Warp, warp_f), (Group::Weft, weft_f)] {
             for t in 0..w.n(g) {
                 let fl = w.floats(g, t);
@@ -176,14 +176,14 @@ fn weaves_are_what_their_names_say() {
         }
     }
     // Satin: no two interlacings of neighbouring wefts are adjacent (move number 2 or 3).
-    let w = load("satin5").weave;
+    let w = load("satin5").weave().clone();
     let under = |r: usize| (0..5).find(|&c| !w.warp_over(c, r)).unwrap();
     for r in 0..5 {
         let d = (under((r + 1) % 5) + 5 - under(r)) % 5;
         assert!(d == 2 || d == 3, "row {r}: move {d}");
     }
     // The parallel-cylinder surface: one endless warp, no weft float.
-    let w = load("parallel").weave;
+    let w = load("parallel").weave().clone();
     assert!(w.floats(Group::Warp, 0)[0].endless);
     assert!(w.floats(Group::Weft, 0).is_empty());
 }

@@ -2,7 +2,7 @@
 //! per-thread albedos, channel by channel.
 
 use clothbake_core::validate::direction_set;
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, UnitVec3};
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, Group, RayTracer, UnitVec3};
 use std::path::Path;
 
 fn load(name: &str) -> Fabric {
@@ -19,9 +19,19 @@ fn dir(theta: f64, phi: f64) -> UnitVec3 {
 /// The diffuse intensity split into what the warp and the weft reflect: the model evaluated
 /// with unit albedo on one group and zero on the other (the specular part is left out).
 fn split(f: &Fabric, wi: UnitVec3, wo: UnitVec3) -> (f64, f64) {
-    let mut probe = f.clone().with_material(f.warp.material);
-    probe.warp.material.albedo = [1.0, 0.0, 0.0];
-    probe.weft.material.albedo = [0.0, 1.0, 0.0];
+    let probe = f
+        .with_material(f.warp().material)
+        .unwrap()
+        .with_groups(
+            |g, y| {
+                y.material.albedo = match g {
+                    Group::Warp => [1.0, 0.0, 0.0],
+                    Group::Weft => [0.0, 1.0, 0.0],
+                }
+            },
+            &clothbake_core::PlainNaming("probe"),
+        )
+        .unwrap();
     let r = AnalyticModel::new(&probe, FacetModel::Huo).eval(wi, wo);
     (r.i_d[0], r.i_d[1])
 }
@@ -36,7 +46,7 @@ fn denim_diffuse_is_the_albedo_weighted_sum_of_warp_and_weft() {
         let (w, fw) = split(&f, wi, wo);
         let r = m.eval(wi, wo);
         for k in 0..3 {
-            let want = f.warp.material.albedo[k] * w + f.weft.material.albedo[k] * fw;
+            let want = f.warp().material.albedo[k] * w + f.weft().material.albedo[k] * fw;
             assert!(
                 (r.i_d[k] - want).abs() <= 1e-12 + 1e-9 * want,
                 "{k}: {r:?} {want}"
@@ -157,10 +167,12 @@ fn per_thread_colour_is_seen_where_the_thread_is() {
         "t",
     )
     .unwrap();
-    let grey = f.clone().with_material(clothbake_core::Material {
-        albedo: [0.45, 0.1, 0.45],
-        ..f.warp.material
-    });
+    let grey = f
+        .with_material(clothbake_core::Material {
+            albedo: [0.45, 0.1, 0.45],
+            ..f.warp().material
+        })
+        .unwrap();
     let (wi, wo) = (dir(30.0, 20.0), dir(40.0, 200.0));
     let a = AnalyticModel::new(&f, FacetModel::Huo).eval(wi, wo).total();
     let g = AnalyticModel::new(&grey, FacetModel::Huo)

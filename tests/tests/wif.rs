@@ -52,21 +52,21 @@ fn denim_is_the_warp_faced_3_1_twill() {
         vec![1, 0, 1, 1],
         vec![1, 1, 0, 1],
     ];
-    assert_eq!(f.weave.to_rows(), want);
+    assert_eq!(f.weave().to_rows(), want);
     // The same point paper as the hand-written JSON fabric of the 3/1 twill.
-    assert_eq!(load("twill31.json").weave, f.weave);
-    assert_eq!(f.name, "denim");
+    assert_eq!(load("twill31.json").weave(), f.weave());
+    assert_eq!(f.name(), "denim");
     // Indigo warp 21,46,110 and off-white weft 240,240,235 of 0..255, decoded from sRGB.
     let indigo = [lin(21.0, 255.0), lin(46.0, 255.0), lin(110.0, 255.0)];
     let white = [lin(240.0, 255.0), lin(240.0, 255.0), lin(235.0, 255.0)];
     for k in 0..3 {
-        assert!(close(f.warp.material.albedo[k], indigo[k]), "{k}");
-        assert!(close(f.weft.material.albedo[k], white[k]), "{k}");
+        assert!(close(f.warp().material.albedo[k], indigo[k]), "{k}");
+        assert!(close(f.weft().material.albedo[k], white[k]), "{k}");
     }
     // Published sRGB decodings: 240 -> 0.8714, 110 -> 0.1559.
     assert!((white[0] - 0.8714).abs() < 1e-4 && (indigo[2] - 0.1559).abs() < 1e-4);
     // Spacing 0.031 cm and thickness 0.030 cm: 0.31 mm centre to centre, radius 0.15 mm.
-    for g in [&f.warp, &f.weft] {
+    for g in [&f.warp(), &f.weft()] {
         for y in &g.threads {
             assert!(close(y.spacing, 0.31) && close(y.radius, 0.15), "{y:?}");
             assert_eq!(y.albedo, None);
@@ -79,9 +79,12 @@ fn denim_reflects_like_the_json_twill_of_the_same_proportions() {
     // twill31.json: radius 1.5, spacing 3.1, the ratio of denim.wif's 0.15 mm and 0.31 mm; only
     // ratios matter, so with denim's material the two give the same reflection.
     let wif = load("denim.wif");
-    let mut json = load("twill31.json");
-    json.warp.material = wif.warp.material;
-    json.weft.material = wif.weft.material;
+    let json = load("twill31.json")
+        .with_groups(
+            |g, y| y.material = wif.group(g).material,
+            &clothbake_core::PlainNaming("twill31"),
+        )
+        .unwrap();
     let (a, b) = (
         AnalyticModel::new(&wif, FacetModel::Huo),
         AnalyticModel::new(&json, FacetModel::Huo),
@@ -108,7 +111,7 @@ fn gingham_reduces_to_its_colour_repeat() {
     let want: Vec<Vec<u8>> = (0..8)
         .map(|j| (0..8).map(|i| ((i + j) % 2 == 0) as u8).collect())
         .collect();
-    assert_eq!(f.weave.to_rows(), want);
+    assert_eq!(f.weave().to_rows(), want);
     let red = [lin(800.0, 999.0), lin(80.0, 999.0), lin(80.0, 999.0)];
     let white = [lin(950.0, 999.0); 3];
     for g in [Group::Warp, Group::Weft] {
@@ -119,7 +122,7 @@ fn gingham_reduces_to_its_colour_repeat() {
         }
     }
     // 0.0125 inch spacing, 0.012 inch thickness.
-    let y = f.warp.threads[3];
+    let y = f.warp().threads[3];
     assert!(close(y.spacing, 0.0125 * 25.4) && close(y.radius, 0.006 * 25.4));
 }
 
@@ -135,13 +138,13 @@ fn twill22_liftplan_on_a_sinking_shed() {
         vec![1, 1, 0, 0],
         vec![0, 1, 1, 0],
     ];
-    assert_eq!(f.weave.to_rows(), want);
+    assert_eq!(f.weave().to_rows(), want);
     // No sizes and no colours in the draft: the documented defaults (0.31 mm, 0.30 mm thick;
     // the thesis's rho_d 0.4).
-    for y in f.warp.threads.iter().chain(&f.weft.threads) {
+    for y in f.warp().threads.iter().chain(&f.weft().threads) {
         assert!(close(y.spacing, 0.31) && close(y.radius, 0.15), "{y:?}");
     }
-    assert_eq!(f.warp.material.albedo, [0.4; 3]);
+    assert_eq!(f.warp().material.albedo, [0.4; 3]);
     // The same draft on a rising shed is the other face: every cell flipped.
     let text = std::fs::read_to_string(tables().join("twill22.wif")).unwrap();
     let rising = parse(
@@ -154,7 +157,7 @@ fn twill22_liftplan_on_a_sinking_shed() {
         .iter()
         .map(|r| r.iter().map(|&c| 1 - c).collect())
         .collect();
-    assert_eq!(rising.weave.to_rows(), flipped);
+    assert_eq!(rising.weave().to_rows(), flipped);
 }
 
 #[test]
@@ -165,11 +168,11 @@ fn options_fill_in_missing_sizes_only() {
         spacing: Some(0.25),
     };
     let f = parse(&text, "t.wif", &o).unwrap();
-    assert!(close(f.weft.threads[0].radius, 0.1) && close(f.weft.threads[0].spacing, 0.25));
+    assert!(close(f.weft().threads[0].radius, 0.1) && close(f.weft().threads[0].spacing, 0.25));
     // denim.wif gives both: the options do not override them.
     let text = std::fs::read_to_string(tables().join("denim.wif")).unwrap();
     let f = parse(&text, "d.wif", &o).unwrap();
-    assert!(close(f.warp.threads[0].radius, 0.15));
+    assert!(close(f.warp().threads[0].radius, 0.15));
 }
 
 #[test]
@@ -181,8 +184,8 @@ fn per_thread_sizes_give_centre_distances() {
         [THREADING]\n1=1\n2=2\n3=1\n4=2\n[LIFTPLAN]\n1=1\n2=2\n";
     let f = parse(body, "t.wif", &WifOptions::default()).unwrap();
     let dp = 25.4 / 720.0;
-    assert_eq!(f.weave.n_warp(), 2);
-    for y in &f.warp.threads {
+    assert_eq!(f.weave().n_warp(), 2);
+    for y in &f.warp().threads {
         assert!(
             close(y.spacing, 0.3 * dp) && close(y.radius, 0.1 * dp),
             "{y:?}"

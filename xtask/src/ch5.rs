@@ -247,11 +247,13 @@ fn convergence(out: &mut String, root: &std::path::Path) {
             let f = if name == "parallel" {
                 pf(n, rho_s)
             } else {
-                let mut f = Fabric::from_path(&root.join("tables/twill.json")).unwrap();
-                for g in [&mut f.warp, &mut f.weft] {
-                    g.material.exponent = n;
-                }
-                f
+                Fabric::from_path(&root.join("tables/twill.json"))
+                    .unwrap()
+                    .with_groups(
+                        |_, g| g.material.exponent = n,
+                        &clothbake_core::PlainNaming("twill"),
+                    )
+                    .unwrap()
             };
             let rt = RayTracer::new(&f, FacetModel::Huo);
             let mut ratio = [0.0; 5];

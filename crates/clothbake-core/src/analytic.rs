@@ -194,7 +194,7 @@ fn occluder_at(
 ) -> (Occluder, Option<(usize, i64)>) {
     let g = seg.group;
     let c = g.other();
-    let weave = &geo.fabric.weave;
+    let weave = &geo.fabric.weave();
     let (ng, nc) = (weave.n(g), weave.n(c));
     let tt = seg.thread as isize + dir * m;
     let p = geo.position(g, tt);
@@ -233,7 +233,7 @@ fn occluder_at(
 fn side_profile(geo: &Geometry, seg: &Segment, cross: isize, dir: isize) -> Vec<Occluder> {
     let mut out = Vec::new();
     let mut last_box = None;
-    for m in 1..=geo.fabric.weave.n(seg.group) as isize {
+    for m in 1..=geo.fabric.weave().n(seg.group) as isize {
         let (o, id) = occluder_at(geo, seg, m, cross, dir);
         if id.is_some() && id == last_box {
             continue;
@@ -249,7 +249,7 @@ fn side_profile(geo: &Geometry, seg: &Segment, cross: isize, dir: isize) -> Vec<
 fn end_profile(geo: &Geometry, seg: &Segment, top: f64, dir: isize) -> Vec<Occluder> {
     let g = seg.group;
     let c = g.other();
-    let weave = &geo.fabric.weave;
+    let weave = &geo.fabric.weave();
     let nc = weave.n(c);
     let (y0, y1) = seg.extent.expect("finite float");
     let (a, f) = (seg.float.start as isize, seg.float.len as isize);
@@ -344,7 +344,7 @@ impl AnalyticModel {
                         return None;
                     }
                     let t = seg.thread as isize + dir;
-                    let nt = rem(t, geo.fabric.weave.n(g));
+                    let nt = rem(t, geo.fabric.weave().n(g));
                     let yarn = geo.fabric.group(g).threads[nt];
                     let mid = 0.5 * (lo + hi);
                     let axial = match geo.segment_at(g, nt, k).map(|i| &geo.segments[i]) {
@@ -779,9 +779,9 @@ mod tests {
         let f = fabric(TWILL);
         let m = AnalyticModel::new(&f, FacetModel::Huo);
         // Same exponent given as a non-integer-looking path: 10 + 1e-13 is not an integer.
-        let mut mat = f.warp.material;
+        let mut mat = f.warp().material;
         mat.exponent = 10.0 + 1e-13;
-        let m2 = AnalyticModel::new(&f.clone().with_material(mat), FacetModel::Huo);
+        let m2 = AnalyticModel::new(&f.with_material(mat).unwrap(), FacetModel::Huo);
         for (a, b) in [
             ((30.0, 20.0), (45.0, 200.0)),
             ((60.0, 90.0), (10.0, 270.0)),

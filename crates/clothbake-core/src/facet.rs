@@ -4,9 +4,9 @@
 //! reflected radiance: I = pi f(l, e) (n.l) for a facet BRDF f. It is split into a part that
 //! scales with the diffuse albedo (returned without the albedo) and a specular part (white).
 
-use crate::fabric::Material;
 use crate::lanes::Real;
 use crate::vec3::Vec3;
+use crate::yarn::Material;
 use serde::{Deserialize, Serialize};
 
 /// The intensity a facet reflects: `diffuse` times the RGB albedo, plus `specular`.

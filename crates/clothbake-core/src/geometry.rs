@@ -9,7 +9,7 @@
 //! * Only floats are modelled (the thesis ignores the non-cylindrical parts of threads): a float of
 //!   a thread over crossing threads a..=b is one segment. Unless given, its extent along its axis
 //!   runs from the surface of the crossing thread before it to the surface of the one after it:
-//!   [P_{a-1} + r_{a-1}, P_{b+1} - r_{b+1}], so a float over f threads at spacing s between crossing
+//!   [P_{a-1} + r_{a-1}, P_{b+1} - r_{b+1}] (the rules live in [`crate::yarn`]), so a float over f threads at spacing s between crossing
 //!   threads of radius r is (f + 1) s - 2 r long (the thesis's twill: 3 * 3.1 - 3 = 6.3 and
 //!   2 * 3.1 - 3 = 3.2). A given `segment_length` is centred in that room.
 //! * Segment ends are flat caps (discs cut by the floor). A thread that never goes under is an
@@ -17,6 +17,7 @@
 
 use crate::fabric::Fabric;
 use crate::weave::{Float, Group};
+use crate::yarn::{float_extent, float_room};
 use std::f64::consts::PI;
 
 /// One cylinder segment (a float) of the period.
@@ -60,42 +61,6 @@ pub struct Geometry {
     pub segments: Vec<Segment>,
 }
 
-fn positions(spacings: impl Iterator<Item = f64>) -> (Vec<f64>, f64) {
-    let mut pos = Vec::new();
-    let mut acc = 0.0;
-    for s in spacings {
-        pos.push(acc);
-        acc += s;
-    }
-    (pos, acc)
-}
-
-/// Unwrapped position of thread `k` (any integer) of group `g`.
-pub fn thread_position(fabric: &Fabric, g: Group, k: isize) -> f64 {
-    let threads = &fabric.group(g).threads;
-    let n = threads.len() as isize;
-    let (pos, period) = positions(threads.iter().map(|t| t.spacing));
-    let q = k.div_euclid(n);
-    pos[k.rem_euclid(n) as usize] + q as f64 * period
-}
-
-/// Radius of thread `k` (any integer, taken modulo the period) of group `g`.
-pub fn thread_radius(fabric: &Fabric, g: Group, k: isize) -> f64 {
-    let threads = &fabric.group(g).threads;
-    threads[k.rem_euclid(threads.len() as isize) as usize].radius
-}
-
-/// The room a float of thread `t` of group `g` has between the surfaces of the crossing threads
-/// before and after it, along its axis (unwrapped coordinates).
-pub fn derived_float_extent(fabric: &Fabric, g: Group, _t: usize, fl: Float) -> (f64, f64) {
-    let c = g.other();
-    let a = fl.start as isize;
-    let b = a + fl.len as isize; // first crossing thread after the float
-    let lo = thread_position(fabric, c, a - 1) + thread_radius(fabric, c, a - 1);
-    let hi = thread_position(fabric, c, b) - thread_radius(fabric, c, b);
-    (lo, hi)
-}
-
 /// Area of a cylinder's cross-section above the floor, for radius `r` and axis height `h`.
 pub fn area_above_floor(r: f64, h: f64) -> f64 {
     let h = h.clamp(-r, r);
@@ -111,8 +76,8 @@ pub fn equal_area_height(r: f64, h: f64) -> f64 {
 impl Geometry {
     /// Builds the micro-geometry of a validated fabric.
     pub fn new(fabric: &Fabric) -> Geometry {
-        let (warp_pos, px) = positions(fabric.warp.threads.iter().map(|t| t.spacing));
-        let (weft_pos, py) = positions(fabric.weft.threads.iter().map(|t| t.spacing));
+        let (warp_pos, px) = fabric.warp().positions();
+        let (weft_pos, py) = fabric.weft().positions();
         let mut segments = Vec::new();
         for g in [Group::Warp, Group::Weft] {
             let pos = match g {
@@ -120,19 +85,10 @@ impl Geometry {
                 Group::Weft => &weft_pos,
             };
             for (t, yarn) in fabric.group(g).threads.iter().enumerate() {
-                for fl in fabric.weave.floats(g, t) {
-                    let extent = if fl.endless {
-                        None
-                    } else {
-                        let (lo, hi) = derived_float_extent(fabric, g, t, fl);
-                        Some(match yarn.segment_length {
-                            Some(len) => {
-                                let mid = 0.5 * (lo + hi);
-                                (mid - 0.5 * len, mid + 0.5 * len)
-                            }
-                            None => (lo, hi),
-                        })
-                    };
+                for fl in fabric.weave().floats(g, t) {
+                    let extent = (!fl.endless).then(|| {
+                        float_extent(float_room(fabric.group(g.other()), fl), yarn.segment_length)
+                    });
                     segments.push(Segment {
                         group: g,
                         thread: t,
@@ -183,8 +139,7 @@ impl Geometry {
     /// Index into `segments` of the float of thread `thread` (group `g`) covering crossing
     /// `cross` (any integer), or `None` when the thread is under there.
     pub fn segment_at(&self, g: Group, thread: usize, cross: isize) -> Option<usize> {
-        let n = self.fabric.weave.n(g.other()) as isize;
-        let n = n as usize;
+        let n = self.fabric.weave().n(g.other());
         let c = cross.rem_euclid(n as isize) as usize;
         self.segments.iter().position(|s| {
             s.group == g

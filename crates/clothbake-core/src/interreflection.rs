@@ -33,11 +33,11 @@
 //!   ranges (C_max = 0.3 around the peak, |y| <= l0 = 1.5).
 
 use crate::arc::Arc;
-use crate::fabric::Material;
 use crate::facet::{CosineFacet, Facet, FacetModel};
 use crate::lanes::{F64x2, Real};
 use crate::trig::{round_nearest, sin_cos};
 use crate::vec3::Vec3;
+use crate::yarn::Material;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Weight of the second bounce (see the module documentation).

@@ -78,9 +78,9 @@ fn weave_equal(w: &Weave, f: impl Fn(usize, usize) -> bool, sx: usize, sy: usize
 /// micro-geometry is invariant up to a translation by whole threads. Materials are per group,
 /// except per-thread albedos, which are part of each [`Yarn`] and so must map onto each other too.
 pub fn symmetries(fabric: &Fabric) -> Vec<Symmetry> {
-    let w = &fabric.weave;
+    let w = &fabric.weave();
     let (nx, ny) = (w.n_warp(), w.n_weft());
-    let (warp, weft) = (&fabric.warp.threads, &fabric.weft.threads);
+    let (warp, weft) = (&fabric.warp().threads, &fabric.weft().threads);
     let (rwarp, rweft) = (reversed(warp), reversed(weft));
     let mut out = Vec::new();
     for sym in [Symmetry::MirrorX, Symmetry::MirrorY, Symmetry::Rotate180] {
@@ -140,10 +140,18 @@ mod tests {
         let odd = fabric("[[1,1,1],[1,1,1]]", "[1.0, 1.2, 1.4]");
         assert_eq!(symmetries(&odd), vec![Symmetry::MirrorY]);
         // So do unequal per-thread colours: they are part of each thread.
-        let mut striped = fabric("[[1,1,1],[1,1,1]]", "1.5");
-        for (y, a) in striped.warp.threads.iter_mut().zip([0.1, 0.2, 0.3]) {
-            y.albedo = Some([a; 3]);
-        }
+        let striped = fabric("[[1,1,1],[1,1,1]]", "1.5")
+            .with_groups(
+                |g, yarns| {
+                    if g == crate::Group::Warp {
+                        for (y, a) in yarns.threads.iter_mut().zip([0.1, 0.2, 0.3]) {
+                            y.albedo = Some([a; 3]);
+                        }
+                    }
+                },
+                &crate::PlainNaming("striped"),
+            )
+            .unwrap();
         assert_eq!(symmetries(&striped), vec![Symmetry::MirrorY]);
     }
 

@@ -23,8 +23,10 @@
 //!   centre-to-centre distance of threads i and i+1 is (s_i + s_{i+1}) / 2. Missing sizes come
 //!   from [`WifOptions`] or the defaults of [`resolve_sizes`].
 
-use crate::fabric::{Fabric, FabricError, Material, Yarn, YarnGroup};
+use crate::fabric::{Fabric, FabricError, Field, Naming, PlainNaming};
+use crate::weave::Group;
 use crate::weave::Weave;
+use crate::yarn::{spacing_fits, Material, Yarn, YarnGroup};
 use std::fmt;
 
 /// Default spacing (mm) of a group when neither the draft nor the options give any size: the
@@ -632,12 +634,40 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
                 .file_stem()
                 .map_or("draft".into(), |s| s.to_string_lossy().into_owned())
         });
-    Ok(Fabric {
-        name,
-        weave,
-        warp: group(&d, "WARP", &warp[..px])?,
-        weft: group(&d, "WEFT", &weft[..py])?,
+    let warp = group(&d, "WARP", &warp[..px])?;
+    let weft = group(&d, "WEFT", &weft[..py])?;
+    Fabric::new(name, weave, warp, weft, &WifNaming(file)).map_err(|e| WifError {
+        file: e.file,
+        section: String::new(),
+        line: None,
+        problem: format!("{}: {}", e.field, e.problem),
+        fix: e.fix,
     })
+}
+
+/// Names a draft's fields by the WIF section and key they come from.
+struct WifNaming<'a>(&'a str);
+
+impl Naming for WifNaming<'_> {
+    fn file(&self) -> &str {
+        self.0
+    }
+
+    fn field(&self, g: Group, field: Field, thread: usize) -> String {
+        let s = match g {
+            Group::Warp => "WARP",
+            Group::Weft => "WEFT",
+        };
+        let t = thread + 1;
+        match field {
+            Field::Radius => format!("[{s}] Thickness (thread {t})"),
+            Field::Spacing => format!("[{s}] Spacing (thread {t})"),
+            Field::Height | Field::SegmentLength | Field::Specular | Field::Exponent => {
+                PlainNaming(self.0).field(g, field, thread)
+            }
+            Field::ThreadAlbedo(_) | Field::Albedo(_) => format!("[{s} COLORS] (thread {t})"),
+        }
+    }
 }
 
 /// The threads of one group: colours and sizes, per thread of the whole draft.
@@ -838,7 +868,7 @@ fn group(d: &Draft, g: &str, t: &[Thread]) -> Result<YarnGroup, WifError> {
         let next = &t[(i + 1) % n];
         let spacing = 0.5 * (t[i].spacing + next.spacing);
         let (r, r_next) = (0.5 * t[i].thickness, 0.5 * next.thickness);
-        if spacing < (r + r_next) * (1.0 - 1e-12) {
+        if !spacing_fits(spacing, r, r_next) {
             let what = if g == "WARP" { "ends" } else { "picks" };
             return Err(d.err(
                 g,
@@ -1014,9 +1044,9 @@ mod tests {
         // A [LIFTPLAN] marked false in [CONTENTS] is ignored: the treadling is woven.
         let body = format!("[CONTENTS]\nLIFTPLAN=false\n{PLAIN}[LIFTPLAN]\n1=1,2\n2=1,2\n");
         let f = parse(&draft(&body), "t.wif", &WifOptions::default()).unwrap();
-        assert_eq!(f.weave.to_rows(), vec![vec![1, 0], vec![0, 1]]);
+        assert_eq!(f.weave().to_rows(), vec![vec![1, 0], vec![0, 1]]);
         let body = format!("{PLAIN}[LIFTPLAN]\n1=1,2\n2=1,2\n");
         let f = parse(&draft(&body), "t.wif", &WifOptions::default()).unwrap();
-        assert_eq!(f.weave.to_rows(), vec![vec![1]]);
+        assert_eq!(f.weave().to_rows(), vec![vec![1]]);
     }
 }

@@ -49,7 +49,7 @@ pub fn bake(
         let pct = done * 100 / total;
         if shown.fetch_max(pct + 1, Ordering::Relaxed) < pct + 1 {
             let mut err = std::io::stderr().lock();
-            let _ = write!(err, "\rbaking {}: {pct:3}%", fabric.fabric.name);
+            let _ = write!(err, "\rbaking {}: {pct:3}%", fabric.fabric.name());
             if done >= total {
                 let _ = writeln!(err);
             }

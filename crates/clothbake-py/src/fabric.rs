@@ -99,7 +99,7 @@ impl PyFabric {
     /// The fabric's name.
     #[getter]
     fn name(&self) -> &str {
-        &self.fabric.name
+        self.fabric.name()
     }
 
     /// The fabric as a dict of the fabric-file schema, every field explicit.
@@ -109,7 +109,7 @@ impl PyFabric {
     }
 
     fn __repr__(&self) -> String {
-        format!("clothbake.Fabric({:?})", self.fabric.name)
+        format!("clothbake.Fabric({:?})", self.fabric.name())
     }
 
     /// f_r(wi, wo) in 1/sr, RGB, for unit vectors in the fabric's frame (+X weft, +Y warp,

@@ -5,7 +5,9 @@ use crate::error::CliError;
 use crate::report::{self, Report};
 use clothbake_core::pathtrace::PathOptions;
 use clothbake_core::Secondary;
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, Reflection};
+use clothbake_core::{
+    AnalyticModel, Fabric, FabricError, FacetModel, PlainNaming, RayTracer, Reflection,
+};
 use std::path::Path;
 
 /// Runs `clothbake eval` and returns the text to print on stdout.
@@ -95,7 +97,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
         reflection.brdf(wi)
     };
     let rep = Report {
-        fabric_name: &fabric.name,
+        fabric_name: fabric.name(),
         file: &args.weave,
         method: args.method,
         facet,
@@ -112,7 +114,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
 /// Reads the fabric of `--weave` (JSON or WIF draft, with the draft's size flags) and applies the
 /// material overrides.
 pub fn load_fabric(weave: &Path, draft: &DraftArgs, m: &MaterialArgs) -> Result<Fabric, CliError> {
-    if draft.any() && !clothbake_core::fabric::is_wif(weave) {
+    if draft.any() && !clothbake_core::source::is_wif(weave) {
         return Err(CliError::new(
             format!(
                 "--radius and --spacing apply only to a WIF draft (*.wif), and {} is a fabric file, which gives its sizes itself",
@@ -122,26 +124,31 @@ pub fn load_fabric(weave: &Path, draft: &DraftArgs, m: &MaterialArgs) -> Result<
         ));
     }
     let fabric = Fabric::from_path_with(weave, &draft.options())?;
-    Ok(apply_material(fabric, m))
+    Ok(apply_material(fabric, m)?)
 }
 
 /// Replaces the facet-material fields given on the command line, in both yarn groups; fields not
 /// given keep each group's value from the file. `--albedo` also replaces per-thread albedos.
 /// (The values were range-checked by the parsers.)
-pub fn apply_material(mut fabric: Fabric, m: &MaterialArgs) -> Fabric {
-    for g in [&mut fabric.warp, &mut fabric.weft] {
-        if let Some(a) = m.albedo {
-            g.material.albedo = a;
-            g.threads.iter_mut().for_each(|y| y.albedo = None);
-        }
-        if let Some(s) = m.specular {
-            g.material.specular = s;
-        }
-        if let Some(n) = m.exponent {
-            g.material.exponent = n;
-        }
+pub fn apply_material(fabric: Fabric, m: &MaterialArgs) -> Result<Fabric, FabricError> {
+    if m.albedo.is_none() && m.specular.is_none() && m.exponent.is_none() {
+        return Ok(fabric);
     }
-    fabric
+    fabric.with_groups(
+        |_, g| {
+            if let Some(a) = m.albedo {
+                g.material.albedo = a;
+                g.threads.iter_mut().for_each(|y| y.albedo = None);
+            }
+            if let Some(s) = m.specular {
+                g.material.specular = s;
+            }
+            if let Some(n) = m.exponent {
+                g.material.exponent = n;
+            }
+        },
+        &PlainNaming("the material options"),
+    )
 }
 
 #[cfg(test)]
@@ -163,11 +170,11 @@ mod tests {
             specular: None,
             exponent: Some(4.0),
         };
-        let f = apply_material(f, &m);
-        assert_eq!(f.warp.material.albedo, [0.1, 0.2, 0.3]);
-        assert_eq!(f.weft.material.exponent, 4.0);
-        assert_eq!(f.warp.material.specular, 0.1);
-        assert_eq!(f.weft.material.specular, 0.2);
+        let f = apply_material(f, &m).unwrap();
+        assert_eq!(f.warp().material.albedo, [0.1, 0.2, 0.3]);
+        assert_eq!(f.weft().material.exponent, 4.0);
+        assert_eq!(f.warp().material.specular, 0.1);
+        assert_eq!(f.weft().material.specular, 0.2);
     }
 
     #[test]

@@ -48,7 +48,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
         (Some(weave), None) => {
             let secondary = args.bounces.options()?;
             let secondary = (args.bounces.bounces == 2).then_some(secondary);
-            let fabric = apply_material(Fabric::from_path(weave)?, &args.material);
+            let fabric = apply_material(Fabric::from_path(weave)?, &args.material)?;
             refuse_existing(args)?;
             let facet = FacetModel::from(args.facet.unwrap_or(crate::cli::FacetArg::Huo));
             let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);
@@ -57,7 +57,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             let source = format!(
                 "fabric {}; f_r cos(theta_light) of the analytic model (facet {}, variant {}, \
                  bounces {})",
-                fabric.name,
+                fabric.name(),
                 facet_name(facet),
                 model.variant().name(),
                 args.bounces.bounces
@@ -76,8 +76,10 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             refuse_existing(args)?;
             let meta = lookup.meta();
             let g = meta.grid;
-            let name = Fabric::from_json_str(&meta.fabric_json, "table metadata")
-                .map_or_else(|_| "(unreadable fabric metadata)".to_string(), |f| f.name);
+            let name = Fabric::from_json_str(&meta.fabric_json, "table metadata").map_or_else(
+                |_| "(unreadable fabric metadata)".to_string(),
+                |f| f.name().to_string(),
+            );
             let source = format!(
                 "fabric {name}; f_r cos(theta_light) looked up (quadrilinear interpolation) in \
                  the table {} ({}, {} x {} x {} x {} cells, bake options {}); the table's fabric \

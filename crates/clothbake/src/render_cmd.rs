@@ -29,7 +29,7 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<ModelShader, CliError> {
         ComponentArg::Secondary => Component::Secondary,
         ComponentArg::Iss => Component::SecondarySpecular,
     };
-    let fabric = apply_material(Fabric::from_path(weave)?, &b.material);
+    let fabric = apply_material(Fabric::from_path(weave)?, &b.material)?;
     ModelShader::new(
         &fabric,
         FacetModel::from(b.facet),

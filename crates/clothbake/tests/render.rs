@@ -153,10 +153,12 @@ fn brightness_follows_the_physics() {
         mean(&grazing)
     );
     // A higher diffuse albedo is brighter at every pixel on the cloth.
-    let mut bright = twill.clone();
-    for g in [&mut bright.warp, &mut bright.weft] {
-        g.material.albedo = [0.6; 3];
-    }
+    let bright = twill
+        .with_groups(
+            |_, g| g.material.albedo = [0.6; 3],
+            &clothbake_core::PlainNaming("bright"),
+        )
+        .unwrap();
     let l = lighting(Vec3::new(0.0, 0.707, 0.707), 0.3);
     let a = draw(&scene, &cam, &l, &s, 1, 2);
     let b = draw(&scene, &cam, &l, &shader(&bright), 1, 2);

@@ -70,7 +70,7 @@ impl ModelShader {
             return Err("the secondary reflection's components need two bounces".into());
         }
         let a: [f64; 3] = std::array::from_fn(|k| {
-            0.5 * (fabric.warp.material.albedo[k] + fabric.weft.material.albedo[k])
+            0.5 * (fabric.warp().material.albedo[k] + fabric.weft().material.albedo[k])
         });
         Ok(ModelShader {
             model: AnalyticModel::with_variant(fabric, facet, variant),
@@ -162,7 +162,7 @@ impl TableShader {
             [1.0; 3],
             |f| {
                 tint_of(std::array::from_fn(|k| {
-                    0.5 * (f.warp.material.albedo[k] + f.weft.material.albedo[k])
+                    0.5 * (f.warp().material.albedo[k] + f.weft().material.albedo[k])
                 }))
             },
         );

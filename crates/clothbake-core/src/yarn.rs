@@ -1,0 +1,133 @@
+//! Yarns and their layout in the period (thesis ch. 2): the plain values a fabric is made of,
+//! and the rules that place them, in one place for the fabric's validation and the geometry.
+//!
+//! * Thread i of a group sits at P_0 = 0, P_{i+1} = P_i + spacing_i across its direction; the
+//!   period is the sum of the spacings and tiles the plane.
+//! * Neighbouring threads may touch but not overlap: spacing_i >= r_i + r_{i+1}
+//!   ([`spacing_fits`]).
+//! * A float over crossing threads a..=b has, along its axis, the room between the surfaces of
+//!   the crossing threads before and after it, [P_{a-1} + r_{a-1}, P_{b+1} - r_{b+1}]
+//!   ([`float_room`]); a given segment length is centred in that room ([`float_extent`]).
+
+use crate::weave::Float;
+
+/// Facet material defaults of thesis sec. 4.3.
+pub const DEFAULT_ALBEDO: f64 = 0.4;
+/// Default specular coefficient rho_s (sec. 4.3).
+pub const DEFAULT_SPECULAR: f64 = 0.3;
+/// Default specular exponent n (sec. 4.3).
+pub const DEFAULT_EXPONENT: f64 = 10.0;
+
+/// Facet material of one yarn group.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// Diffuse albedo rho_d per RGB channel, each in [0, 1].
+    pub albedo: [f64; 3],
+    /// Specular coefficient rho_s in [0, 1].
+    pub specular: f64,
+    /// Specular exponent n >= 0.
+    pub exponent: f64,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            albedo: [DEFAULT_ALBEDO; 3],
+            specular: DEFAULT_SPECULAR,
+            exponent: DEFAULT_EXPONENT,
+        }
+    }
+}
+
+/// One thread of the period: its cylinder radius and axis height above the floor z = 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Yarn {
+    /// Cylinder radius (> 0).
+    pub radius: f64,
+    /// Height of the cylinder axis above the floor, in (-radius, radius); 0 is a half cylinder.
+    pub height: f64,
+    /// Centre-to-centre distance to the next thread of the same group (>= the two radii).
+    pub spacing: f64,
+    /// Explicit length of every float of this thread, or `None` to derive it ([`float_room`]).
+    pub segment_length: Option<f64>,
+    /// This thread's own diffuse albedo rho_d (RGB), overriding the group material's albedo;
+    /// `None` to use the group's (fabric files: `thread_albedo`).
+    pub albedo: Option<[f64; 3]>,
+}
+
+/// A yarn group (warp or weft): its threads in the period and their facet material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct YarnGroup {
+    /// One entry per thread of the period.
+    pub threads: Vec<Yarn>,
+    /// Facet material of the whole group (a thread's own albedo overrides its `albedo`).
+    pub material: Material,
+}
+
+impl YarnGroup {
+    /// Diffuse albedo of thread `t` (index modulo the period): its own, else the group's.
+    pub fn albedo(&self, t: usize) -> [f64; 3] {
+        self.threads[t % self.threads.len()]
+            .albedo
+            .unwrap_or(self.material.albedo)
+    }
+
+    /// Facet material of thread `t` (index modulo the period).
+    pub fn thread_material(&self, t: usize) -> Material {
+        Material {
+            albedo: self.albedo(t),
+            ..self.material
+        }
+    }
+
+    /// Positions P_i of the threads across their direction, and the period (sum of spacings).
+    pub fn positions(&self) -> (Vec<f64>, f64) {
+        let mut pos = Vec::with_capacity(self.threads.len());
+        let mut acc = 0.0;
+        for t in &self.threads {
+            pos.push(acc);
+            acc += t.spacing;
+        }
+        (pos, acc)
+    }
+
+    /// Unwrapped position of thread `k` (any integer).
+    pub fn position(&self, k: isize) -> f64 {
+        let n = self.threads.len() as isize;
+        let (pos, period) = self.positions();
+        pos[k.rem_euclid(n) as usize] + k.div_euclid(n) as f64 * period
+    }
+
+    /// Radius of thread `k` (any integer, taken modulo the period).
+    pub fn radius(&self, k: isize) -> f64 {
+        self.threads[k.rem_euclid(self.threads.len() as isize) as usize].radius
+    }
+}
+
+/// Whether threads of radii `r` and `r_next` may stand `spacing` apart: they may touch but not
+/// overlap (to a relative 1e-12, so that sizes converted between units still touch).
+pub fn spacing_fits(spacing: f64, r: f64, r_next: f64) -> bool {
+    spacing >= (r + r_next) * (1.0 - 1e-12)
+}
+
+/// The room a float `fl` has along its axis between the surfaces of the `crossing` group's
+/// threads before and after it (unwrapped coordinates).
+pub fn float_room(crossing: &YarnGroup, fl: Float) -> (f64, f64) {
+    let a = fl.start as isize;
+    let b = a + fl.len as isize; // first crossing thread after the float
+    let lo = crossing.position(a - 1) + crossing.radius(a - 1);
+    let hi = crossing.position(b) - crossing.radius(b);
+    (lo, hi)
+}
+
+/// The extent of a float's segment along its axis: its room, or `segment_length` centred in it.
+pub fn float_extent(room: (f64, f64), segment_length: Option<f64>) -> (f64, f64) {
+    let (lo, hi) = room;
+    match segment_length {
+        Some(len) => {
+            let mid = 0.5 * (lo + hi);
+            (mid - 0.5 * len, mid + 0.5 * len)
+        }
+        None => (lo, hi),
+    }
+}
