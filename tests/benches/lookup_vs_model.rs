@@ -2,7 +2,7 @@
 //! twill baked on the default grid (f16, as the default EXR holds it), the same direction
 //! pairs for both (issue 5: the lookup must be at least 50 times faster).
 
-use clothbake::bake::DEFAULT_GRID;
+use clothbake_bake::DEFAULT_GRID;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel};
 use clothbake_loader::Precision;
 use clothbake_tests::accuracy::{baked_brdf, random_pairs, to_f32};

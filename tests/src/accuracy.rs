@@ -8,7 +8,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use clothbake::bake::{bake, BakeOptions};
+use clothbake_bake::{bake, BakeOptions};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3};
 use clothbake_loader::{Brdf, Grid, Options, Precision, StoredTable};
 

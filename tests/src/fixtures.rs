@@ -1,6 +1,6 @@
 //! Inputs and scratch folders shared by the integration tests.
 
-use clothbake::bake::{bake, BakeOptions};
+use clothbake_bake::{bake, BakeOptions};
 use clothbake_core::Fabric;
 use clothbake_loader::{write_exr, Brdf, Options, Precision};
 use std::path::{Path, PathBuf};

@@ -3,7 +3,7 @@
 //! table and checks lookups, batched lookups, samples and pdfs against the Rust loader, bit for
 //! bit, and its error paths (missing file, NULL pointers, unknown flags).
 
-use clothbake::bake::{bake, BakeOptions};
+use clothbake_bake::{bake, BakeOptions};
 use clothbake_core::Fabric;
 use clothbake_loader::{write_exr, Brdf, Grid, Options, Precision};
 use clothbake_tests::fixtures::temp_dir;

@@ -8,9 +8,9 @@
 //! * A Lambertian BRDF rho/pi: every cell with both directions above the horizon reads rho/pi
 //!   in all three channels, and nothing is reported as anisotropy.
 
-use clothbake::export::merl::{merl_bytes, merl_table};
-use clothbake::export::model_brdf;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Vec3};
+use clothbake_export::merl::{merl_bytes, merl_table};
+use clothbake_export::model_brdf;
 use std::f64::consts::PI;
 use std::path::Path;
 

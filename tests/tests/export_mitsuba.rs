@@ -11,8 +11,8 @@
 //! (CI installs them, see .ci/run). With `CLOTHBAKE_FIGURES=DIR` the two images of each test
 //! are also written as PNG into DIR (docs/figures/ holds the committed ones).
 
-use clothbake::export::{model_brdf, rgl, table_brdf};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Vec3};
+use clothbake_export::{model_brdf, rgl, table_brdf};
 use clothbake_tests::fixtures::{bake_and_open, coloured_twill, temp_dir};
 use std::path::Path;
 use std::process::Command;
@@ -106,7 +106,7 @@ fn render_and_compare(
     let brdf = model_brdf(&model, None);
     let fields = rgl::rgl_fields(source, &rgl::DEFAULT_GRID, "clothbake test: twill", colour);
     let bsdf = dir.join("twill.bsdf");
-    clothbake::export::write_file(&bsdf, &rgl::tensor_file(&fields), true).unwrap();
+    clothbake_export::write_file(&bsdf, &rgl::tensor_file(&fields), true).unwrap();
 
     let out = dir.join("out");
     python(&[

@@ -9,8 +9,8 @@
 //!
 //! Skipped with a message when python3 cannot import numpy, except under `CI`.
 
-use clothbake::export::{model_brdf, rgl};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel};
+use clothbake_export::{model_brdf, rgl};
 use clothbake_tests::fixtures::temp_dir;
 use std::path::Path;
 use std::process::Command;
@@ -66,7 +66,7 @@ fn the_spectral_file_meets_pbrt_v4s_reader_and_projects_back_to_the_rgb_file() {
     let (spec, rgb) = (dir.join("denim_spec.bsdf"), dir.join("denim_rgb.bsdf"));
     for (p, c) in [(&spec, rgl::Colour::Spectral), (&rgb, rgl::Colour::Rgb)] {
         let fields = rgl::rgl_fields(&brdf, &grid, "clothbake test: denim", c);
-        clothbake::export::write_file(p, &rgl::tensor_file(&fields), true).unwrap();
+        clothbake_export::write_file(p, &rgl::tensor_file(&fields), true).unwrap();
     }
     let s = check(&["pbrt", spec.to_str().unwrap()]);
     eprintln!("pbrt-v4 reader conditions: {s}");

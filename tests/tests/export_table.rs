@@ -4,8 +4,8 @@
 //! within a few degrees of the horizon), so the luminance-weighted relative RMSE over all nodes
 //! must be small and most nodes close.
 
-use clothbake::export::{model_brdf, rgl, table_brdf};
 use clothbake_core::{AnalyticModel, FacetModel};
+use clothbake_export::{model_brdf, rgl, table_brdf};
 use clothbake_tests::fixtures::{bake_and_open, coloured_twill, temp_dir};
 
 fn rgb_values(fields: &[rgl::Field]) -> Vec<f32> {

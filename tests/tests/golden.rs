@@ -3,8 +3,8 @@
 //! difference. After an intended change, regenerate them with `cargo xtask golden` and review
 //! the difference (`clothbake diff`) before committing (see docs/baking.md).
 
-use clothbake::compare::compare;
-use clothbake::golden::{bake_golden, golden_path, shipped_fabrics, GRID, TOLERANCE};
+use clothbake_bake::compare::compare;
+use clothbake_bake::golden::{bake_golden, golden_path, shipped_fabrics, GRID, TOLERANCE};
 use clothbake_core::Fabric;
 use clothbake_loader::read_table;
 use std::path::{Path, PathBuf};

@@ -2,7 +2,7 @@
 //! under 3% against direct evaluation of the analytic model (issue 5; the full table with other
 //! grids is `cargo xtask loader-accuracy`, docs/loader.md).
 
-use clothbake::bake::DEFAULT_GRID;
+use clothbake_bake::DEFAULT_GRID;
 use clothbake_core::Fabric;
 use clothbake_loader::Precision;
 use clothbake_tests::accuracy::{baked_brdf, measure};

@@ -15,12 +15,12 @@
 //! figure (Fig. 4.5 and 5.17 share exposure 1, V itself, so the inter-reflection's brightening shows;
 //! each disk figure uses 1 / its largest value over all seven n).
 
-use clothbake::render::camera::Camera;
-use clothbake::render::render;
-use clothbake::render::scene::Scene;
-use clothbake::render::shade::{Component, Lighting, ModelShader};
-use clothbake::render::tonemap::{self, Curve, Image};
 use clothbake_core::{Fabric, FacetModel, SecondaryOptions, Variant, Vec3};
+use clothbake_render::camera::Camera;
+use clothbake_render::render;
+use clothbake_render::scene::Scene;
+use clothbake_render::shade::{Component, Lighting, ModelShader};
+use clothbake_render::tonemap::{self, Curve, Image};
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;

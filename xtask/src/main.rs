@@ -6,7 +6,7 @@
 //! * `validate`: holds the analytic model against the ray-traced ground truth for every shipped
 //!   fabric and writes the error tables to `docs/validation.md`.
 //! * `golden`: bakes every shipped fabric (`tables/*.json`) at the golden grid into
-//!   `tables/golden/<name>.bin` (see `clothbake::golden` and `docs/baking.md`).
+//!   `tables/golden/<name>.bin` (see `clothbake_bake::golden` and `docs/baking.md`).
 //! * `bench-bake [--bounces-2]`: times the default-grid bake of the twill with 1 and 2 threads
 //!   (and, with `--bounces-2`, once with the secondary reflection).
 //! * `loader-accuracy`: the loader's interpolation error on the twill for several grids, into
@@ -16,8 +16,8 @@
 //!   of sampling settings and analytic orders on the benchmark's surfaces, the parallel
 //!   cylinders and the twill (printed only).
 
-use clothbake::bake::{bake, BakeOptions};
-use clothbake::golden::{bake_golden, golden_path, shipped_fabrics};
+use clothbake_bake::golden::{bake_golden, golden_path, shipped_fabrics};
+use clothbake_bake::{bake, BakeOptions};
 mod ch5;
 mod figures;
 mod ir_accuracy;

@@ -1,8 +1,8 @@
-//! `clothbake.bake`: a table baked in memory by the baker library (`clothbake::bake::bake`).
+//! `clothbake.bake`: a table baked in memory by the baker library (`clothbake_bake::bake`).
 
 use crate::fabric::{check_bounces, facet_model, PyFabric};
 use crate::table::{table_err, PyTable};
-use clothbake::bake::{bake as bake_grid, BakeError, BakeOptions};
+use clothbake_bake::{bake as bake_grid, BakeError, BakeOptions};
 use clothbake_loader::{Grid, StoredTable};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
@@ -40,7 +40,7 @@ pub fn bake(
         bounces,
         ..BakeOptions::default()
     };
-    let total = clothbake::bake::evaluations(&fabric.fabric, &grid).max(1) as u64;
+    let total = clothbake_bake::evaluations(&fabric.fabric, &grid).max(1) as u64;
     let shown = AtomicU64::new(0);
     let report = |done: u64| {
         if !progress {

@@ -10,13 +10,13 @@ use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg, ShardAr
 use crate::cli::{DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::{table_error, CliError};
 use crate::eval_cmd::load_fabric;
-use clothbake::bake::{self, BakeError, BakeOptions, Baker, Method, DEFAULT_GRID};
-use clothbake::checkpoint::{checkpoint_path, Checkpointer, DEFAULT_INTERVAL};
-use clothbake::merge;
-use clothbake::output::{write_table, Format};
-use clothbake::shard::{
+use clothbake_bake::checkpoint::{checkpoint_path, Checkpointer, DEFAULT_INTERVAL};
+use clothbake_bake::merge;
+use clothbake_bake::output::{write_table, Format};
+use clothbake_bake::shard::{
     describe_rows, read_part, shard_from_env, shard_rows, write_part, Kind, Part, ShardId,
 };
+use clothbake_bake::{self as bake, BakeError, BakeOptions, Baker, Method, DEFAULT_GRID};
 use clothbake_core::{Caps, Variant};
 use clothbake_loader::{Precision, TableError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};

@@ -7,7 +7,7 @@
 
 use crate::error::CliError;
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use clothbake::shard::{parse_shard_id, ShardId};
+use clothbake_bake::shard::{parse_shard_id, ShardId};
 use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
 use clothbake_core::{
     Caps, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
@@ -316,9 +316,9 @@ pub struct ExportArgs {
     pub quiet: bool,
 }
 
-/// `--rgl-res NT,NP,NS` (see `clothbake::export::rgl::RglGrid`).
+/// `--rgl-res NT,NP,NS` (see `clothbake_export::rgl::RglGrid`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RglResArg(pub clothbake::export::rgl::RglGrid);
+pub struct RglResArg(pub clothbake_export::rgl::RglGrid);
 
 /// Parses `--rgl-res NT,NP,NS`: three whole numbers, each from 2 to 1024.
 pub fn parse_rgl_res(s: &str) -> Result<RglResArg, String> {
@@ -337,7 +337,7 @@ pub fn parse_rgl_res(s: &str) -> Result<RglResArg, String> {
             .parse::<usize>()
             .map_err(|_| format!("`{p}` is not a whole number; {FIX}"))?;
     }
-    let g = clothbake::export::rgl::RglGrid {
+    let g = clothbake_export::rgl::RglGrid {
         n_theta: n[0],
         n_phi: n[1],
         n_slice: n[2],
@@ -1017,7 +1017,7 @@ pub struct BrdfArgs {
     pub material: MaterialArgs,
 }
 
-/// `--component` values (mirrors `clothbake::render::shade::Component`).
+/// `--component` values (mirrors `clothbake_render::shade::Component`).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ComponentArg {
     /// I_1, plus I_2 with --bounces 2.
@@ -1387,7 +1387,7 @@ mod tests {
     fn grids() {
         assert_eq!(
             parse_res("32,64,32,64").unwrap(),
-            clothbake::bake::DEFAULT_GRID
+            clothbake_bake::DEFAULT_GRID
         );
         assert_eq!(parse_res(" 1, 2 ,3,4").unwrap().n_phi_o, 4);
         for (bad, needle) in [

@@ -5,7 +5,7 @@
 
 use crate::cli::DiffArgs;
 use crate::error::CliError;
-use clothbake::compare::{compare, Tolerance, DEFAULT_ABS, DEFAULT_REL};
+use clothbake_bake::compare::{compare, Tolerance, DEFAULT_ABS, DEFAULT_REL};
 use clothbake_loader::read_table;
 use std::fmt::Write as _;
 

@@ -6,9 +6,9 @@
 use crate::cli::ExportArgs;
 use crate::error::CliError;
 use crate::eval_cmd::apply_material;
-use clothbake::export::{self, merl, rgl, spectrum, Brdf};
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel};
+use clothbake_export::{self as export, merl, rgl, spectrum, Brdf};
 use clothbake_loader::TableError;
 use std::fmt::Write as _;
 use std::path::PathBuf;

@@ -2,7 +2,7 @@
 
 use crate::cli::InfoArgs;
 use crate::error::CliError;
-use clothbake::albedo::{directional_albedo, nearest_azimuth, nearest_polar};
+use clothbake_bake::albedo::{directional_albedo, nearest_azimuth, nearest_polar};
 use clothbake_loader::{read_table, Table};
 use std::fmt::Write as _;
 use std::io::Read;

@@ -1,16 +1,16 @@
 //! `clothbake merge -o TABLE SHARD...`: the shards of a bake into its table.
 //!
 //! Reads every shard (refusing damaged or foreign files), checks them with
-//! [`clothbake::merge::merge`] (same fabric, options, grid and tool version; every shard once),
+//! [`clothbake_bake::merge::merge`] (same fabric, options, grid and tool version; every shard once),
 //! then writes the table atomically through the loader. Any failure: one line naming the shard
 //! and the cause, exit 2, nothing written.
 
 use crate::bake_cmd::{output_format, preflight};
 use crate::cli::{FormatArg, MergeArgs};
 use crate::error::CliError;
-use clothbake::merge::{merge, orbits_of};
-use clothbake::output::{write_table, Format};
-use clothbake::shard::read_part;
+use clothbake_bake::merge::{merge, orbits_of};
+use clothbake_bake::output::{write_table, Format};
+use clothbake_bake::shard::read_part;
 
 /// Runs the merge and returns the summary line for stdout (empty with --quiet).
 pub fn run(a: &MergeArgs) -> Result<String, CliError> {

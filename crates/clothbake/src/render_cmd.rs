@@ -1,18 +1,18 @@
-//! `clothbake render` and `clothbake plot`: the command-line side of `clothbake::render` and
-//! `clothbake::plot` (building the shader, checking outputs, progress, summary line).
+//! `clothbake render` and `clothbake plot`: the command-line side of `clothbake_render` and
+//! `clothbake_render::plot` (building the shader, checking outputs, progress, summary line).
 
 use crate::cli::{
     BrdfArgs, ComponentArg, Exposure, PlotArgs, PlotKind, RenderArgs, SceneArg, TonemapArg,
 };
 use crate::error::{table_error, CliError};
 use crate::eval_cmd::apply_material;
-use clothbake::plot::{self, Plot, Source};
-use clothbake::render::camera::{Camera, CameraError};
-use clothbake::render::scene::Scene;
-use clothbake::render::shade::{Component, Lighting, ModelShader, Shader, TableShader};
-use clothbake::render::tonemap::{self, Curve};
-use clothbake::render::{self as renderer};
 use clothbake_core::{Fabric, FacetModel, Vec3};
+use clothbake_render::camera::{Camera, CameraError};
+use clothbake_render::plot::{self, Plot, Source};
+use clothbake_render::scene::Scene;
+use clothbake_render::shade::{Component, Lighting, ModelShader, Shader, TableShader};
+use clothbake_render::tonemap::{self, Curve};
+use clothbake_render::{self as renderer};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};

@@ -1,9 +1,9 @@
 //! Shards merged in-process equal the single-process bake, bit for bit, for fabrics with
 //! every kind of symmetry (copies cross rows, and so shards) and any shard count.
 
-use clothbake::bake::{bake, BakeOptions, Baker, Row};
-use clothbake::merge::{merge, orbits_of};
-use clothbake::shard::{read_part, shard_rows, write_part, Kind, Part, ShardId};
+use clothbake_bake::merge::{merge, orbits_of};
+use clothbake_bake::shard::{read_part, shard_rows, write_part, Kind, Part, ShardId};
+use clothbake_bake::{bake, BakeOptions, Baker, Row};
 use clothbake_core::Fabric;
 use clothbake_loader::Grid;
 use std::collections::BTreeMap;

@@ -7,6 +7,7 @@
 //! is bit-identical for any number of threads. [`tonemap`] turns it into PNG bytes.
 
 pub mod camera;
+pub mod plot;
 pub mod scene;
 pub mod shade;
 pub mod tonemap;

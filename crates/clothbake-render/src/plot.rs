@@ -13,7 +13,7 @@
 //! largest difference relative to the first source's largest value. Text is drawn with the
 //! DejaVu Sans font built into the program (no system fonts are needed).
 
-use crate::render::shade::Shader;
+use crate::shade::Shader;
 use clothbake_core::UnitVec3;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -374,7 +374,7 @@ pub fn write(path: &Path, plot: &Plot, sources: &[Source], overwrite: bool) -> R
                 draw(&root, plot, sources)?;
                 root.present().map_err(err)?;
             }
-            crate::render::tonemap::write_png_rgb8(path, w, h, &buf, overwrite).map_err(fail)
+            crate::tonemap::write_png_rgb8(path, w, h, &buf, overwrite).map_err(fail)
         }
         Some("svg") => {
             let mut s = String::new();

@@ -2,9 +2,9 @@
 //! (one after the other, in-process) and merged, and the merge alone. One thread, the twill on
 //! a 16 x 32 x 16 x 32 grid, direct reflection.
 
-use clothbake::bake::{bake, BakeOptions, Baker, Row};
-use clothbake::merge::merge;
-use clothbake::shard::{shard_rows, Kind, Part, ShardId};
+use clothbake_bake::merge::merge;
+use clothbake_bake::shard::{shard_rows, Kind, Part, ShardId};
+use clothbake_bake::{bake, BakeOptions, Baker, Row};
 use clothbake_core::Fabric;
 use clothbake_loader::Grid;
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -4,8 +4,8 @@
 //! `cargo xtask golden` writes them; the test `tests/tests/golden.rs` bakes each fabric afresh
 //! with the same [`options`] and compares it with its golden table to [`TOLERANCE`].
 
-use crate::bake::{bake, BakeError, BakeOptions};
 use crate::compare::Tolerance;
+use crate::sweep::{bake, BakeError, BakeOptions};
 use clothbake_core::Fabric;
 use clothbake_loader::{Grid, Table};
 use std::path::{Path, PathBuf};

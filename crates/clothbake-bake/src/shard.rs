@@ -1,6 +1,6 @@
 //! Shards and checkpoints: part of a bake's rows, in a file of their own.
 //!
-//! A bake's (theta_i, phi_i) rows are independent (see [`crate::bake::Baker`]). A **shard** is
+//! A bake's (theta_i, phi_i) rows are independent (see [`crate::sweep::Baker`]). A **shard** is
 //! shard K of N of a [`split`] of the rows, baked by one process (`clothbake bake --shard K/N`),
 //! and `clothbake merge` assembles the shards into the table. A **checkpoint** holds the rows a
 //! bake (or a shard's bake) has finished so far, for `--resume`. Both are a [`Part`] in the same
@@ -17,7 +17,7 @@
 //! (rows in increasing order, each [`Row`] in cell order, RGB): exactly the f32 values the
 //! single-process bake computes, so a merge is bit-identical to it.
 
-use crate::bake::{row_cell, Orbits, Row};
+use crate::sweep::{row_cell, Orbits, Row};
 use clothbake_loader::{write_atomic, Grid, Metadata, TableError};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

@@ -3,13 +3,13 @@
 //! symmetric weave on the sphere, brightness orderings, and a swatch pixel recomputed from the
 //! camera's stated conventions and the model directly.
 
-use clothbake::plot::{self, Plot, Source};
-use clothbake::render::camera::Camera;
-use clothbake::render::scene::Scene;
-use clothbake::render::shade::{Component, Lighting, ModelShader, Shader};
-use clothbake::render::tonemap::Image;
-use clothbake::render::{render, scene::Drape};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Variant, Vec3};
+use clothbake_render::camera::Camera;
+use clothbake_render::plot::{self, Plot, Source};
+use clothbake_render::scene::Scene;
+use clothbake_render::shade::{Component, Lighting, ModelShader, Shader};
+use clothbake_render::tonemap::Image;
+use clothbake_render::{render, scene::Drape};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -304,8 +304,8 @@ fn secondary_components_need_two_bounces() {
 /// itself, up to the table's interpolation error.
 #[test]
 fn table_shader_agrees_with_the_model() {
-    use clothbake::bake::{bake, BakeOptions};
-    use clothbake::render::shade::TableShader;
+    use clothbake_bake::{bake, BakeOptions};
+    use clothbake_render::shade::TableShader;
     let twill = fabric("twill");
     let opts = BakeOptions {
         grid: clothbake_loader::Grid {

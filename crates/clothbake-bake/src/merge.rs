@@ -5,8 +5,8 @@
 //! 0..N-1 given once, each holding exactly the rows [`crate::shard::split`] assigns to it. The
 //! assembly is [`Orbits::assemble`], the single bake's own, so the table is bit-identical.
 
-use crate::bake::{symmetry_name, tool_name, usable_symmetries, Orbits, Row};
 use crate::shard::{describe_rows, shard_rows, Kind, Part, PartError, ShardId};
+use crate::sweep::{symmetry_name, tool_name, usable_symmetries, Orbits, Row};
 use clothbake_core::Fabric;
 use clothbake_loader::{Metadata, Table};
 use std::collections::BTreeMap;

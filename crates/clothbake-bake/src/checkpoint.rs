@@ -8,8 +8,8 @@
 //! and bakes only the rows it lacks; as rows are pure functions of the inputs, the table is
 //! bit-identical to an uninterrupted bake.
 
-use crate::bake::Row;
 use crate::shard::{write_part, Kind, Part, ShardId};
+use crate::sweep::Row;
 use clothbake_loader::{Metadata, TableError};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

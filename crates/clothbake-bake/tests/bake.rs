@@ -1,7 +1,7 @@
 //! The bake library: copied (symmetric) cells equal directly evaluated ones, and the table does
 //! not depend on the number of threads.
 
-use clothbake::bake::{bake, direction, BakeOptions, DEFAULT_GRID};
+use clothbake_bake::{bake, direction, BakeOptions, DEFAULT_GRID};
 use clothbake_core::symmetry::symmetries;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, SecondaryOptions, Variant};
 use clothbake_loader::{Grid, Table};
@@ -198,9 +198,9 @@ fn progress_reaches_the_total() {
     // Progress counts evaluated cells: half of them for the twill's rotation symmetry.
     assert_eq!(
         max.load(Ordering::Relaxed),
-        clothbake::bake::evaluations(&f, &SMALL) as u64
+        clothbake_bake::evaluations(&f, &SMALL) as u64
     );
-    assert_eq!(clothbake::bake::evaluations(&f, &SMALL), SMALL.len() / 2);
+    assert_eq!(clothbake_bake::evaluations(&f, &SMALL), SMALL.len() / 2);
     assert_eq!(
         calls.load(Ordering::Relaxed),
         u64::from(SMALL.n_theta_i * SMALL.n_phi_i)

@@ -1,0 +1,22 @@
+//! clothbake-bake: bake a fabric's BRDF into a table.
+//!
+//! [`sweep`] evaluates the (theta_i, phi_i, theta_o, phi_o) grid of a fabric in parallel rows
+//! through the model's BSDF and returns the table (its items are re-exported here: [`bake`],
+//! [`BakeOptions`], [`Baker`]); [`shard`], [`merge`] and [`checkpoint`] split a bake into
+//! shards, assemble them and resume an interrupted one (docs/cluster.md); [`output`] writes
+//! tables with reproducible bytes; [`compare`] holds two tables against each other
+//! (`clothbake diff`, the golden tables of [`golden`]); [`albedo`] integrates a table's
+//! directional albedo (`clothbake info`). The file formats live in `clothbake-loader`.
+//! Nothing here parses command lines or draws progress bars: the `clothbake` binary and the
+//! Python package call the same functions.
+
+pub mod albedo;
+pub mod checkpoint;
+pub mod compare;
+pub mod golden;
+pub mod merge;
+pub mod output;
+pub mod shard;
+pub mod sweep;
+
+pub use sweep::*;
