@@ -28,7 +28,7 @@ fn side_by_side(c: &mut Criterion) {
         b.iter(|| {
             k = (k + 1) % N;
             let (a, o) = pairs[k];
-            black_box(model.eval(black_box(a), black_box(o)).brdf(a))
+            black_box(model.intensity(black_box(a), black_box(o)).brdf(a))
         })
     });
     g.bench_function("table_lookup/per_pair", |b| {

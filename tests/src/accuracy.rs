@@ -70,7 +70,7 @@ pub fn measure(fabric: &Fabric, brdf: &Brdf, pairs: usize, seed: u64) -> Accurac
     let mut errors = Vec::with_capacity(pairs);
     let mut zero = 0;
     for (wi, wo) in random_pairs(pairs, seed) {
-        let want = model.eval(wi, wo).brdf(wi);
+        let want = model.intensity(wi, wo).brdf(wi);
         let got = brdf.eval(to_f32(wi), to_f32(wo));
         if want.iter().any(|&w| w <= 0.0) {
             zero += 1;

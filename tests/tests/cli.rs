@@ -107,7 +107,7 @@ fn shipped_tables_load_and_build_their_geometry() {
             lengths(&geo, Group::Weft)
         );
         // The model runs on it (finite, non-negative).
-        let r = AnalyticModel::new(&f, FacetModel::Huo).eval(
+        let r = AnalyticModel::new(&f, FacetModel::Huo).intensity(
             UnitVec3::from_degrees(45.0, 90.0),
             UnitVec3::from_degrees(30.0, 250.0),
         );

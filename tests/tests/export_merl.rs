@@ -8,9 +8,9 @@
 //! * A Lambertian BRDF rho/pi: every cell with both directions above the horizon reads rho/pi
 //!   in all three channels, and nothing is reported as anisotropy.
 
+use clothbake_core::{AnalyticBsdf, Bsdf, FromFn};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Vec3};
 use clothbake_export::merl::{merl_bytes, merl_table};
-use clothbake_export::model_brdf;
 use std::f64::consts::PI;
 use std::path::Path;
 
@@ -123,14 +123,14 @@ fn the_merl_reader_finds_the_models_rotation_average() {
             .0
         })
         .collect();
-    let full = model_brdf(&model, None);
-    let brdf = |a: UnitVec3, b: UnitVec3| {
+    let full = AnalyticBsdf::new(model.clone(), None);
+    let brdf = FromFn(|a: UnitVec3, b: UnitVec3| {
         if rows.contains(&Merl::cell(a.get(), b.get()).0) {
-            full(a, b)
+            full.f(a, b)
         } else {
             [0.0; 3]
         }
-    };
+    });
     // Four rotations (0, 90, 180, 270 degrees); the twill is unchanged by a half turn.
     let rotations = 4;
     let table = merl_table(&brdf, rotations, true);
@@ -145,7 +145,7 @@ fn the_merl_reader_finds_the_models_rotation_average() {
         for s in 0..rotations {
             let r = 2.0 * PI * s as f64 / rotations as f64;
             let (a, b) = (unit(rotate_z(a, r)), unit(rotate_z(b, r)));
-            let (x, y) = (full(a, b), full(b, a));
+            let (x, y) = (full.f(a, b), full.f(b, a));
             for c in 0..3 {
                 want[c] += 0.5 * (x[c] + y[c]) / rotations as f64;
             }
@@ -170,13 +170,13 @@ fn the_merl_reader_finds_the_models_rotation_average() {
 #[test]
 fn a_lambertian_brdf_gives_a_constant_table() {
     let rho = [0.5, 0.3, 0.8];
-    let brdf = |wi: UnitVec3, wo: UnitVec3| {
+    let brdf = FromFn(|wi: UnitVec3, wo: UnitVec3| {
         if wi.above_horizon() && wo.above_horizon() {
             rho.map(|r| r / PI)
         } else {
             [0.0; 3]
         }
-    };
+    });
     let table = merl_table(&brdf, 3, false);
     let merl = Merl::parse(&merl_bytes(&table));
     assert_eq!(table.anisotropy.weighted, 0.0);

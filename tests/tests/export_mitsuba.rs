@@ -11,8 +11,9 @@
 //! (CI installs them, see .ci/run). With `CLOTHBAKE_FIGURES=DIR` the two images of each test
 //! are also written as PNG into DIR (docs/figures/ holds the committed ones).
 
+use clothbake_core::{AnalyticBsdf, Bsdf};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Vec3};
-use clothbake_export::{model_brdf, rgl, table_brdf};
+use clothbake_export::rgl;
 use clothbake_tests::fixtures::{bake_and_open, coloured_twill, temp_dir};
 use std::path::Path;
 use std::process::Command;
@@ -94,7 +95,7 @@ struct Compared {
 /// Writes `<prefix>_mitsuba.png` and `<prefix>_reference.png` under CLOTHBAKE_FIGURES if set.
 fn render_and_compare(
     tag: &str,
-    source: &(dyn Fn(UnitVec3, UnitVec3) -> [f64; 3] + Sync),
+    source: &dyn Bsdf,
     colour: rgl::Colour,
     variant: &str,
     spp: u32,
@@ -103,7 +104,7 @@ fn render_and_compare(
     let dir = temp_dir(&format!("mitsuba-{tag}"));
     let f = fabric();
     let model = AnalyticModel::new(&f, FacetModel::Huo);
-    let brdf = model_brdf(&model, None);
+    let brdf = AnalyticBsdf::new(model.clone(), None);
     let fields = rgl::rgl_fields(source, &rgl::DEFAULT_GRID, "clothbake test: twill", colour);
     let bsdf = dir.join("twill.bsdf");
     clothbake_export::write_file(&bsdf, &rgl::tensor_file(&fields), true).unwrap();
@@ -154,7 +155,7 @@ fn render_and_compare(
         let q = &pairs[6 * p..6 * p + 6];
         let light = UnitVec3::new(Vec3::new(q[0], q[1], q[2])).unwrap();
         let eye = UnitVec3::new(Vec3::new(q[3], q[4], q[5])).unwrap();
-        let fr = brdf(light, eye);
+        let fr = brdf.f(light, eye);
         for c in 0..3 {
             let want = e * fr[c] * light.cos_theta();
             let got = img[3 * p + c] as f64;
@@ -200,7 +201,7 @@ fn mitsuba_renders_the_exported_bsdf_like_the_model() {
     let model = AnalyticModel::new(&f, FacetModel::Huo);
     let c = render_and_compare(
         "rgb",
-        &model_brdf(&model, None),
+        &AnalyticBsdf::new(model.clone(), None),
         rgl::Colour::Rgb,
         "scalar_rgb",
         16,
@@ -220,7 +221,7 @@ fn mitsuba_spectral_renders_the_spectral_bsdf_like_the_model() {
     let model = AnalyticModel::new(&f, FacetModel::Huo);
     let c = render_and_compare(
         "spectral",
-        &model_brdf(&model, None),
+        &AnalyticBsdf::new(model.clone(), None),
         rgl::Colour::Spectral,
         "scalar_spectral",
         SPECTRAL_SPP,
@@ -237,7 +238,7 @@ fn mitsuba_renders_the_export_of_a_baked_table_like_the_model() {
     }
     let dir = temp_dir("baked-table");
     let lookup = bake_and_open(&fabric(), &dir.join("twill.exr"));
-    let source = table_brdf(&lookup);
+    let source = lookup;
     let c = render_and_compare(
         "table",
         &source,

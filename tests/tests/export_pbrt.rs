@@ -9,8 +9,9 @@
 //!
 //! Skipped with a message when python3 cannot import numpy, except under `CI`.
 
+use clothbake_core::AnalyticBsdf;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel};
-use clothbake_export::{model_brdf, rgl};
+use clothbake_export::rgl;
 use clothbake_tests::fixtures::temp_dir;
 use std::path::Path;
 use std::process::Command;
@@ -56,7 +57,7 @@ fn the_spectral_file_meets_pbrt_v4s_reader_and_projects_back_to_the_rgb_file() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/denim.wif");
     let fabric = Fabric::from_path(&path).unwrap();
     let model = AnalyticModel::new(&fabric, FacetModel::Huo);
-    let brdf = model_brdf(&model, None);
+    let brdf = AnalyticBsdf::new(model.clone(), None);
     let grid = rgl::RglGrid {
         n_theta: 6,
         n_phi: 8,

@@ -4,8 +4,9 @@
 //! within a few degrees of the horizon), so the luminance-weighted relative RMSE over all nodes
 //! must be small and most nodes close.
 
+use clothbake_core::AnalyticBsdf;
 use clothbake_core::{AnalyticModel, FacetModel};
-use clothbake_export::{model_brdf, rgl, table_brdf};
+use clothbake_export::rgl;
 use clothbake_tests::fixtures::{bake_and_open, coloured_twill, temp_dir};
 
 fn rgb_values(fields: &[rgl::Field]) -> Vec<f32> {
@@ -24,9 +25,9 @@ fn the_export_of_a_baked_table_matches_the_export_of_the_model() {
     let fabric = coloured_twill();
     let dir = temp_dir("export-table");
     let lookup = bake_and_open(&fabric, &dir.join("twill.exr"));
-    let from_table = table_brdf(&lookup);
+    let from_table = lookup;
     let model = AnalyticModel::new(&fabric, FacetModel::Huo);
-    let from_model = model_brdf(&model, None);
+    let from_model = AnalyticBsdf::new(model.clone(), None);
     // A coarser grid than the default keeps the test fast; the nodes are where they always are.
     let grid = rgl::RglGrid {
         n_theta: 8,

@@ -32,7 +32,7 @@ fn split(f: &Fabric, wi: UnitVec3, wo: UnitVec3) -> (f64, f64) {
             &clothbake_core::PlainNaming("probe"),
         )
         .unwrap();
-    let r = AnalyticModel::new(&probe, FacetModel::Huo).eval(wi, wo);
+    let r = AnalyticModel::new(&probe, FacetModel::Huo).intensity(wi, wo);
     (r.i_d[0], r.i_d[1])
 }
 
@@ -44,7 +44,7 @@ fn denim_diffuse_is_the_albedo_weighted_sum_of_warp_and_weft() {
     let m = AnalyticModel::new(&f, FacetModel::Huo);
     for (wi, wo) in direction_set(12, 70.0) {
         let (w, fw) = split(&f, wi, wo);
-        let r = m.eval(wi, wo);
+        let r = m.intensity(wi, wo);
         for k in 0..3 {
             let want = f.warp().material.albedo[k] * w + f.weft().material.albedo[k] * fw;
             assert!(
@@ -100,7 +100,7 @@ fn denim_is_bluest_where_only_warp_is_seen() {
     let m = AnalyticModel::new(&f, FacetModel::Huo);
     let rt = RayTracer::new(&f, FacetModel::Huo);
     let ratio = |v: [f64; 3]| v[2] / v[0];
-    let (ma, mb) = (m.eval(a.0, a.1).i_d, m.eval(b.0, b.1).i_d);
+    let (ma, mb) = (m.intensity(a.0, a.1).i_d, m.intensity(b.0, b.1).i_d);
     let (ta, tb) = (
         rt.render(a.0, a.1, 100_000, 3).reflection.i_d,
         rt.render(b.0, b.1, 100_000, 4).reflection.i_d,
@@ -141,7 +141,7 @@ fn model_matches_ground_truth_per_channel_with_colours() {
         let pairs = direction_set(24, 70.0);
         let mut err = [0.0; 3];
         for (k, &(wi, wo)) in pairs.iter().enumerate() {
-            let a = m.eval(wi, wo).total();
+            let a = m.intensity(wi, wo).total();
             let t = rt.render(wi, wo, 40_000, 11 + k as u64).reflection.total();
             for c in 0..3 {
                 err[c] += (a[c] - t[c]).abs() / t[c] / pairs.len() as f64;
@@ -174,9 +174,11 @@ fn per_thread_colour_is_seen_where_the_thread_is() {
         })
         .unwrap();
     let (wi, wo) = (dir(30.0, 20.0), dir(40.0, 200.0));
-    let a = AnalyticModel::new(&f, FacetModel::Huo).eval(wi, wo).total();
+    let a = AnalyticModel::new(&f, FacetModel::Huo)
+        .intensity(wi, wo)
+        .total();
     let g = AnalyticModel::new(&grey, FacetModel::Huo)
-        .eval(wi, wo)
+        .intensity(wi, wo)
         .total();
     let t = RayTracer::new(&f, FacetModel::Huo).render(wi, wo, 100_000, 5);
     for c in 0..3 {

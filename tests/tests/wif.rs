@@ -94,7 +94,7 @@ fn denim_reflects_like_the_json_twill_of_the_same_proportions() {
             UnitVec3::from_degrees(ti, pi),
             UnitVec3::from_degrees(to, po),
         );
-        let (x, y) = (a.eval(wi, wo).total(), b.eval(wi, wo).total());
+        let (x, y) = (a.intensity(wi, wo).total(), b.intensity(wi, wo).total());
         for k in 0..3 {
             assert!((x[k] - y[k]).abs() <= 1e-9 * y[k], "{x:?} {y:?}");
         }

@@ -140,8 +140,8 @@ fn sphere(out: &mut String) {
         ] {
             let (mut a, mut s, mut ratio) = (Vec::new(), Vec::new(), 0.0);
             for &(wi, wo) in &pts {
-                let ra = m.eval_with(wi, wo, Some(&SecondaryOptions { method: am, kernel }));
-                let rs = m.eval_with(wi, wo, Some(&SecondaryOptions { method: sm, kernel }));
+                let ra = m.intensity_with(wi, wo, Some(&SecondaryOptions { method: am, kernel }));
+                let rs = m.intensity_with(wi, wo, Some(&SecondaryOptions { method: sm, kernel }));
                 a.push(ra.secondary.unwrap().ss[0]);
                 s.push(rs.secondary.unwrap().ss[0]);
                 ratio += ra.secondary.unwrap().ss[0] / ra.i_s[0].max(1e-12) / pts.len() as f64;
@@ -212,7 +212,7 @@ fn disk(out: &mut String) {
             let (mut mss, mut mr, mut m2, mut m21) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
             let mut share = [0.0; 4];
             for &(wi, wo) in &pts {
-                let r = m.eval_with(wi, wo, Some(&SecondaryOptions { method, kernel }));
+                let r = m.intensity_with(wi, wo, Some(&SecondaryOptions { method, kernel }));
                 let s = r.secondary.unwrap();
                 let i2 = s.total()[0];
                 mss = mss.max(s.ss[0]);

@@ -19,7 +19,7 @@ use clothbake_core::{Fabric, FacetModel, SecondaryOptions, Variant, Vec3};
 use clothbake_render::camera::Camera;
 use clothbake_render::render;
 use clothbake_render::scene::Scene;
-use clothbake_render::shade::{Component, Lighting, ModelShader};
+use clothbake_render::shade::{Component, Lighting, Shader};
 use clothbake_render::tonemap::{self, Curve, Image};
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -60,7 +60,7 @@ fn shot(
     size: u32,
     aa: u32,
     lighting: &Lighting,
-    shader: &ModelShader,
+    shader: &Shader,
 ) -> Image {
     let (lo, hi) = scene.bounds();
     let fov = Camera::fitting_fov(eye, Vec3::default(), size, size, lo, hi);
@@ -96,7 +96,7 @@ fn cloth(root: &Path, dir: &Path, bounces: u32, size: u32, aa: u32, name: &str) 
     let mut images = Vec::new();
     for weave in ["basket", "twill"] {
         let f = Fabric::from_path(&root.join(format!("tables/{weave}.json"))).unwrap();
-        let s = ModelShader::new(
+        let s = Shader::model(
             &f,
             FacetModel::Huo,
             Variant::Refined,
@@ -129,7 +129,7 @@ fn disks(dir: &Path, size: u32) {
         let images: Vec<Image> = [1.0, 2.0, 4.0, 8.0, 16.0, 24.0, 32.0]
             .iter()
             .map(|&n| {
-                let s = ModelShader::new(
+                let s = Shader::model(
                     &crate::ch5::pf(n, 0.7),
                     FacetModel::Huo,
                     Variant::Refined,

@@ -92,7 +92,7 @@ fn eval(m: &AnalyticModel, method: SecondaryMethod) -> Vec<(f64, f64)> {
     secondary_direction_set()
         .par_iter()
         .map(|&(wi, wo)| {
-            let r = m.eval_with(wi, wo, Some(&opts));
+            let r = m.intensity_with(wi, wo, Some(&opts));
             (r.secondary.expect("asked for").total()[0], r.direct()[0])
         })
         .collect()

@@ -13,8 +13,8 @@
 use clothbake_core::interreflection::{Orders, Ranges, Sampling};
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{
-    AnalyticModel, Caps, Fabric, FacetModel, Kernel, RayTracer, SecondaryMethod, SecondaryOptions,
-    UnitVec3, Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, Caps, Fabric, FacetModel, Kernel, RayTracer,
+    SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
 };
 use clothbake_loader::{Grid, Metadata, Table, FORMAT_VERSION};
 use rayon::prelude::*;
@@ -408,7 +408,8 @@ impl Baker {
         let eval: CellFn = match opts.method {
             Method::Analytic { variant } => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
-                Box::new(move |_, wi, wo| m.eval_with(wi, wo, secondary.as_ref()).brdf(wi))
+                let bsdf = AnalyticBsdf::new(m, secondary);
+                Box::new(move |_, wi, wo| bsdf.f(wi, wo))
             }
             Method::Raytrace {
                 samples,

@@ -55,7 +55,7 @@ fn check_copies(name: &str, bounces: u32) {
     let eval = |ti, pi, to, po| {
         let wi = direction(ti, g.n_theta_i, pi, g.n_phi_i);
         let wo = direction(to, g.n_theta_o, po, g.n_phi_o);
-        m.eval_with(wi, wo, sec.as_ref()).brdf(wi)
+        m.intensity_with(wi, wo, sec.as_ref()).brdf(wi)
     };
     for ti in 0..g.n_theta_i {
         for pi in 0..g.n_phi_i {

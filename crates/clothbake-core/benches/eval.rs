@@ -42,7 +42,7 @@ fn analytic(c: &mut Criterion) {
                 b.iter(|| {
                     let (wi, wo) = dirs[k % dirs.len()];
                     k += 1;
-                    black_box(m.eval(black_box(wi), black_box(wo)))
+                    black_box(m.intensity(black_box(wi), black_box(wo)))
                 })
             },
         );
@@ -85,7 +85,7 @@ fn secondary(c: &mut Criterion) {
             b.iter(|| {
                 let (wi, wo) = dirs[k % dirs.len()];
                 k += 1;
-                black_box(m.eval_with(black_box(wi), black_box(wo), Some(&opts)))
+                black_box(m.intensity_with(black_box(wi), black_box(wo), Some(&opts)))
             })
         });
     }
@@ -163,7 +163,7 @@ fn secondary_vs_sampling(c: &mut Criterion) {
                 b.iter(|| {
                     let (wi, wo) = dirs[k % dirs.len()];
                     k += 1;
-                    black_box(m.eval_with(black_box(wi), black_box(wo), Some(&opts)))
+                    black_box(m.intensity_with(black_box(wi), black_box(wo), Some(&opts)))
                 })
             });
         }

@@ -4,7 +4,7 @@
 //! crossing it floats over (the piece's cross-section sees that crossing row's neighbours), builds
 //! for each piece the active-occluder tables of its two cross-section sides and for each segment
 //! those of its two ends (sec. 3.2), and merges identical pieces into independent *units* with
-//! multiplicities D_i (eq. 4.11). Evaluation ([`AnalyticModel::eval`]) then, per unit:
+//! multiplicities D_i (eq. 4.11). Evaluation ([`AnalyticModel::intensity`]) then, per unit:
 //!
 //! 1. arc: above-floor arc, minus self-shadowing/self-blocking (Poulin & Fournier), minus the
 //!    arc the active neighbour hides from L and from E (eqs 3.4-3.5);
@@ -443,14 +443,14 @@ impl AnalyticModel {
     /// Directly reflected intensity toward `wo` for unit light from `wi` (eq. 4.11): the
     /// visible-area-weighted average over the units of the period. Zero when either direction
     /// is at or below the horizon.
-    pub fn eval(&self, wi: UnitVec3, wo: UnitVec3) -> Reflection {
-        self.eval_with(wi, wo, None)
+    pub fn intensity(&self, wi: UnitVec3, wo: UnitVec3) -> Reflection {
+        self.intensity_with(wi, wo, None)
     }
 
-    /// As [`AnalyticModel::eval`], adding the secondary reflection I_2 between adjacent
+    /// As [`AnalyticModel::intensity`], adding the secondary reflection I_2 between adjacent
     /// parallel cylinders (thesis ch. 5; for cloth, sec. 5.4's approximation) when `secondary`
     /// is given. I_2 is averaged over the same visible projected area as I_1.
-    pub fn eval_with(
+    pub fn intensity_with(
         &self,
         wi: UnitVec3,
         wo: UnitVec3,
@@ -715,7 +715,7 @@ mod tests {
                 .as_str(),
         );
         let m = AnalyticModel::new(&f, FacetModel::Huo);
-        let r = m.eval(UnitVec3::Z, UnitVec3::Z);
+        let r = m.intensity(UnitVec3::Z, UnitVec3::Z);
         assert!((r.i_d[0] - 0.4 * PI / 4.0).abs() < 1e-12, "{:?}", r);
         // Specular: rho_s int_0^pi sin^n sin / 2 = rho_s int sin^11 / 2.
         let q = integrate(&mut |t: f64| t.sin().powi(11), 0.0, PI, 1e-14);
@@ -758,7 +758,7 @@ mod tests {
                     num_s += (n.dot(h) / h.length()).powi(10) * ne;
                 }
             }
-            let r = m.eval(wi, wo);
+            let r = m.intensity(wi, wo);
             assert!(
                 (r.i_d[0] - 0.4 * num_d / den).abs() < 1e-6,
                 "{:?} vs {}",
@@ -789,8 +789,8 @@ mod tests {
         ] {
             let wi = UnitVec3::from_degrees(a.0, a.1);
             let wo = UnitVec3::from_degrees(b.0, b.1);
-            let x = m.eval(wi, wo).i_s[0];
-            let y = m2.eval(wi, wo).i_s[0];
+            let x = m.intensity(wi, wo).i_s[0];
+            let y = m2.intensity(wi, wo).i_s[0];
             assert!((x - y).abs() < 1e-8 * x.max(1e-3), "{x} {y}");
         }
     }

@@ -9,6 +9,7 @@
 
 pub mod analytic;
 pub mod arc;
+pub mod brdf;
 pub mod fabric;
 pub mod facet;
 pub mod geometry;
@@ -24,12 +25,13 @@ pub mod source;
 pub mod symmetry;
 pub mod trig;
 pub mod validate;
-pub mod vec3;
 pub mod weave;
 pub mod wif;
 pub mod yarn;
 
 pub use analytic::{AnalyticModel, SecondaryMethod, SecondaryOptions, Variant};
+pub use brdf::{AnalyticBsdf, Component};
+pub use clothbake_bsdf::{vec3, Bsdf, BsdfSample, FromFn, Rgb};
 pub use fabric::{Fabric, FabricError, Field, Naming, PlainNaming};
 pub use facet::{Facet, FacetIntensity, FacetModel};
 pub use geometry::Geometry;

@@ -309,7 +309,11 @@ mod tests {
                     kernel,
                     ..Default::default()
                 };
-                let a = m.eval_with(wi, wo, Some(&opts)).secondary.unwrap().total()[0];
+                let a = m
+                    .intensity_with(wi, wo, Some(&opts))
+                    .secondary
+                    .unwrap()
+                    .total()[0];
                 let p = rt.render_paths(
                     wi,
                     wo,

@@ -163,17 +163,17 @@ mod tests {
             UnitVec3::from_degrees(50.0, 20.0),
             UnitVec3::from_degrees(35.0, 200.0),
         );
-        let a = m.eval(wi, wo).total();
+        let a = m.intensity(wi, wo).total();
         let s = Symmetry::Rotate180;
-        let b = m.eval(s.apply(wi), s.apply(wo)).total();
+        let b = m.intensity(s.apply(wi), s.apply(wo)).total();
         assert!((a[0] - b[0]).abs() < 1e-12);
         // ... and a mirror it does not have really changes the result somewhere.
         let worst = (0..40)
             .map(|k| {
                 let wi = UnitVec3::from_degrees(10.0 + k as f64 * 1.7, k as f64 * 37.0);
                 let wo = UnitVec3::from_degrees(60.0 - k as f64 * 1.1, 90.0 + k as f64 * 53.0);
-                let x = m.eval(wi, wo).total()[0];
-                let y = m.eval(wi.mirror_x(), wo.mirror_x()).total()[0];
+                let x = m.intensity(wi, wo).total()[0];
+                let y = m.intensity(wi.mirror_x(), wo.mirror_x()).total()[0];
                 (x - y).abs() / x
             })
             .fold(0.0, f64::max);

@@ -152,7 +152,7 @@ pub fn compare_with(
             let est = tracer.render(wi, wo, samples, seed.wrapping_add(k as u64));
             Comparison {
                 pair: (wi, wo),
-                analytic: mean(model.eval(wi, wo).total()),
+                analytic: mean(model.intensity(wi, wo).total()),
                 traced: mean(est.reflection.total()),
                 std_err: mean(est.std_err),
             }

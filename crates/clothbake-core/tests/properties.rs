@@ -57,9 +57,9 @@ proptest! {
         for (name, maps) in symmetric_tables() {
             for facet in [FacetModel::Huo, FacetModel::Lewis] {
                 let m = AnalyticModel::new(&table(name), facet);
-                let a = m.eval(wi, wo).total();
+                let a = m.intensity(wi, wo).total();
                 for (what, f) in &maps {
-                    let b = m.eval(f(wi), f(wo)).total();
+                    let b = m.intensity(f(wi), f(wo)).total();
                     prop_assert!(close(a, b), "{name} {what} {facet:?}: {a:?} vs {b:?}");
                 }
             }
@@ -70,8 +70,8 @@ proptest! {
     fn zero_below_the_horizon(t in 90.0f64..180.0, p in 0.0f64..360.0, other in dir()) {
         let below = UnitVec3::from_degrees(t, p);
         let m = AnalyticModel::new(&table("twill.json"), FacetModel::Huo);
-        prop_assert_eq!(m.eval(below, other).total(), [0.0; 3]);
-        prop_assert_eq!(m.eval(other, below).total(), [0.0; 3]);
+        prop_assert_eq!(m.intensity(below, other).total(), [0.0; 3]);
+        prop_assert_eq!(m.intensity(other, below).total(), [0.0; 3]);
     }
 
     #[test]
@@ -97,7 +97,7 @@ proptest! {
         let f = Fabric::from_json_str(&json.to_string(), "random").unwrap();
         let facet = if lewis { FacetModel::Lewis } else { FacetModel::Huo };
         let m = AnalyticModel::new(&f, facet);
-        let r = m.eval(wi, wo);
+        let r = m.intensity(wi, wo);
         for v in r.i_d.iter().chain(&r.i_s) {
             prop_assert!(v.is_finite() && *v >= 0.0, "{json} -> {r:?}");
         }

@@ -55,7 +55,10 @@ fn i2(
     kernel: Kernel,
 ) -> f64 {
     let opts = SecondaryOptions { method, kernel };
-    m.eval_with(wi, wo, Some(&opts)).secondary.unwrap().total()[0]
+    m.intensity_with(wi, wo, Some(&opts))
+        .secondary
+        .unwrap()
+        .total()[0]
 }
 
 /// The analytic solution at its default orders (`Orders::default()`).
@@ -269,9 +272,12 @@ fn thesis_ranges_integrate_a_part_of_the_full_ranges() {
         kernel: Kernel::Thesis,
     };
     let (wi, wo) = pairs()[0];
-    let t = m.eval_with(wi, wo, Some(&opts(thesis))).secondary.unwrap();
+    let t = m
+        .intensity_with(wi, wo, Some(&opts(thesis)))
+        .secondary
+        .unwrap();
     let f = m
-        .eval_with(wi, wo, Some(&opts(analytic())))
+        .intensity_with(wi, wo, Some(&opts(analytic())))
         .secondary
         .unwrap();
     for (a, b) in [(t.ss, f.ss), (t.sd, f.sd), (t.ds, f.ds), (t.dd, f.dd)] {

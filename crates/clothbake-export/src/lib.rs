@@ -9,15 +9,15 @@
 //! * [`merl`]: the 90 x 90 x 180 half/difference-angle binary of the MERL database. Isotropic
 //!   only: the cloth's BRDF is averaged over rotations about the normal.
 //!
-//! Both sample a [`Brdf`]: any function of (wi toward the light, wo toward the eye) returning f_r
-//! in 1/sr, RGB; [`model_brdf`] wraps the analytic model as the baker evaluates it,
-//! [`table_brdf`] a baked table's lookup.
+//! Both sample a [`Bsdf`]'s f_r (wi toward the light, wo toward the eye, in 1/sr, RGB): the
+//! analytic model as the baker evaluates it (`clothbake_core::AnalyticBsdf`) or a baked table
+//! (`clothbake_loader::Brdf`).
 
 pub mod merl;
 pub mod rgl;
 pub mod spectrum;
 
-use clothbake_core::{AnalyticModel, SecondaryOptions, UnitVec3, Vec3};
+use clothbake_core::{UnitVec3, Vec3};
 use clothbake_loader::{write_atomic, TableError};
 use std::io::Write;
 use std::path::Path;
@@ -28,34 +28,7 @@ pub fn write_file(path: &Path, bytes: &[u8], overwrite: bool) -> Result<(), Tabl
     write_atomic(path, overwrite, |w| w.write_all(bytes))
 }
 
-/// f_r(wi, wo) in 1/sr, RGB: wi toward the light, wo toward the eye, both in the fabric's frame
-/// (+X weft, +Y warp, +Z normal). Must be zero when either direction is at or below the horizon.
-pub type Brdf<'a> = dyn Fn(UnitVec3, UnitVec3) -> [f64; 3] + Sync + 'a;
-
-/// The analytic model's f_r = I / (pi cos theta_i) (thesis eq. 4.1 summed over the units), with
-/// the secondary reflection of ch. 5 when `secondary` is given: what `clothbake bake` tabulates.
-pub fn model_brdf<'a>(
-    model: &'a AnalyticModel,
-    secondary: Option<SecondaryOptions>,
-) -> impl Fn(UnitVec3, UnitVec3) -> [f64; 3] + Sync + 'a {
-    move |wi, wo| {
-        if !(wi.above_horizon() && wo.above_horizon()) {
-            return [0.0; 3];
-        }
-        model.eval_with(wi, wo, secondary.as_ref()).brdf(wi)
-    }
-}
-
-/// A baked table's f_r through the loader's interpolated lookup (`Brdf::eval`, zero at and below
-/// the horizon): the source of `clothbake export --table`.
-pub fn table_brdf(
-    lookup: &clothbake_loader::Brdf,
-) -> impl Fn(UnitVec3, UnitVec3) -> [f64; 3] + Sync + '_ {
-    move |wi: UnitVec3, wo: UnitVec3| {
-        let v = |u: UnitVec3| [u.x as f32, u.y as f32, u.z as f32];
-        lookup.eval(v(wi), v(wo)).map(f64::from)
-    }
-}
+pub use clothbake_core::Bsdf;
 
 /// The mirror image of `v` about the unit vector `m`: 2 (v.m) m - v (`None` only for a
 /// degenerate input).
@@ -102,19 +75,5 @@ mod tests {
         let (t, p) = r.to_spherical();
         assert!((t.to_degrees() - 40.0).abs() < 1e-12);
         assert!((p.to_degrees() - (30.0 - 180.0)).abs() < 1e-12);
-    }
-
-    #[test]
-    fn model_brdf_is_zero_below_the_horizon() {
-        let f = clothbake_core::Fabric::from_path(
-            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/plain.json"),
-        )
-        .unwrap();
-        let m = AnalyticModel::new(&f, clothbake_core::FacetModel::Huo);
-        let b = model_brdf(&m, None);
-        let below = unit(1.0, 0.0, -0.1).unwrap();
-        assert_eq!(b(below, UnitVec3::Z), [0.0; 3]);
-        assert_eq!(b(UnitVec3::Z, below), [0.0; 3]);
-        assert!(b(UnitVec3::Z, UnitVec3::from_degrees(30.0, 10.0))[0] > 0.0);
     }
 }

@@ -12,7 +12,7 @@
 //! eye (phi_d and phi_d + pi share a cell). It is evaluated at the cell's centre in the readers'
 //! index space. What the average loses is reported as [`Anisotropy`].
 
-use super::{luminance, Brdf};
+use super::{luminance, Bsdf};
 use clothbake_core::{UnitVec3, Vec3};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -60,7 +60,7 @@ pub fn half_diff_to_pair(theta_h: f64, phi_h: f64, theta_d: f64, phi_d: f64) -> 
 /// a rotation by pi about the normal, e.g. `Symmetry::Rotate180` of the fabric) and an even
 /// count only the first half is evaluated: the second repeats it.
 pub fn cell_value(
-    brdf: &Brdf,
+    brdf: &dyn Bsdf,
     angles: (f64, f64, f64),
     phi_samples: usize,
     half_turn: bool,
@@ -83,7 +83,7 @@ pub fn cell_value(
         let (Some(a), Some(b)) = (UnitVec3::new(a), UnitVec3::new(b)) else {
             continue;
         };
-        let (f, g) = (brdf(a, b), brdf(b, a));
+        let (f, g) = (brdf.f(a, b), brdf.f(b, a));
         let v: [f64; 3] = std::array::from_fn(|c| 0.5 * (f[c] + g[c]));
         for c in 0..3 {
             sum[c] += v[c];
@@ -125,7 +125,7 @@ pub struct MerlTable {
 /// Tabulates `brdf` (rows of theta_h in parallel on the current rayon pool, collected in order:
 /// deterministic). `phi_samples` >= 1 rotations are averaged per cell; `half_turn` as in
 /// [`cell_value`].
-pub fn merl_table(brdf: &Brdf, phi_samples: usize, half_turn: bool) -> MerlTable {
+pub fn merl_table(brdf: &dyn Bsdf, phi_samples: usize, half_turn: bool) -> MerlTable {
     assert!(phi_samples >= 1);
     let rows: Vec<Vec<([f64; 3], f64)>> = (0..N_THETA_H)
         .into_par_iter()
@@ -208,10 +208,10 @@ mod tests {
 
     #[test]
     fn isotropic_brdf_has_no_spread() {
-        let brdf = |wi: UnitVec3, wo: UnitVec3| {
+        let brdf = clothbake_core::FromFn(|wi: UnitVec3, wo: UnitVec3| {
             let c = wi.cos_theta() * wo.cos_theta();
             [c, 2.0 * c, 0.5]
-        };
+        });
         let (v, rel) = cell_value(&brdf, cell_angles(30, 20, 50), 12, false);
         assert!(rel < 1e-12, "{rel}");
         let (a, b) = half_diff_to_pair(
@@ -226,10 +226,10 @@ mod tests {
     #[test]
     fn half_turn_symmetry_halves_the_work_not_the_result() {
         // Invariant under (x, y) -> (-x, -y), anisotropic otherwise.
-        let brdf = |wi: UnitVec3, wo: UnitVec3| {
+        let brdf = clothbake_core::FromFn(|wi: UnitVec3, wo: UnitVec3| {
             let v = (wi.x + wo.x).powi(2) + 0.3 * wi.x * wo.y;
             [1.0 + v, 2.0, 0.5 + wi.y * wo.y]
-        };
+        });
         for cell in [(10, 5, 7), (40, 30, 100), (70, 10, 179)] {
             let a = cell_angles(cell.0, cell.1, cell.2);
             let (full, rf) = cell_value(&brdf, a, 16, false);

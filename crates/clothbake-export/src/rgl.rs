@@ -21,7 +21,7 @@
 //! n_phi, j <= n_phi (the last node repeats the first: no symmetry reduction, which both
 //! Mitsuba 3 and pbrt-v4 accept).
 
-use super::{luminance, reflect, spectrum, Brdf};
+use super::{luminance, reflect, spectrum, Bsdf};
 use clothbake_core::UnitVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -200,7 +200,7 @@ pub fn slice_half_vector(x: usize, y: usize, n: usize) -> (UnitVec3, f64) {
 }
 
 /// The tables of one view direction v: rgb (3 x n x n, channel-major) and luminance (n x n).
-fn slice(brdf: &Brdf, v: UnitVec3, n: usize) -> (Vec<f32>, Vec<f32>) {
+fn slice(brdf: &dyn Bsdf, v: UnitVec3, n: usize) -> (Vec<f32>, Vec<f32>) {
     let mut rgb = vec![0f32; 3 * n * n];
     let mut lum = vec![0f64; n * n];
     for y in 0..n {
@@ -211,7 +211,7 @@ fn slice(brdf: &Brdf, v: UnitVec3, n: usize) -> (Vec<f32>, Vec<f32>) {
                 continue;
             };
             // What the reader returns: f_r(light, view) cos(theta_light).
-            let f = brdf(l, v).map(|c| c * l.cos_theta());
+            let f = brdf.f(l, v).map(|c| c * l.cos_theta());
             for (c, fc) in f.iter().enumerate() {
                 rgb[(c * n + y) * n + x] = *fc as f32;
             }
@@ -246,7 +246,7 @@ pub struct Slices {
 
 /// Evaluates `brdf` on every slice of `grid`. Deterministic: slices are evaluated in parallel on
 /// the current rayon pool and collected in order.
-pub fn rgl_slices(brdf: &Brdf, grid: &RglGrid) -> Slices {
+pub fn rgl_slices(brdf: &dyn Bsdf, grid: &RglGrid) -> Slices {
     let (nt, np, n) = (grid.n_theta, grid.n_phi + 1, grid.n_slice);
     let thetas = grid.theta_nodes();
     let phis = grid.phi_nodes();
@@ -265,7 +265,12 @@ pub fn rgl_slices(brdf: &Brdf, grid: &RglGrid) -> Slices {
 }
 
 /// The fields of a `.bsdf` file for `brdf` on `grid`: [`rgl_slices`] then [`fields_of`].
-pub fn rgl_fields(brdf: &Brdf, grid: &RglGrid, description: &str, colour: Colour) -> Vec<Field> {
+pub fn rgl_fields(
+    brdf: &dyn Bsdf,
+    grid: &RglGrid,
+    description: &str,
+    colour: Colour,
+) -> Vec<Field> {
     fields_of(&rgl_slices(brdf, grid), description, colour)
 }
 
@@ -383,13 +388,13 @@ mod tests {
     fn lambertian_slices_hold_rho_cos_over_pi() {
         // f_r = rho / pi: every rgb node whose light is above the horizon holds rho cos / pi.
         let rho = 0.5;
-        let brdf = |wi: UnitVec3, wo: UnitVec3| {
+        let brdf = clothbake_core::FromFn(|wi: UnitVec3, wo: UnitVec3| {
             if wi.above_horizon() && wo.above_horizon() {
                 [rho / PI; 3]
             } else {
                 [0.0; 3]
             }
-        };
+        });
         let g = RglGrid {
             n_theta: 3,
             n_phi: 4,

@@ -379,9 +379,9 @@ mod tests {
                         UnitVec3::from_degrees(ti, pi),
                         UnitVec3::from_degrees(to, po),
                     );
-                    let f = rgb_model.eval(wi, wo).brdf(wi);
+                    let f = rgb_model.intensity(wi, wo).brdf(wi);
                     let want = up.spectrum(f)[w];
-                    let got = grey_model.eval(wi, wo).brdf(wi);
+                    let got = grey_model.intensity(wi, wo).brdf(wi);
                     assert!((got[0] - got[2]).abs() <= 1e-12 * got[0].abs());
                     assert!(
                         (got[0] - want).abs()

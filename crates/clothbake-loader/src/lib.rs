@@ -9,12 +9,14 @@
 pub mod angles;
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+mod bsdf;
 pub mod format;
 pub mod lookup;
 mod nodes;
 pub mod sampling;
 pub mod stored;
 
+pub use clothbake_bsdf::{Bsdf, BsdfSample, UnitVec3};
 pub use format::{
     read_binary, read_exr, read_exr_stored, read_table, read_table_stored, write_atomic,
     write_binary, write_exr, Grid, Metadata, Precision, Table, TableError, FORMAT_VERSION,

@@ -254,6 +254,11 @@ impl Brdf {
         values + self.sampler.as_ref().map_or(0, Sampler::memory_bytes)
     }
 
+    /// True when the table was opened with importance sampling ([`Options::sampling`]).
+    pub fn has_sampling(&self) -> bool {
+        self.sampler.is_some()
+    }
+
     /// True when lookups are symmetrised (see [`Options::reciprocal`]).
     pub fn is_reciprocal(&self) -> bool {
         self.reciprocal

@@ -154,7 +154,7 @@ impl PyFabric {
                 py.detach(|| {
                     pairs
                         .par_iter()
-                        .map(|&(a, b)| parts(&m.eval_with(a, b, secondary.as_ref()), a))
+                        .map(|&(a, b)| parts(&m.intensity_with(a, b, secondary.as_ref()), a))
                         .collect()
                 })
             }
@@ -204,7 +204,7 @@ impl PyFabric {
         check_unit("wi", 0, wi)?;
         check_unit("wo", 0, wo)?;
         let (a, b) = (unit(wi), unit(wo));
-        let f = self.model(facet_model(facet)?).eval(a, b).brdf(a);
+        let f = self.model(facet_model(facet)?).intensity(a, b).brdf(a);
         Ok((f[0], f[1], f[2]))
     }
 }

@@ -26,7 +26,7 @@ pub struct Source<'a> {
     /// Legend name (e.g. the table's file name, or "model").
     pub name: String,
     /// The BRDF.
-    pub shader: &'a dyn Shader,
+    pub shader: &'a Shader,
 }
 
 /// What to plot.
@@ -49,7 +49,7 @@ pub enum Plot {
 }
 
 /// Mean of the three channels of f_r.
-fn value(s: &dyn Shader, wi: UnitVec3, wo: UnitVec3) -> f64 {
+fn value(s: &Shader, wi: UnitVec3, wo: UnitVec3) -> f64 {
     let f = s.f_r(wi, wo);
     (f64::from(f[0]) + f64::from(f[1]) + f64::from(f[2])) / 3.0
 }
@@ -66,7 +66,7 @@ pub fn plane_direction(s: f64, phi_i: f64) -> UnitVec3 {
 
 /// The slice of `s` for wi = (theta_i, phi_i): (signed angle, value) at 1-degree steps from
 /// -89.5 to 89.5.
-pub fn slice(s: &dyn Shader, theta_i: f64, phi_i: f64) -> Vec<(f64, f64)> {
+pub fn slice(s: &Shader, theta_i: f64, phi_i: f64) -> Vec<(f64, f64)> {
     let wi = UnitVec3::from_degrees(theta_i, phi_i);
     (0..180)
         .map(|k| {
@@ -82,7 +82,7 @@ const SECTORS: usize = 72;
 
 /// The hemisphere map of `s` for wi = (theta_i, phi_i): `RINGS x SECTORS` values at the cell
 /// centres, ring-major.
-pub fn hemisphere(s: &dyn Shader, theta_i: f64, phi_i: f64) -> Vec<f64> {
+pub fn hemisphere(s: &Shader, theta_i: f64, phi_i: f64) -> Vec<f64> {
     let wi = UnitVec3::from_degrees(theta_i, phi_i);
     let mut v = Vec::with_capacity(RINGS * SECTORS);
     for r in 0..RINGS {

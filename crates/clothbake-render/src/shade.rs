@@ -1,5 +1,5 @@
-//! Shading: the BRDF behind one small trait ([`ModelShader`]: the analytic model;
-//! [`TableShader`]: a baked table), and the pixel value of a lit surface point.
+//! Shading: a [`Shader`] (any [`Bsdf`]: the analytic model or a baked table) and the pixel
+//! value of a lit surface point.
 //!
 //! Pixel value (linear, per RGB channel), for a surface point seen from the eye:
 //!
@@ -17,68 +17,73 @@
 //! * where `wo` is at or below the local horizon (the back of the surface) V = 0; where `wi`
 //!   is, only the ambient term remains. There are no cast shadows between parts of the scene.
 
+pub use clothbake_core::Component;
 use clothbake_core::{
-    intensity_to_brdf, AnalyticModel, Fabric, FacetModel, SecondaryOptions, UnitVec3, Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FacetModel, SecondaryOptions, UnitVec3, Variant,
 };
 
-/// A BRDF in the fabric's local frame.
-pub trait Shader: Sync {
-    /// f_r(wi, wo) in 1/sr, RGB; zero when either direction is at or below the horizon.
-    fn f_r(&self, wi: UnitVec3, wo: UnitVec3) -> [f32; 3];
-    /// The cloth's colour for the ambient term: the diffuse colour over its largest channel.
-    fn tint(&self) -> [f32; 3];
-}
-
-/// Which part of the model's reflection a [`ModelShader`] shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Component {
-    /// Everything computed: I_1, plus I_2 with two bounces.
-    #[default]
-    Total,
-    /// The direct reflection I_1 = I_d + I_s (thesis eq. 4.11).
-    Direct,
-    /// The secondary reflection I_2 = I_ss + I_sd + I_ds + I_dd alone (eq. 5.15).
-    Secondary,
-    /// The specular-specular secondary reflection I_ss alone (eq. 5.11).
-    SecondarySpecular,
-}
-
-/// The analytic model evaluated directly at every shading point.
-pub struct ModelShader {
-    model: AnalyticModel,
-    secondary: Option<SecondaryOptions>,
-    component: Component,
+/// What a picture shades with: a [`Bsdf`] (the analytic model or a baked table, through the
+/// one interface) and the cloth's tint for the ambient term.
+pub struct Shader {
+    bsdf: Box<dyn Bsdf>,
     tint: [f32; 3],
 }
 
-impl ModelShader {
-    /// The model of `fabric`; `secondary` adds I_2 (two bounces). [`Component::Secondary`]
+impl Shader {
+    /// Any BSDF with the tint of its ambient term.
+    pub fn new(bsdf: Box<dyn Bsdf>, tint: [f32; 3]) -> Shader {
+        Shader { bsdf, tint }
+    }
+
+    /// The analytic model of `fabric`; `secondary` adds I_2 (two bounces). [`Component::Secondary`]
     /// and [`Component::SecondarySpecular`] need `secondary`.
-    pub fn new(
+    pub fn model(
         fabric: &Fabric,
         facet: FacetModel,
         variant: Variant,
         secondary: Option<SecondaryOptions>,
         component: Component,
-    ) -> Result<ModelShader, String> {
-        if secondary.is_none()
-            && matches!(
-                component,
-                Component::Secondary | Component::SecondarySpecular
-            )
-        {
-            return Err("the secondary reflection's components need two bounces".into());
-        }
-        let a: [f64; 3] = std::array::from_fn(|k| {
-            0.5 * (fabric.warp().material.albedo[k] + fabric.weft().material.albedo[k])
-        });
-        Ok(ModelShader {
-            model: AnalyticModel::with_variant(fabric, facet, variant),
+    ) -> Result<Shader, String> {
+        let bsdf = AnalyticBsdf::new(
+            AnalyticModel::with_variant(fabric, facet, variant),
             secondary,
-            component,
-            tint: tint_of(a),
-        })
+        )
+        .with_component(component)
+        .ok_or("the secondary reflection's components need two bounces")?;
+        Ok(Shader::new(Box::new(bsdf), fabric_tint(fabric)))
     }
+
+    /// The baked table at `path` (either format), looked up with the loader's interpolation.
+    /// The tint comes from the fabric file stored in the table's metadata ((1, 1, 1) if it
+    /// cannot be read).
+    pub fn table(path: &std::path::Path) -> Result<Shader, clothbake_loader::TableError> {
+        let options = clothbake_loader::Options {
+            sampling: false,
+            ..Default::default()
+        };
+        let brdf = clothbake_loader::Brdf::open(path, options)?;
+        let tint = Fabric::from_json_str(&brdf.meta().fabric_json, "table metadata")
+            .map_or([1.0; 3], |f| fabric_tint(&f));
+        Ok(Shader::new(Box::new(brdf), tint))
+    }
+
+    /// f_r(wi, wo) in 1/sr, RGB, in the render's f32; zero when either direction is at or
+    /// below the horizon.
+    pub fn f_r(&self, wi: UnitVec3, wo: UnitVec3) -> [f32; 3] {
+        self.bsdf.f(wi, wo).map(|x| x as f32)
+    }
+
+    /// The cloth's colour for the ambient term: the diffuse colour over its largest channel.
+    pub fn tint(&self) -> [f32; 3] {
+        self.tint
+    }
+}
+
+/// A fabric's tint: the mean of its two groups' diffuse colours over its largest channel.
+fn fabric_tint(fabric: &Fabric) -> [f32; 3] {
+    tint_of(std::array::from_fn(|k| {
+        0.5 * (fabric.warp().material.albedo[k] + fabric.weft().material.albedo[k])
+    }))
 }
 
 /// A colour divided by its largest channel ((1, 1, 1) for black or grey).
@@ -88,24 +93,6 @@ pub fn tint_of(c: [f64; 3]) -> [f32; 3] {
         std::array::from_fn(|k| (c[k] / m) as f32)
     } else {
         [1.0; 3]
-    }
-}
-
-impl Shader for ModelShader {
-    fn f_r(&self, wi: UnitVec3, wo: UnitVec3) -> [f32; 3] {
-        let r = self.model.eval_with(wi, wo, self.secondary.as_ref());
-        let s = r.secondary.unwrap_or_default();
-        let i = match self.component {
-            Component::Total => r.total(),
-            Component::Direct => r.direct(),
-            Component::Secondary => s.total(),
-            Component::SecondarySpecular => s.ss,
-        };
-        intensity_to_brdf(i, wi).map(|x| x as f32)
-    }
-
-    fn tint(&self) -> [f32; 3] {
-        self.tint
     }
 }
 
@@ -123,7 +110,7 @@ pub struct Lighting {
 /// The pixel value of a surface point with local light and eye directions `wi`, `wo` (not
 /// necessarily above the horizon): see the module documentation.
 pub fn radiance(
-    shader: &dyn Shader,
+    shader: &Shader,
     lighting: &Lighting,
     wi: clothbake_core::Vec3,
     wo: clothbake_core::Vec3,
@@ -141,42 +128,4 @@ pub fn radiance(
         }
     }
     v
-}
-
-/// A baked table, looked up with the loader's interpolation (`clothbake_loader::Brdf::eval`).
-pub struct TableShader {
-    brdf: clothbake_loader::Brdf,
-    tint: [f32; 3],
-}
-
-impl TableShader {
-    /// Opens the table at `path` (either format). The tint comes from the fabric file stored in
-    /// the table's metadata ((1, 1, 1) if it cannot be read).
-    pub fn open(path: &std::path::Path) -> Result<TableShader, clothbake_loader::TableError> {
-        let options = clothbake_loader::Options {
-            sampling: false,
-            ..Default::default()
-        };
-        let brdf = clothbake_loader::Brdf::open(path, options)?;
-        let tint = Fabric::from_json_str(&brdf.meta().fabric_json, "table metadata").map_or(
-            [1.0; 3],
-            |f| {
-                tint_of(std::array::from_fn(|k| {
-                    0.5 * (f.warp().material.albedo[k] + f.weft().material.albedo[k])
-                }))
-            },
-        );
-        Ok(TableShader { brdf, tint })
-    }
-}
-
-impl Shader for TableShader {
-    fn f_r(&self, wi: UnitVec3, wo: UnitVec3) -> [f32; 3] {
-        let v = |u: UnitVec3| [u.x as f32, u.y as f32, u.z as f32];
-        self.brdf.eval(v(wi), v(wo))
-    }
-
-    fn tint(&self) -> [f32; 3] {
-        self.tint
-    }
 }

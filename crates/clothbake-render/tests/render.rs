@@ -7,7 +7,7 @@ use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Variant, Vec3}
 use clothbake_render::camera::Camera;
 use clothbake_render::plot::{self, Plot, Source};
 use clothbake_render::scene::Scene;
-use clothbake_render::shade::{Component, Lighting, ModelShader, Shader};
+use clothbake_render::shade::{Component, Lighting, Shader};
 use clothbake_render::tonemap::Image;
 use clothbake_render::{render, scene::Drape};
 use std::f64::consts::PI;
@@ -21,8 +21,8 @@ fn fabric(name: &str) -> Fabric {
     Fabric::from_path(&p).unwrap()
 }
 
-fn shader(f: &Fabric) -> ModelShader {
-    ModelShader::new(f, FacetModel::Huo, Variant::Refined, None, Component::Total).unwrap()
+fn shader(f: &Fabric) -> Shader {
+    Shader::model(f, FacetModel::Huo, Variant::Refined, None, Component::Total).unwrap()
 }
 
 fn unit(v: Vec3) -> Vec3 {
@@ -37,14 +37,7 @@ fn lighting(light: Vec3, ambient: f64) -> Lighting {
     }
 }
 
-fn draw(
-    scene: &Scene,
-    cam: &Camera,
-    l: &Lighting,
-    s: &dyn Shader,
-    aa: u32,
-    threads: usize,
-) -> Image {
+fn draw(scene: &Scene, cam: &Camera, l: &Lighting, s: &Shader, aa: u32, threads: usize) -> Image {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -224,7 +217,7 @@ fn swatch_pixels_equal_the_model_at_their_directions() {
             }
             let wi = UnitVec3::new(light).unwrap();
             let wo = UnitVec3::new(eye - p).unwrap();
-            let i_total = model.eval(wi, wo).total();
+            let i_total = model.intensity(wi, wo).total();
             for (k, &ik) in i_total.iter().enumerate() {
                 let fr = ik / (PI * wi.cos_theta());
                 let want = 0.25 + fr * wi.cos_theta() * 2.0;
@@ -243,7 +236,7 @@ fn swatch_pixels_equal_the_model_at_their_directions() {
 #[test]
 fn secondary_components_need_two_bounces() {
     let f = fabric("parallel");
-    assert!(ModelShader::new(
+    assert!(Shader::model(
         &f,
         FacetModel::Huo,
         Variant::Refined,
@@ -252,7 +245,7 @@ fn secondary_components_need_two_bounces() {
     )
     .is_err());
     let opts = clothbake_core::SecondaryOptions::default();
-    let total = ModelShader::new(
+    let total = Shader::model(
         &f,
         FacetModel::Huo,
         Variant::Refined,
@@ -260,7 +253,7 @@ fn secondary_components_need_two_bounces() {
         Component::Total,
     )
     .unwrap();
-    let direct = ModelShader::new(
+    let direct = Shader::model(
         &f,
         FacetModel::Huo,
         Variant::Refined,
@@ -268,7 +261,7 @@ fn secondary_components_need_two_bounces() {
         Component::Direct,
     )
     .unwrap();
-    let second = ModelShader::new(
+    let second = Shader::model(
         &f,
         FacetModel::Huo,
         Variant::Refined,
@@ -276,7 +269,7 @@ fn secondary_components_need_two_bounces() {
         Component::Secondary,
     )
     .unwrap();
-    let iss = ModelShader::new(
+    let iss = Shader::model(
         &f,
         FacetModel::Huo,
         Variant::Refined,
@@ -305,7 +298,7 @@ fn secondary_components_need_two_bounces() {
 #[test]
 fn table_shader_agrees_with_the_model() {
     use clothbake_bake::{bake, BakeOptions};
-    use clothbake_render::shade::TableShader;
+    use clothbake_render::shade::Shader;
     let twill = fabric("twill");
     let opts = BakeOptions {
         grid: clothbake_loader::Grid {
@@ -321,7 +314,7 @@ fn table_shader_agrees_with_the_model() {
         .table;
     let path = temp("twill-16.bin");
     clothbake_loader::write_binary(&path, &table, true).unwrap();
-    let ts = TableShader::open(&path).unwrap();
+    let ts = Shader::table(&path).unwrap();
     let ms = shader(&twill);
     let scene = Scene::swatch(30.0);
     let cam = Camera::new(Vec3::new(0.0, -55.0, 45.0), Vec3::default(), 60.0, 24, 24).unwrap();

@@ -7,8 +7,8 @@ use crate::cli::ExportArgs;
 use crate::error::CliError;
 use crate::eval_cmd::apply_material;
 use clothbake_core::symmetry::{symmetries, Symmetry};
-use clothbake_core::{AnalyticModel, Fabric, FacetModel};
-use clothbake_export::{self as export, merl, rgl, spectrum, Brdf};
+use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel};
+use clothbake_export::{self as export, merl, rgl, spectrum, Bsdf};
 use clothbake_loader::TableError;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -53,13 +53,14 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             let facet = FacetModel::from(args.facet.unwrap_or(crate::cli::FacetArg::Huo));
             let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);
             let model = AnalyticModel::with_variant(&fabric, facet, variant.into());
-            let brdf = export::model_brdf(&model, secondary);
+            let variant_name = model.variant().name();
+            let brdf = AnalyticBsdf::new(model, secondary);
             let source = format!(
                 "fabric {}; f_r cos(theta_light) of the analytic model (facet {}, variant {}, \
                  bounces {})",
                 fabric.name(),
                 facet_name(facet),
-                model.variant().name(),
+                variant_name,
                 args.bounces.bounces
             );
             // A fabric unchanged by a half turn has a BRDF unchanged by it: half the rotations.
@@ -93,10 +94,9 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
                 meta.options_json,
                 meta.fabric_json
             );
-            let brdf = export::table_brdf(&lookup);
             // No half-turn shortcut for a table: lookups are cheap, and the interpolated table
             // need not be exactly symmetric.
-            write_all(args, &brdf, &source, false)
+            write_all(args, &lookup, &source, false)
         }
     }
 }
@@ -139,7 +139,7 @@ fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
 /// Writes every requested file from `brdf`; `source` opens the RGL description.
 fn write_all(
     args: &ExportArgs,
-    brdf: &Brdf,
+    brdf: &dyn Bsdf,
     source: &str,
     half_turn: bool,
 ) -> Result<String, CliError> {

@@ -10,7 +10,7 @@ use clothbake_core::{Fabric, FacetModel, Vec3};
 use clothbake_render::camera::{Camera, CameraError};
 use clothbake_render::plot::{self, Plot, Source};
 use clothbake_render::scene::Scene;
-use clothbake_render::shade::{Component, Lighting, ModelShader, Shader, TableShader};
+use clothbake_render::shade::{Component, Lighting, Shader};
 use clothbake_render::tonemap::{self, Curve};
 use clothbake_render::{self as renderer};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -20,7 +20,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 /// The model shader of `--weave`, with its options checked.
-fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<ModelShader, CliError> {
+fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
     let opts = b.bounces.options()?;
     let secondary = (b.bounces.bounces == 2).then_some(opts);
     let component = match b.component {
@@ -30,7 +30,7 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<ModelShader, CliError> {
         ComponentArg::Iss => Component::SecondarySpecular,
     };
     let fabric = apply_material(Fabric::from_path(weave)?, &b.material)?;
-    ModelShader::new(
+    Shader::model(
         &fabric,
         FacetModel::from(b.facet),
         b.variant.into(),
@@ -55,10 +55,8 @@ fn component_name(c: ComponentArg) -> &'static str {
 }
 
 /// The shader of a baked table (the loader's interpolated lookup).
-fn table_shader(path: &Path) -> Result<Box<dyn Shader>, CliError> {
-    Ok(Box::new(
-        TableShader::open(path).map_err(|e| table_error(&e))?,
-    ))
+fn table_shader(path: &Path) -> Result<Shader, CliError> {
+    Shader::table(path).map_err(|e| table_error(&e))
 }
 
 /// Options that only apply to the model, given with --table.
@@ -79,7 +77,7 @@ fn check_model_only(b: &BrdfArgs) -> Result<(), CliError> {
 }
 
 /// A named BRDF source.
-type Named = (String, Box<dyn Shader>);
+type Named = (String, Shader);
 
 /// The sources named on the command line, in order: tables first, then the model.
 fn sources(b: &BrdfArgs, most: usize) -> Result<Vec<Named>, CliError> {
@@ -108,10 +106,7 @@ fn sources(b: &BrdfArgs, most: usize) -> Result<Vec<Named>, CliError> {
         out.push((file_name(t), table_shader(t)?));
     }
     if let Some(w) = &b.weave {
-        out.push((
-            format!("model {}", file_name(w)),
-            Box::new(model_shader(w, b)?),
-        ));
+        out.push((format!("model {}", file_name(w)), model_shader(w, b)?));
     }
     Ok(out)
 }
@@ -207,17 +202,7 @@ pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
     };
     let never = AtomicBool::new(false);
     let img = pool
-        .install(|| {
-            renderer::render(
-                &scene,
-                &camera,
-                &lighting,
-                shader.as_ref(),
-                a.aa,
-                &progress,
-                &never,
-            )
-        })
+        .install(|| renderer::render(&scene, &camera, &lighting, &shader, a.aa, &progress, &never))
         .expect("never cancelled");
     if let Some(b) = &bar {
         b.finish_and_clear();
@@ -275,7 +260,7 @@ pub fn run_plot(a: &PlotArgs) -> Result<String, CliError> {
         .iter()
         .map(|(name, s)| Source {
             name: name.clone(),
-            shader: s.as_ref(),
+            shader: s,
         })
         .collect();
     let p = match a.kind {

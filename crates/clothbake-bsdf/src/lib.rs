@@ -1,0 +1,155 @@
+//! clothbake-bsdf: the one BSDF interface of clothbake, after pbrt-v4's BxDF, and the vector
+//! maths it is written in.
+//!
+//! Every reflectance clothbake computes or loads — the analytic model (any facet, variant and
+//! bounce setting, `clothbake_core::AnalyticBsdf`) and a baked table (`clothbake_loader::Brdf`)
+//! — implements [`Bsdf`]; baking, export, pictures and Python use only this trait. It lives in
+//! a crate of its own, below both the model and the loader, so that renderers that link the
+//! loader alone get it without the model.
+//!
+//! Conventions: local frame with +X the weft direction, +Y the warp direction, +Z the macro
+//! normal; `wi` points toward the light, `wo` toward the eye, both unit vectors
+//! ([`UnitVec3`]); values are linear RGB. Directions at or below the horizon
+//! (cos theta <= [`HORIZON_COS`]) reflect nothing.
+
+pub mod vec3;
+
+pub use vec3::{half_vector, UnitVec3, Vec3, HORIZON_COS};
+
+use std::f64::consts::PI;
+
+/// Linear RGB.
+pub type Rgb = [f64; 3];
+
+/// An incident direction drawn by [`Bsdf::sample`], with f_r and the density there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// The sampled incident direction (toward the light), above the horizon.
+    pub wi: UnitVec3,
+    /// f_r(wi, wo) in 1/sr.
+    pub f: Rgb,
+    /// Its density per unit solid angle, > 0.
+    pub pdf: f64,
+}
+
+impl BsdfSample {
+    /// The estimator's weight f_r(wi, wo) cos(theta_i) / pdf.
+    pub fn weight(&self) -> Rgb {
+        let c = self.wi.cos_theta() / self.pdf;
+        self.f.map(|f| f * c)
+    }
+}
+
+/// A bidirectional reflectance distribution: f_r, a sampler of incident directions and its
+/// density, on local-frame unit directions.
+pub trait Bsdf: Sync {
+    /// f_r(wi, wo) in 1/sr, RGB; zero when either direction is at or below the horizon.
+    fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb;
+
+    /// Draws an incident direction for the outgoing `wo` from `u` in [0, 1)^2; `None` when
+    /// there is none (`wo` below the horizon). The default draws cos(theta_i)-weighted
+    /// directions ([`cosine_sample`]), valid for any f_r.
+    fn sample(&self, wo: UnitVec3, u: [f64; 2]) -> Option<BsdfSample> {
+        default_sample(self, wo, u)
+    }
+
+    /// The density per unit solid angle with which [`Bsdf::sample`] draws `wi` for `wo`. The
+    /// default is that of [`cosine_sample`], cos(theta_i) / pi.
+    fn pdf(&self, wo: UnitVec3, wi: UnitVec3) -> f64 {
+        default_pdf(wo, wi)
+    }
+}
+
+/// A function f_r(wi, wo) as a [`Bsdf`] (with the default sampling): for a user's own
+/// reflectance and for tests. The function must return zero at and below the horizon.
+pub struct FromFn<F>(pub F);
+
+impl<F: Fn(UnitVec3, UnitVec3) -> Rgb + Sync> Bsdf for FromFn<F> {
+    fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb {
+        (self.0)(wi, wo)
+    }
+}
+
+/// The default [`Bsdf::sample`]: a [`cosine_sample`] with f_r from `b` and [`default_pdf`].
+pub fn default_sample<B: Bsdf + ?Sized>(b: &B, wo: UnitVec3, u: [f64; 2]) -> Option<BsdfSample> {
+    if !wo.above_horizon() {
+        return None;
+    }
+    let wi = cosine_sample(u);
+    let pdf = default_pdf(wo, wi);
+    (pdf > 0.0).then(|| BsdfSample {
+        wi,
+        f: b.f(wi, wo),
+        pdf,
+    })
+}
+
+/// The default [`Bsdf::pdf`]: cos(theta_i) / pi above the horizon, else 0.
+pub fn default_pdf(wo: UnitVec3, wi: UnitVec3) -> f64 {
+    if !(wo.above_horizon() && wi.above_horizon()) {
+        return 0.0;
+    }
+    wi.cos_theta() / PI
+}
+
+/// A direction of the upper hemisphere with density cos(theta) / pi, from `u` in [0, 1)^2
+/// (Malley's method: a uniform point of the unit disc lifted to the hemisphere).
+pub fn cosine_sample(u: [f64; 2]) -> UnitVec3 {
+    let r = u[0].clamp(0.0, 1.0).sqrt();
+    let phi = 2.0 * PI * u[1];
+    let z = (1.0 - r * r).max(0.0).sqrt().max(2.0 * HORIZON_COS);
+    UnitVec3::new(Vec3::new(r * phi.cos(), r * phi.sin(), z)).unwrap_or(UnitVec3::Z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A Lambertian reflector of albedo rho: f_r = rho / pi.
+    struct Lambert(f64);
+    impl Bsdf for Lambert {
+        fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb {
+            if wi.above_horizon() && wo.above_horizon() {
+                [self.0 / PI; 3]
+            } else {
+                [0.0; 3]
+            }
+        }
+    }
+
+    #[test]
+    fn the_default_sampler_gives_a_lambertian_its_albedo_as_weight() {
+        // Closed form: f cos / pdf = (rho / pi) cos / (cos / pi) = rho for every sample.
+        let b = Lambert(0.7);
+        let wo = UnitVec3::from_degrees(40.0, 10.0);
+        for k in 0..64 {
+            let u = [(k as f64 + 0.5) / 64.0, ((k * 37) % 64) as f64 / 64.0];
+            let s = b.sample(wo, u).unwrap();
+            assert!(s.wi.above_horizon());
+            assert!((s.pdf - b.pdf(wo, s.wi)).abs() < 1e-15);
+            for w in s.weight() {
+                assert!((w - 0.7).abs() < 1e-12, "{w}");
+            }
+        }
+        assert!(b
+            .sample(UnitVec3::from_degrees(90.0, 0.0), [0.5; 2])
+            .is_none());
+    }
+
+    #[test]
+    fn the_default_density_integrates_to_one() {
+        // Midpoint rule over the hemisphere: int pdf dw = 1.
+        let (nt, np) = (400, 64);
+        let mut s = 0.0;
+        for i in 0..nt {
+            let t = (i as f64 + 0.5) * (PI / 2.0) / nt as f64;
+            for j in 0..np {
+                let p = (j as f64 + 0.5) * 2.0 * PI / np as f64;
+                let wi = UnitVec3::from_spherical(t, p);
+                s += Lambert(1.0).pdf(UnitVec3::Z, wi) * t.sin();
+            }
+        }
+        s *= (PI / 2.0 / nt as f64) * (2.0 * PI / np as f64);
+        assert!((s - 1.0).abs() < 1e-5, "{s}");
+    }
+}

@@ -1,0 +1,40 @@
+//! A baked table as a [`Bsdf`]: f_r by [`Brdf::eval`], sampling and density by the table's own
+//! importance sampling ([`Brdf::sample`], [`Brdf::pdf`]; the trait's cosine default where the
+//! table was opened without sampling). Directions are rounded to f32 as the lookup takes them.
+
+use crate::lookup::Brdf;
+use clothbake_bsdf::{Bsdf, BsdfSample, Rgb, UnitVec3, Vec3};
+
+fn f32s(u: UnitVec3) -> [f32; 3] {
+    [u.x as f32, u.y as f32, u.z as f32]
+}
+
+impl Bsdf for Brdf {
+    fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb {
+        self.eval(f32s(wi), f32s(wo)).map(f64::from)
+    }
+
+    fn sample(&self, wo: UnitVec3, u: [f64; 2]) -> Option<BsdfSample> {
+        if !self.has_sampling() {
+            return clothbake_bsdf::default_sample(self, wo, u);
+        }
+        let s = self.sample(f32s(wo), u[0] as f32, u[1] as f32);
+        if s.pdf <= 0.0 {
+            return None;
+        }
+        let [x, y, z] = s.wi.map(f64::from);
+        let wi = UnitVec3::new(Vec3::new(x, y, z))?;
+        Some(BsdfSample {
+            wi,
+            f: Bsdf::f(self, wi, wo),
+            pdf: f64::from(s.pdf),
+        })
+    }
+
+    fn pdf(&self, wo: UnitVec3, wi: UnitVec3) -> f64 {
+        if !self.has_sampling() {
+            return clothbake_bsdf::default_pdf(wo, wi);
+        }
+        f64::from(Brdf::pdf(self, f32s(wo), f32s(wi)))
+    }
+}
