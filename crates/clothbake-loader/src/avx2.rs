@@ -14,7 +14,7 @@
 
 use std::arch::x86_64::*;
 
-use crate::lookup::HORIZON_COS;
+use crate::angles::HORIZON_COS;
 use crate::nodes::{next_column, Nodes, SpanLanes};
 
 /// True when this processor runs the kernel.
@@ -419,7 +419,7 @@ pub(crate) unsafe fn batch<const HALF: bool, V>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::Grid;
+    use crate::table::Grid;
 
     /// The documented position in cells (as `nodes::polar_axis`/`azimuth_axis` before
     /// clamping) of an angle in f64 on axis `k` of `n` cells.

@@ -25,22 +25,16 @@
 use std::fmt;
 use std::path::Path;
 
+pub use crate::angles::{above_horizon, HORIZON_COS};
+
 use crate::angles::{direction, theta_phi};
 #[cfg(target_arch = "x86_64")]
 use crate::avx2;
-use crate::format::{Grid, Metadata, Precision, Table, TableError};
+use crate::error::TableError;
 use crate::nodes::{self, Lane, Nodes, Values};
 use crate::sampling::Sampler;
 use crate::stored::{Samples, StoredTable};
-
-/// Directions with `cos theta` at or below this are on or below the horizon: zero.
-pub const HORIZON_COS: f32 = 1e-9;
-
-/// True when a unit vector is above the horizon (`z > 1e-9`); false for NaN.
-#[inline(always)]
-pub fn above_horizon(w: [f32; 3]) -> bool {
-    w[2] > HORIZON_COS
-}
+use crate::table::{Grid, Metadata, Precision, Table};
 
 /// True when a pair has a value: both directions above the horizon, no component NaN.
 #[inline(always)]
@@ -166,7 +160,7 @@ pub struct Brdf {
 impl Brdf {
     /// Loads a table file (either format, see [`crate::read_table_stored`]).
     pub fn open(path: &Path, options: Options) -> Result<Brdf, TableError> {
-        let stored = crate::format::read_table_stored(path)?;
+        let stored = crate::read::read_table_stored(path)?;
         Brdf::from_stored(stored, options).map_err(|e| match e {
             TableError::InvalidTable { reason } => TableError::Corrupted {
                 path: path.to_path_buf(),

@@ -18,8 +18,8 @@
 //! once per lookup and then reads the 8 runs without further checks.
 
 use crate::angles::{atan2, ATAN_COEFFS};
-use crate::format::Grid;
 use crate::stored::f16_to_f32;
+use crate::table::Grid;
 
 /// Lanes per node: R, G, B and a zero pad.
 pub(crate) const LANES: usize = 4;
