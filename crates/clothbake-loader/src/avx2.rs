@@ -1,5 +1,5 @@
 //! The lookup on x86-64 processors with AVX2, FMA and F16C (chosen at run time, see
-//! [`crate::Kernel`]): the four angles of a pair in one SSE register, computed straight as
+//! [`crate::SimdPath`]): the four angles of a pair in one SSE register, computed straight as
 //! positions in cells (the fast `atan2` whose octant fix-ups, cells per radian and polar/azimuth
 //! offsets are folded into its last fused multiply-add), the four axes' spans in one register,
 //! and the 8 runs of 8 lanes as eight 256-bit fused multiply-adds (F16C widens 8 halves in one

@@ -34,7 +34,7 @@ pub use container::{
 pub use error::TableError;
 pub use exr::{read_exr, read_exr_stored, write_exr, EXR_MAGIC};
 pub use half::f16;
-pub use lookup::{Brdf, Kernel, LengthMismatch, Memory, Options, Sample, HORIZON_COS};
+pub use lookup::{Brdf, LengthMismatch, Memory, Options, Sample, SimdPath, HORIZON_COS};
 pub use read::{read_table, read_table_stored};
 pub use stored::{Samples, StoredTable};
 pub use table::{Grid, Metadata, Precision, Table, FORMAT_VERSION, MAX_CELLS};
