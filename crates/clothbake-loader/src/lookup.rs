@@ -260,13 +260,11 @@ impl Brdf {
         let (n, r) = (&self.nodes, self.reciprocal);
         match (&n.values, self.simd) {
             // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C
-            // (`with_simd_path`, `SimdPath::best`); the values' type matches HALF.
+            // (`with_simd_path`, `SimdPath::best`); the lane type picks the loads.
             #[cfg(target_arch = "x86_64")]
-            (Values::F16(v), SimdPath::Avx2) => unsafe { avx2::eval::<true, u16>(n, v, r, wi, wo) },
+            (Values::F16(v), SimdPath::Avx2) => unsafe { avx2::eval(n, v, r, wi, wo) },
             #[cfg(target_arch = "x86_64")]
-            (Values::F32(v), SimdPath::Avx2) => unsafe {
-                avx2::eval::<false, f32>(n, v, r, wi, wo)
-            },
+            (Values::F32(v), SimdPath::Avx2) => unsafe { avx2::eval(n, v, r, wi, wo) },
             (Values::F16(v), _) => self.eval_portable(v, wi, wo),
             (Values::F32(v), _) => self.eval_portable(v, wi, wo),
         }
@@ -302,13 +300,9 @@ impl Brdf {
         match (&n.values, self.simd) {
             // SAFETY: as in `eval`.
             #[cfg(target_arch = "x86_64")]
-            (Values::F16(v), SimdPath::Avx2) => unsafe {
-                avx2::at_angles_of::<true, u16>(n, v, rc, ang)
-            },
+            (Values::F16(v), SimdPath::Avx2) => unsafe { avx2::at_angles_of(n, v, rc, ang) },
             #[cfg(target_arch = "x86_64")]
-            (Values::F32(v), SimdPath::Avx2) => unsafe {
-                avx2::at_angles_of::<false, f32>(n, v, rc, ang)
-            },
+            (Values::F32(v), SimdPath::Avx2) => unsafe { avx2::at_angles_of(n, v, rc, ang) },
             (Values::F16(v), _) => self.blend_reciprocal(v, ang),
             (Values::F32(v), _) => self.blend_reciprocal(v, ang),
         }
@@ -333,13 +327,9 @@ impl Brdf {
         match (&n.values, self.simd) {
             // SAFETY: as in `eval`.
             #[cfg(target_arch = "x86_64")]
-            (Values::F16(v), SimdPath::Avx2) => unsafe {
-                avx2::batch::<true, u16>(n, v, r, wi, wo, out)
-            },
+            (Values::F16(v), SimdPath::Avx2) => unsafe { avx2::batch(n, v, r, wi, wo, out) },
             #[cfg(target_arch = "x86_64")]
-            (Values::F32(v), SimdPath::Avx2) => unsafe {
-                avx2::batch::<false, f32>(n, v, r, wi, wo, out)
-            },
+            (Values::F32(v), SimdPath::Avx2) => unsafe { avx2::batch(n, v, r, wi, wo, out) },
             (Values::F16(v), _) => self.batch_in(v, wi, wo, out),
             (Values::F32(v), _) => self.batch_in(v, wi, wo, out),
         }
