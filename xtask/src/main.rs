@@ -330,7 +330,7 @@ fn loader_accuracy() {
         std::process::exit(1);
     };
     let new = format!("{}{begin}\n{out}{}", &doc[..b], &doc[e..]);
-    clothbake_loader::write_atomic(&path, true, |w| {
+    clothbake_loader::write_atomic_as(&path, "document", true, |w| {
         std::io::Write::write_all(w, new.as_bytes())
     })
     .expect("write docs/loader.md");

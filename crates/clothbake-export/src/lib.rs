@@ -18,14 +18,14 @@ pub mod rgl;
 pub mod spectrum;
 
 use clothbake_core::{UnitVec3, Vec3};
-use clothbake_loader::{write_atomic, TableError};
+use clothbake_loader::{write_atomic_as, TableError};
 use std::io::Write;
 use std::path::Path;
 
 /// Writes `bytes` to `path` atomically (temporary file, fsync, rename), refusing an existing
 /// file unless `overwrite`.
 pub fn write_file(path: &Path, bytes: &[u8], overwrite: bool) -> Result<(), TableError> {
-    write_atomic(path, overwrite, |w| w.write_all(bytes))
+    write_atomic_as(path, "exported file", overwrite, |w| w.write_all(bytes))
 }
 
 pub use clothbake_core::Bsdf;

@@ -8,7 +8,7 @@
 //! The side-by-side comparison with the analytic model is `cargo bench -p clothbake-tests`.
 
 use clothbake_loader::{
-    Brdf, Grid, Kernel, Memory, Metadata, Options, Precision, StoredTable, Table,
+    Brdf, Grid, Memory, Metadata, Options, Precision, SimdPath, StoredTable, Table,
 };
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
@@ -59,11 +59,11 @@ fn lookup(c: &mut Criterion) {
     let half = brdf(Memory::AsStored, false);
     let wide = brdf(Memory::F32, false);
     let recip = brdf(Memory::AsStored, true);
-    let portable = |b: &Brdf| b.clone().with_kernel(Kernel::Portable).unwrap();
+    let portable = |b: &Brdf| b.clone().with_simd_path(SimdPath::Portable).unwrap();
     let (half_p, wide_p) = (portable(&half), portable(&wide));
     let (wi, wo) = pairs(WARM);
     let mut g = c.benchmark_group("lookup");
-    println!("default kernel: {:?}", half.kernel());
+    println!("default kernel: {:?}", half.simd_path());
     for (name, b) in [
         ("f16", &half),
         ("f32", &wide),

@@ -8,6 +8,15 @@
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
+/// Directions with `cos theta` at or below this are on or below the horizon: zero.
+pub const HORIZON_COS: f32 = 1e-9;
+
+/// True when a unit vector is above the horizon (`z > 1e-9`); false for NaN.
+#[inline(always)]
+pub fn above_horizon(w: [f32; 3]) -> bool {
+    w[2] > HORIZON_COS
+}
+
 /// Coefficients `c_j` of `atan(a) ~ a * sum_j c_j a^(2j)` on `0 <= a <= 1`.
 pub(crate) const ATAN_COEFFS: [f32; 6] = [
     0.999_977_2,

@@ -1,5 +1,5 @@
 //! The lookup on x86-64 processors with AVX2, FMA and F16C (chosen at run time, see
-//! [`crate::Kernel`]): the four angles of a pair in one SSE register, computed straight as
+//! [`crate::SimdPath`]): the four angles of a pair in one SSE register, computed straight as
 //! positions in cells (the fast `atan2` whose octant fix-ups, cells per radian and polar/azimuth
 //! offsets are folded into its last fused multiply-add), the four axes' spans in one register,
 //! and the 8 runs of 8 lanes as eight 256-bit fused multiply-adds (F16C widens 8 halves in one
@@ -14,8 +14,8 @@
 
 use std::arch::x86_64::*;
 
-use crate::lookup::HORIZON_COS;
-use crate::nodes::{next_column, Nodes, SpanLanes};
+use crate::angles::HORIZON_COS;
+use crate::nodes::{next_column, Lane, Nodes, SpanLanes};
 
 /// True when this processor runs the kernel.
 pub(crate) fn available() -> bool {
@@ -161,14 +161,13 @@ unsafe fn positions_of_angles(nodes: &Nodes, ang: __m128) -> __m128 {
     )
 }
 
-/// The quadrilinear blend at positions `pos` (cells, before clamping) of f16 (`HALF`) or f32
-/// values.
+/// The quadrilinear blend at positions `pos` (cells, before clamping) of f16 or f32 values.
 /// # Safety
 /// The processor must have AVX2, FMA and F16C.
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
-unsafe fn blend<const HALF: bool, V>(nodes: &Nodes, v: &[V], pos: __m128) -> [f32; 3] {
-    gather::<HALF, V>(nodes, v, &corner(nodes, pos))
+unsafe fn blend<V: Lane>(nodes: &Nodes, v: &[V], pos: __m128) -> [f32; 3] {
+    gather(nodes, v, &corner(nodes, pos))
 }
 
 /// Where a lookup falls ([`crate::nodes::Corner`] in registers).
@@ -228,37 +227,35 @@ unsafe fn corner(nodes: &Nodes, pos: __m128) -> Corner {
 /// The blend of the 8 runs of a corner.
 ///
 /// # Safety
-/// The processor must have AVX2, FMA and F16C; `V` is `u16` (half bits) when `HALF`, else
-/// `f32`.
+/// The processor must have AVX2, FMA and F16C.
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
-unsafe fn gather<const HALF: bool, V>(nodes: &Nodes, v: &[V], k: &Corner) -> [f32; 3] {
+unsafe fn gather<V: Lane>(nodes: &Nodes, v: &[V], k: &Corner) -> [f32; 3] {
     let Corner { base, w, d } = *k;
-    let Some(p) = nodes.runs(v, base) else {
+    let sum = nodes.with_runs(
+        v,
+        base,
+        #[inline(always)]
+        |runs| {
+            // Each run widened to 8 f32 as its lane type loads it (F16C for halves).
+            let load = |r: usize| V::load8(runs[r]);
+            // Run r weighs w_r (a broadcast from memory: a load, not a shuffle); (1 - t_po, t_po)
+            // by D is common to all runs and applied once to the sum; the weights do not wait for
+            // the loads, and the sum is a tree (short chain after them).
+            let mut wr = [0f32; 8];
+            _mm256_storeu_ps(wr.as_mut_ptr(), w); // 8 f32, unaligned
+            let lane = |r: usize| _mm256_broadcast_ss(&wr[r]);
+            let y0 = _mm256_fmadd_ps(load(1), lane(1), _mm256_mul_ps(load(0), lane(0)));
+            let y1 = _mm256_fmadd_ps(load(3), lane(3), _mm256_mul_ps(load(2), lane(2)));
+            let y2 = _mm256_fmadd_ps(load(5), lane(5), _mm256_mul_ps(load(4), lane(4)));
+            let y3 = _mm256_fmadd_ps(load(7), lane(7), _mm256_mul_ps(load(6), lane(6)));
+            _mm256_add_ps(_mm256_add_ps(y0, y1), _mm256_add_ps(y2, y3))
+        },
+    );
+    let Some(sum) = sum else {
         return [0.0; 3];
     };
-    // `runs` gives pointers valid for 8 reads of V (u16 halves when HALF).
-    let load = |r: usize| {
-        if HALF {
-            _mm256_cvtph_ps(_mm_loadu_si128(p[r] as *const __m128i))
-        } else {
-            _mm256_loadu_ps(p[r] as *const f32)
-        }
-    };
-    // Run r weighs w_r (a broadcast from memory: a load, not a shuffle); (1 - t_po, t_po) by
-    // D is common to all runs and applied once to the sum; the weights do not wait for the
-    // loads, and the sum is a tree (short chain after them).
-    let mut wr = [0f32; 8];
-    _mm256_storeu_ps(wr.as_mut_ptr(), w); // 8 f32, unaligned
-    let lane = |r: usize| _mm256_broadcast_ss(&wr[r]);
-    let y0 = _mm256_fmadd_ps(load(1), lane(1), _mm256_mul_ps(load(0), lane(0)));
-    let y1 = _mm256_fmadd_ps(load(3), lane(3), _mm256_mul_ps(load(2), lane(2)));
-    let y2 = _mm256_fmadd_ps(load(5), lane(5), _mm256_mul_ps(load(4), lane(4)));
-    let y3 = _mm256_fmadd_ps(load(7), lane(7), _mm256_mul_ps(load(6), lane(6)));
-    let acc = _mm256_mul_ps(
-        _mm256_add_ps(_mm256_add_ps(y0, y1), _mm256_add_ps(y2, y3)),
-        d,
-    );
+    let acc = _mm256_mul_ps(sum, d);
     let rgb = _mm_add_ps(_mm256_castps256_ps128(acc), _mm256_extractf128_ps::<1>(acc));
     let mut out = [0f32; 4];
     _mm_storeu_ps(out.as_mut_ptr(), rgb); // 4 f32, unaligned
@@ -277,11 +274,10 @@ unsafe fn swap(ang: __m128) -> __m128 {
 /// The lookup of one pair (see [`crate::Brdf::eval`]), symmetrised when `reciprocal`.
 ///
 /// # Safety
-/// The processor must have AVX2, FMA and F16C ([`available`]); `v` must be `u16` half bits
-/// when `HALF`, else `f32`.
+/// The processor must have AVX2, FMA and F16C ([`available`]).
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
-pub(crate) unsafe fn eval<const HALF: bool, V>(
+pub(crate) unsafe fn eval<V: Lane>(
     nodes: &Nodes,
     v: &[V],
     reciprocal: bool,
@@ -289,13 +285,13 @@ pub(crate) unsafe fn eval<const HALF: bool, V>(
     wo: [f32; 3],
 ) -> [f32; 3] {
     if reciprocal {
-        return eval_reciprocal::<HALF, V>(nodes, v, wi, wo);
+        return eval_reciprocal(nodes, v, wi, wo);
     }
     let (pos, ok) = positions(nodes, wi, wo);
     if !ok {
         return [0.0; 3];
     }
-    blend::<HALF, V>(nodes, v, pos)
+    blend(nodes, v, pos)
 }
 
 /// The symmetrised lookup of one pair, out of line (so that the plain lookup keeps its
@@ -305,19 +301,14 @@ pub(crate) unsafe fn eval<const HALF: bool, V>(
 /// As [`eval`].
 #[inline(never)]
 #[target_feature(enable = "avx2,fma,f16c")]
-unsafe fn eval_reciprocal<const HALF: bool, V>(
-    nodes: &Nodes,
-    v: &[V],
-    wi: [f32; 3],
-    wo: [f32; 3],
-) -> [f32; 3] {
+unsafe fn eval_reciprocal<V: Lane>(nodes: &Nodes, v: &[V], wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
     let (o, ok) = octant(wi, wo);
     if !ok {
         return [0.0; 3];
     }
-    let f = blend::<HALF, V>(nodes, v, cells(&nodes.lanes, o));
+    let f = blend(nodes, v, cells(&nodes.lanes, o));
     // The swapped pair: its octant parts swap, its positions do not (the axes' scales differ).
-    let r = blend::<HALF, V>(nodes, v, cells(&nodes.lanes, swap_octant(o)));
+    let r = blend(nodes, v, cells(&nodes.lanes, swap_octant(o)));
     mean(f, r)
 }
 
@@ -337,17 +328,17 @@ fn mean(f: [f32; 3], r: [f32; 3]) -> [f32; 3] {
 /// As [`eval`].
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
-pub(crate) unsafe fn at_angles<const HALF: bool, V>(
+pub(crate) unsafe fn at_angles<V: Lane>(
     nodes: &Nodes,
     v: &[V],
     reciprocal: bool,
     ang: __m128,
 ) -> [f32; 3] {
-    let f = blend::<HALF, V>(nodes, v, positions_of_angles(nodes, ang));
+    let f = blend(nodes, v, positions_of_angles(nodes, ang));
     if !reciprocal {
         return f;
     }
-    let r = blend::<HALF, V>(nodes, v, positions_of_angles(nodes, swap(ang)));
+    let r = blend(nodes, v, positions_of_angles(nodes, swap(ang)));
     mean(f, r)
 }
 
@@ -357,13 +348,13 @@ pub(crate) unsafe fn at_angles<const HALF: bool, V>(
 /// As [`eval`].
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
-pub(crate) unsafe fn at_angles_of<const HALF: bool, V>(
+pub(crate) unsafe fn at_angles_of<V: Lane>(
     nodes: &Nodes,
     v: &[V],
     reciprocal: bool,
     ang: [f32; 4],
 ) -> [f32; 3] {
-    at_angles::<HALF, V>(nodes, v, reciprocal, _mm_loadu_ps(ang.as_ptr()))
+    at_angles(nodes, v, reciprocal, _mm_loadu_ps(ang.as_ptr()))
 }
 
 /// [`eval`] of every pair, into `out` (same lengths, checked by the caller).
@@ -371,7 +362,7 @@ pub(crate) unsafe fn at_angles_of<const HALF: bool, V>(
 /// # Safety
 /// As [`eval`].
 #[target_feature(enable = "avx2,fma,f16c")]
-pub(crate) unsafe fn batch<const HALF: bool, V>(
+pub(crate) unsafe fn batch<V: Lane>(
     nodes: &Nodes,
     v: &[V],
     reciprocal: bool,
@@ -401,25 +392,25 @@ pub(crate) unsafe fn batch<const HALF: bool, V>(
                 corner(nodes, ang[3].0),
             ];
             for (o, c) in o.iter_mut().zip(&c) {
-                *o = gather::<HALF, V>(nodes, v, c);
+                *o = gather(nodes, v, c);
             }
         } else {
             for (i, o) in o.iter_mut().enumerate() {
-                *o = eval::<HALF, V>(nodes, v, reciprocal, wi[k + i], wo[k + i]);
+                *o = eval(nodes, v, reciprocal, wi[k + i], wo[k + i]);
             }
         }
     }
     let rest = chunks.into_remainder();
     let k = n - rest.len();
     for (i, o) in rest.iter_mut().enumerate() {
-        *o = eval::<HALF, V>(nodes, v, reciprocal, wi[k + i], wo[k + i]);
+        *o = eval(nodes, v, reciprocal, wi[k + i], wo[k + i]);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::Grid;
+    use crate::table::Grid;
 
     /// The documented position in cells (as `nodes::polar_axis`/`azimuth_axis` before
     /// clamping) of an angle in f64 on axis `k` of `n` cells.

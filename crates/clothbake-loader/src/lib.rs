@@ -1,26 +1,42 @@
 //! clothbake-loader: the baked BRDF table formats and render-time lookup of baked tables.
 //!
-//! This crate is the one renderers link (from C through `clothbake-capi`). [`mod@format`]
-//! reads and writes tables in both formats (OpenEXR and the checksummed binary file); see
-//! `docs/table-format.md`. [`mod@stored`] keeps half-float tables half in memory.
-//! [`mod@lookup`] interpolates them ([`Brdf::eval`]) and [`mod@sampling`] importance-samples
-//! them ([`Brdf::sample`]); see `docs/loader.md`.
+//! This crate is the one renderers link (from C through `clothbake-capi`). A [`Table`] (a
+//! [`Grid`], its [`Metadata`] and RGB values) is read with [`read_table`] from either format:
+//! OpenEXR ([`mod@exr`]) or the checksummed binary file ([`write_binary`]), which is one kind
+//! of the binary [`mod@container`] that also holds the baker's shards and checkpoints; see
+//! `docs/table-format.md`. Files are written atomically ([`write_atomic_as`]).
+//! [`mod@stored`] keeps half-float tables half in memory. [`mod@lookup`] interpolates them
+//! ([`Brdf::eval`]) and [`mod@sampling`] importance-samples them ([`Brdf::sample`]); see
+//! `docs/loader.md`.
 
 pub mod angles;
+mod atomic;
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 mod bsdf;
-pub mod format;
+mod binary;
+mod bytes;
+pub mod container;
+mod error;
+pub mod exr;
 pub mod lookup;
 mod nodes;
+mod read;
 pub mod sampling;
 pub mod stored;
+mod table;
 
 pub use clothbake_bsdf::{Bsdf, BsdfSample, UnitVec3};
-pub use format::{
-    read_binary, read_exr, read_exr_stored, read_table, read_table_stored, write_atomic,
-    write_binary, write_exr, Grid, Metadata, Precision, Table, TableError, FORMAT_VERSION,
+pub use atomic::{write_atomic, write_atomic_as};
+pub use binary::{read_binary, write_binary};
+pub use container::{
+    read_container, write_container, write_container_chunks, Container, ContainerKind,
+    BINARY_MAGIC, CONTAINER_VERSION,
 };
+pub use error::TableError;
+pub use exr::{read_exr, read_exr_stored, write_exr, EXR_MAGIC};
 pub use half::f16;
-pub use lookup::{Brdf, Kernel, LengthMismatch, Memory, Options, Sample, HORIZON_COS};
+pub use lookup::{Brdf, LengthMismatch, Memory, Options, Sample, SimdPath, HORIZON_COS};
+pub use read::{read_table, read_table_stored};
 pub use stored::{Samples, StoredTable};
+pub use table::{Grid, Metadata, Precision, Table, FORMAT_VERSION, MAX_CELLS};

@@ -19,28 +19,22 @@
 //! The pole nodes are precomputed at load time: the values are stored in a padded copy with
 //! one extra polar row (the pole) on each polar axis, 4 lanes a node and a copied wrap column
 //! on the `phi_o` axis (`crate::nodes`), so every lookup is the same branch-free gather of 8
-//! runs of two adjacent nodes. The code is chosen once per [`Brdf`] ([`Kernel`]): AVX2 + FMA +
+//! runs of two adjacent nodes. The code is chosen once per [`Brdf`] ([`SimdPath`]): AVX2 + FMA +
 //! F16C when the processor has them, else portable Rust.
 
 use std::fmt;
 use std::path::Path;
 
+pub use crate::angles::{above_horizon, HORIZON_COS};
+
 use crate::angles::{direction, theta_phi};
 #[cfg(target_arch = "x86_64")]
 use crate::avx2;
-use crate::format::{Grid, Metadata, Precision, Table, TableError};
+use crate::error::TableError;
 use crate::nodes::{self, Lane, Nodes, Values};
 use crate::sampling::Sampler;
 use crate::stored::{Samples, StoredTable};
-
-/// Directions with `cos theta` at or below this are on or below the horizon: zero.
-pub const HORIZON_COS: f32 = 1e-9;
-
-/// True when a unit vector is above the horizon (`z > 1e-9`); false for NaN.
-#[inline(always)]
-pub fn above_horizon(w: [f32; 3]) -> bool {
-    w[2] > HORIZON_COS
-}
+use crate::table::{Grid, Metadata, Precision, Table};
 
 /// True when a pair has a value: both directions above the horizon, no component NaN.
 #[inline(always)]
@@ -118,37 +112,37 @@ impl fmt::Display for LengthMismatch {
 
 impl std::error::Error for LengthMismatch {}
 
-/// The code that runs the lookups, chosen once when a [`Brdf`] is built.
+/// The code path (kernel) that runs the lookups, chosen once when a [`Brdf`] is built.
 ///
 /// Both follow the same rules with the same operations in each lane; the AVX2 kernel fuses
 /// multiply-adds and sums in another order, so the two agree to about 1e-5 relative (tested),
 /// not bit for bit. Each is deterministic: the same lookup gives the same bits every time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kernel {
+pub enum SimdPath {
     /// Plain Rust (SSE2 on x86-64; any target).
     Portable,
     /// x86-64 with AVX2, FMA and F16C, detected at run time.
     Avx2,
 }
 
-impl Kernel {
+impl SimdPath {
     /// True when this processor can run the kernel.
     pub fn is_available(self) -> bool {
         match self {
-            Kernel::Portable => true,
+            SimdPath::Portable => true,
             #[cfg(target_arch = "x86_64")]
-            Kernel::Avx2 => crate::avx2::available(),
+            SimdPath::Avx2 => crate::avx2::available(),
             #[cfg(not(target_arch = "x86_64"))]
-            Kernel::Avx2 => false,
+            SimdPath::Avx2 => false,
         }
     }
 
     /// The fastest kernel this processor runs (the default of every [`Brdf`]).
-    pub fn best() -> Kernel {
-        if Kernel::Avx2.is_available() {
-            Kernel::Avx2
+    pub fn best() -> SimdPath {
+        if SimdPath::Avx2.is_available() {
+            SimdPath::Avx2
         } else {
-            Kernel::Portable
+            SimdPath::Portable
         }
     }
 }
@@ -158,7 +152,7 @@ impl Kernel {
 pub struct Brdf {
     meta: Metadata,
     nodes: Nodes,
-    kernel: Kernel,
+    simd: SimdPath,
     reciprocal: bool,
     sampler: Option<Sampler>,
 }
@@ -166,7 +160,7 @@ pub struct Brdf {
 impl Brdf {
     /// Loads a table file (either format, see [`crate::read_table_stored`]).
     pub fn open(path: &Path, options: Options) -> Result<Brdf, TableError> {
-        let stored = crate::format::read_table_stored(path)?;
+        let stored = crate::read::read_table_stored(path)?;
         Brdf::from_stored(stored, options).map_err(|e| match e {
             TableError::InvalidTable { reason } => TableError::Corrupted {
                 path: path.to_path_buf(),
@@ -196,34 +190,34 @@ impl Brdf {
         );
         let nodes = pad(&g, &value, f16);
         drop(samples);
-        let kernel = if nodes.lanes.exact {
-            Kernel::best()
+        let simd = if nodes.lanes.exact {
+            SimdPath::best()
         } else {
-            Kernel::Portable
+            SimdPath::Portable
         };
         Ok(Brdf {
             meta,
             nodes,
-            kernel,
+            simd,
             reciprocal: options.reciprocal,
             sampler,
         })
     }
 
-    /// The same table looked up by `kernel`; `None` when this processor cannot run it (or,
-    /// for [`Kernel::Avx2`], an axis has more than 2^22 cells).
-    pub fn with_kernel(mut self, kernel: Kernel) -> Option<Brdf> {
-        let fits = kernel == Kernel::Portable || self.nodes.lanes.exact;
-        (fits && kernel.is_available()).then(|| {
-            self.kernel = kernel;
+    /// The same table looked up by `path`; `None` when this processor cannot run it (or,
+    /// for [`SimdPath::Avx2`], an axis has more than 2^22 cells).
+    pub fn with_simd_path(mut self, path: SimdPath) -> Option<Brdf> {
+        let fits = path == SimdPath::Portable || self.nodes.lanes.exact;
+        (fits && path.is_available()).then(|| {
+            self.simd = path;
             self
         })
     }
 
-    /// The kernel running the lookups ([`Kernel::best`] unless chosen by
-    /// [`Brdf::with_kernel`], or an axis has more than 2^22 cells).
-    pub fn kernel(&self) -> Kernel {
-        self.kernel
+    /// The code path running the lookups ([`SimdPath::best`] unless chosen by
+    /// [`Brdf::with_simd_path`], or an axis has more than 2^22 cells).
+    pub fn simd_path(&self) -> SimdPath {
+        self.simd
     }
 
     /// The table's metadata.
@@ -269,13 +263,13 @@ impl Brdf {
     #[inline]
     pub fn eval(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
         let (n, r) = (&self.nodes, self.reciprocal);
-        match (&n.values, self.kernel) {
+        match (&n.values, self.simd) {
             // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C
-            // (`with_kernel`, `Kernel::best`); the values' type matches HALF.
+            // (`with_simd_path`, `SimdPath::best`); the lane type picks the loads.
             #[cfg(target_arch = "x86_64")]
-            (Values::F16(v), Kernel::Avx2) => unsafe { avx2::eval::<true, u16>(n, v, r, wi, wo) },
+            (Values::F16(v), SimdPath::Avx2) => unsafe { avx2::eval(n, v, r, wi, wo) },
             #[cfg(target_arch = "x86_64")]
-            (Values::F32(v), Kernel::Avx2) => unsafe { avx2::eval::<false, f32>(n, v, r, wi, wo) },
+            (Values::F32(v), SimdPath::Avx2) => unsafe { avx2::eval(n, v, r, wi, wo) },
             (Values::F16(v), _) => self.eval_portable(v, wi, wo),
             (Values::F32(v), _) => self.eval_portable(v, wi, wo),
         }
@@ -308,16 +302,12 @@ impl Brdf {
         };
         let ang = [r(theta_i), r(wrap(phi_i)), r(theta_o), r(wrap(phi_o))];
         let (n, rc) = (&self.nodes, self.reciprocal);
-        match (&n.values, self.kernel) {
+        match (&n.values, self.simd) {
             // SAFETY: as in `eval`.
             #[cfg(target_arch = "x86_64")]
-            (Values::F16(v), Kernel::Avx2) => unsafe {
-                avx2::at_angles_of::<true, u16>(n, v, rc, ang)
-            },
+            (Values::F16(v), SimdPath::Avx2) => unsafe { avx2::at_angles_of(n, v, rc, ang) },
             #[cfg(target_arch = "x86_64")]
-            (Values::F32(v), Kernel::Avx2) => unsafe {
-                avx2::at_angles_of::<false, f32>(n, v, rc, ang)
-            },
+            (Values::F32(v), SimdPath::Avx2) => unsafe { avx2::at_angles_of(n, v, rc, ang) },
             (Values::F16(v), _) => self.blend_reciprocal(v, ang),
             (Values::F32(v), _) => self.blend_reciprocal(v, ang),
         }
@@ -339,16 +329,12 @@ impl Brdf {
             });
         }
         let (n, r) = (&self.nodes, self.reciprocal);
-        match (&n.values, self.kernel) {
+        match (&n.values, self.simd) {
             // SAFETY: as in `eval`.
             #[cfg(target_arch = "x86_64")]
-            (Values::F16(v), Kernel::Avx2) => unsafe {
-                avx2::batch::<true, u16>(n, v, r, wi, wo, out)
-            },
+            (Values::F16(v), SimdPath::Avx2) => unsafe { avx2::batch(n, v, r, wi, wo, out) },
             #[cfg(target_arch = "x86_64")]
-            (Values::F32(v), Kernel::Avx2) => unsafe {
-                avx2::batch::<false, f32>(n, v, r, wi, wo, out)
-            },
+            (Values::F32(v), SimdPath::Avx2) => unsafe { avx2::batch(n, v, r, wi, wo, out) },
             (Values::F16(v), _) => self.batch_in(v, wi, wo, out),
             (Values::F32(v), _) => self.batch_in(v, wi, wo, out),
         }

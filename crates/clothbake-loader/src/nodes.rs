@@ -1,6 +1,6 @@
 //! The lookup's node table: the grid padded for branch-free gathers, and the portable blend.
 //!
-//! Layout (in lanes, `V` = `u16` half-float bits or `f32`): polar rows `0..=n_theta_i` (row 0
+//! Layout (in lanes, `V` = [`f16`] or `f32`, see [`Lane`]): polar rows `0..=n_theta_i` (row 0
 //! the pole node, row `k + 1` cell `k`) x `n_phi_i` azimuth columns x polar rows
 //! `0..=n_theta_o` x `n_phi_o + 1` azimuth columns (the last a copy of column 0) x 4 lanes
 //! (R, G, B, 0). A node is one 16-byte (f32) or 8-byte (f16) vector; the two `phi_o`
@@ -14,32 +14,62 @@
 //! and `lo + 1 <= n` (the copied column `n` exists), `phi_i` columns `lo` and
 //! `next_column(lo) <= n - 1`. For each `phi_i` column `b` the lowest run starts at
 //! `base_b = lo_a s_ti + b s_pi + lo_c s_to + 4 lo_d` and the highest ends at
-//! `base_b + s_ti + s_to + 8`, at most `len`. [`Nodes::runs`] checks exactly those two ends
-//! once per lookup and then reads the 8 runs without further checks.
+//! `base_b + s_ti + s_to + 8`, at most `len`. [`Nodes::with_runs`] checks exactly those two ends
+//! once per lookup and returns the 8 runs as arrays borrowed from the values.
+
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::{__m128i, __m256, _mm256_cvtph_ps, _mm256_loadu_ps, _mm_loadu_si128};
+
+use half::f16;
 
 use crate::angles::{atan2, ATAN_COEFFS};
-use crate::format::Grid;
 use crate::stored::f16_to_f32;
+use crate::table::Grid;
 
 /// Lanes per node: R, G, B and a zero pad.
 pub(crate) const LANES: usize = 4;
 
-/// Values of the padded table at their precision (`u16` holds half-float bits).
+/// Values of the padded table at their precision.
 #[derive(Clone, Debug)]
 pub(crate) enum Values {
-    F16(Vec<u16>),
+    F16(Vec<f16>),
     F32(Vec<f32>),
 }
 
-/// A value type the portable gather widens to f32.
-pub(crate) trait Lane: Copy {
-    fn widen(self) -> f32;
+mod sealed {
+    /// Implemented for the lane types only: [`super::Lane`] cannot be implemented elsewhere.
+    pub trait Sealed {}
+    impl Sealed for half::f16 {}
+    impl Sealed for f32 {}
 }
 
-impl Lane for u16 {
+/// The type of the padded table's lanes, [`f16`] or `f32`: the type alone picks how the
+/// lookups widen and load them. Sealed: implemented for those two only.
+pub(crate) trait Lane: Copy + sealed::Sealed {
+    /// The lane as f32 (exact).
+    fn widen(self) -> f32;
+
+    /// The 8 lanes of a run widened to f32 in one register: F16C's conversion of 8 halves,
+    /// or one load of 8 floats.
+    ///
+    /// # Safety
+    /// The processor must have AVX2, FMA and F16C.
+    #[cfg(target_arch = "x86_64")]
+    unsafe fn load8(run: &[Self; 8]) -> __m256;
+}
+
+impl Lane for f16 {
     #[inline(always)]
     fn widen(self) -> f32 {
-        f16_to_f32(self)
+        f16_to_f32(self.to_bits())
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline]
+    #[target_feature(enable = "avx2,fma,f16c")]
+    unsafe fn load8(run: &[f16; 8]) -> __m256 {
+        // 16 bytes, unaligned: the 8 halves of `run`.
+        _mm256_cvtph_ps(_mm_loadu_si128(run.as_ptr().cast::<__m128i>()))
     }
 }
 
@@ -47,6 +77,14 @@ impl Lane for f32 {
     #[inline(always)]
     fn widen(self) -> f32 {
         self
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline]
+    #[target_feature(enable = "avx2,fma,f16c")]
+    unsafe fn load8(run: &[f32; 8]) -> __m256 {
+        // 32 bytes, unaligned: the 8 floats of `run`.
+        _mm256_loadu_ps(run.as_ptr())
     }
 }
 
@@ -170,11 +208,7 @@ impl Nodes {
         }
         debug_assert_eq!(out.len(), len);
         let values = if f16 {
-            Values::F16(
-                out.iter()
-                    .map(|&v| half::f16::from_f32(v).to_bits())
-                    .collect(),
-            )
+            Values::F16(out.iter().map(|&v| f16::from_f32(v)).collect())
         } else {
             Values::F32(out)
         };
@@ -199,13 +233,21 @@ impl Nodes {
         }
     }
 
-    /// The first lanes of the 8 runs of a lookup whose runs at the low and high `phi_i`
-    /// columns start at lanes `base[0]` and `base[1]`: run `r = 4 ia + 2 ib + ic` at
-    /// `base[ib] + ia s_ti + ic s_to`, each valid for 8 reads of `v`; `None` when they would
-    /// not all lie inside `v` (never for a [`Corner`] of this table: see the module
-    /// documentation).
+    /// `f` of the 8 runs of a lookup whose runs at the low and high `phi_i` columns start at
+    /// lanes `base[0]` and `base[1]`: run `r = 4 ia + 2 ib + ic` is the 8 lanes of `v` from
+    /// `base[ib] + ia s_ti + ic s_to`, borrowed from `v`. `None`, without calling `f`, when
+    /// they would not all lie inside `v` (never for a [`Corner`] of this table: see the module
+    /// documentation). One bounds check for all 8.
+    ///
+    /// The runs go to `f` rather than out in an `Option`: that `Option`'s `None` would be a
+    /// null first reference, which the compiler cannot rule out and would test on every lookup.
     #[inline(always)]
-    pub(crate) fn runs<V>(&self, v: &[V], base: [usize; 2]) -> Option<[*const V; 8]> {
+    pub(crate) fn with_runs<'v, V, R>(
+        &self,
+        v: &'v [V],
+        base: [usize; 2],
+        f: impl FnOnce([&'v [V; 8]; 8]) -> R,
+    ) -> Option<R> {
         match v.len().checked_sub(self.extent) {
             Some(last) if base[0] <= last && base[1] <= last => {}
             _ => return None,
@@ -214,20 +256,20 @@ impl Nodes {
         let p = v.as_ptr();
         let [b0, b1] = base;
         // SAFETY: b + s_ti + s_to + 8 <= v.len() for both bases (checked above, as
-        // b <= v.len() - extent, without overflow; every offset below is at most that sum), so each pointer lies inside `v`
-        // with at least 8 values after it.
-        unsafe {
-            Some([
-                p.add(b0),
-                p.add(b0 + s_to),
-                p.add(b1),
-                p.add(b1 + s_to),
-                p.add(b0 + s_ti),
-                p.add(b0 + s_ti + s_to),
-                p.add(b1 + s_ti),
-                p.add(b1 + s_ti + s_to),
-            ])
-        }
+        // b <= v.len() - extent, without overflow), and every start below is at most
+        // b + s_ti + s_to, so each run of 8 lies inside `v`; a `[V; 8]` has the alignment of
+        // `V`, and the runs borrow `v`.
+        let run = |at: usize| unsafe { &*p.add(at).cast::<[V; 8]>() };
+        Some(f([
+            run(b0),
+            run(b0 + s_to),
+            run(b1),
+            run(b1 + s_to),
+            run(b0 + s_ti),
+            run(b0 + s_ti + s_to),
+            run(b1 + s_ti),
+            run(b1 + s_ti + s_to),
+        ]))
     }
 
     /// The corner of a lookup at angles `[theta_i, phi_i, theta_o, phi_o]`, radians (phi in
@@ -254,17 +296,23 @@ impl Nodes {
     #[inline(always)]
     pub(crate) fn blend<V: Lane>(&self, v: &[V], ang: [f32; 4]) -> [f32; 3] {
         let k = self.corner(ang);
-        let Some(runs) = self.runs(v, k.base) else {
+        let sum = self.with_runs(
+            v,
+            k.base,
+            #[inline(always)]
+            |runs| {
+                let mut acc = [0f32; 8];
+                for (run, w) in runs.into_iter().zip(k.w) {
+                    for (a, x) in acc.iter_mut().zip(run) {
+                        *a += x.widen() * w;
+                    }
+                }
+                acc
+            },
+        );
+        let Some(acc) = sum else {
             return [0.0; 3];
         };
-        let mut acc = [0f32; 8];
-        for (&p, w) in runs.iter().zip(k.w) {
-            // SAFETY: `runs` gives pointers valid for 8 reads.
-            let run = unsafe { &*(p as *const [V; 8]) };
-            for (a, x) in acc.iter_mut().zip(run) {
-                *a += x.widen() * w;
-            }
-        }
         let (u, t) = (1.0 - k.t_po, k.t_po);
         [
             acc[0] * u + acc[4] * t,
@@ -317,4 +365,70 @@ pub(crate) fn angles(wi: [f32; 3], wo: [f32; 3]) -> [f32; 4] {
     let y = [rho(wi), wi[1], rho(wo), wo[1]];
     let x = [wi[2], wi[0], wo[2], wo[0]];
     std::array::from_fn(|k| atan2(y[k], x[k]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_are_the_lanes_at_their_offsets_or_none() {
+        let g = Grid {
+            n_theta_i: 2,
+            n_phi_i: 3,
+            n_theta_o: 4,
+            n_phi_o: 5,
+        };
+        let node = |a: u32, b: u32, c: u32, d: u32| [a as f32, b as f32, (10 * c + d) as f32];
+        let nodes = Nodes::new(&g, &node, false);
+        let Values::F32(v) = &nodes.values else {
+            panic!("f32 lanes")
+        };
+        let [s_ti, _, s_to] = nodes.strides;
+        let last = v.len() - (s_ti + s_to + 8);
+        for [b0, b1] in [[0, 0], [last, 0], [3, last], [last, last]] {
+            let runs = nodes.with_runs(v, [b0, b1], |r| r.map(|x| *x)).unwrap();
+            let starts = [
+                b0,
+                b0 + s_to,
+                b1,
+                b1 + s_to,
+                b0 + s_ti,
+                b0 + s_ti + s_to,
+                b1 + s_ti,
+                b1 + s_ti + s_to,
+            ];
+            for (run, s) in runs.iter().zip(starts) {
+                assert_eq!(run[..], v[s..s + 8], "base {b0}, {b1}");
+            }
+        }
+        for base in [[last + 1, 0], [0, last + 1], [usize::MAX, 0]] {
+            assert!(nodes.with_runs(v, base, |_| ()).is_none(), "{base:?}");
+        }
+        assert!(nodes.with_runs(&v[..s_ti], [0, 0], |_| ()).is_none());
+    }
+
+    #[test]
+    fn lanes_widen_and_load_exactly() {
+        let xs = [0.0f32, -0.0, 1.5, -65504.0, 6.1e-5, 3e-8, 0.1, 1e4];
+        let halves = xs.map(f16::from_f32);
+        for h in halves {
+            assert_eq!(h.widen().to_bits(), h.to_f32().to_bits());
+        }
+        #[cfg(target_arch = "x86_64")]
+        if crate::avx2::available() {
+            let mut got = [[0f32; 8]; 2];
+            // SAFETY: AVX2, FMA and F16C were detected.
+            unsafe {
+                use std::arch::x86_64::_mm256_storeu_ps;
+                _mm256_storeu_ps(got[0].as_mut_ptr(), f16::load8(&halves));
+                _mm256_storeu_ps(got[1].as_mut_ptr(), f32::load8(&xs));
+            }
+            assert_eq!(
+                got[0].map(f32::to_bits),
+                halves.map(|h| h.to_f32().to_bits())
+            );
+            assert_eq!(got[1].map(f32::to_bits), xs.map(f32::to_bits));
+        }
+    }
 }

@@ -21,7 +21,7 @@
 //! row's conditional CDF; the remainders of both, rescaled to [0, 1), place the direction
 //! uniformly in solid angle inside the cell (`cos theta` and `phi` uniform).
 
-use crate::format::Grid;
+use crate::table::Grid;
 
 /// Weight of the uniform part of the sampling density (see the module documentation).
 pub const DEFENSIVE: f64 = 0.01;

@@ -7,7 +7,8 @@
 
 use half::f16;
 
-use crate::format::{check_values, Metadata, Precision, Table, TableError};
+use crate::error::TableError;
+use crate::table::{check_values, Metadata, Precision, Table};
 
 /// The RGB values of a table, interleaved as in [`Table::values`], at one precision.
 #[derive(Clone, Debug, PartialEq)]

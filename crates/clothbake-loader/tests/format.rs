@@ -3,10 +3,9 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use clothbake_loader::format::{BINARY_MAGIC, EXR_MAGIC};
 use clothbake_loader::{
     read_binary, read_exr, read_table, write_atomic, write_binary, write_exr, Grid, Metadata,
-    Precision, Table, TableError, FORMAT_VERSION,
+    Precision, Table, TableError, BINARY_MAGIC, EXR_MAGIC, FORMAT_VERSION,
 };
 
 /// A grid with a different size on every axis, so that layout mix-ups show.
@@ -113,34 +112,30 @@ fn binary_round_trip_is_exact() {
     assert_eq!(back, table);
     assert_eq!(read_table(&path).unwrap(), table);
     assert_eq!(listing(d.path()), ["t.bin"]);
-    // The documented layout.
+    // The documented layout, parsed here: the container of kind "table" with the metadata as
+    // its JSON header.
     let bytes = fs::read(&path).unwrap();
     assert_eq!(&bytes[..8], b"CLTHBAKE");
-    assert_eq!(
-        u32::from_le_bytes(bytes[8..12].try_into().unwrap()),
-        FORMAT_VERSION
-    );
-    let header_len = u64::from_le_bytes(bytes[12..20].try_into().unwrap()) as usize;
-    let n_at = 20 + header_len;
-    let n = u64::from_le_bytes(bytes[n_at..n_at + 8].try_into().unwrap()) as usize;
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 2);
+    assert_eq!(&bytes[12..28], b"table\0\0\0\0\0\0\0\0\0\0\0");
+    let header_len = u64::from_le_bytes(bytes[28..36].try_into().unwrap()) as usize;
+    let n = u64::from_le_bytes(bytes[36..44].try_into().unwrap()) as usize;
     assert_eq!(n, 360);
-    assert_eq!(bytes.len(), n_at + 8 + 4 * n + 4);
-    let first = f32::from_le_bytes(bytes[n_at + 8..n_at + 12].try_into().unwrap());
-    assert_eq!(first, table.values[0]);
+    assert_eq!(bytes.len(), 44 + header_len + 4 * n + 4);
+    let header: serde_json::Value = serde_json::from_slice(&bytes[44..44 + header_len]).unwrap();
+    assert_eq!(header["format_version"], FORMAT_VERSION);
+    assert_eq!(header["grid"]["n_phi_i"], 3);
+    assert_eq!(header["fabric_json"], table.meta.fabric_json.as_str());
+    let meta: Metadata = serde_json::from_value(header).unwrap();
+    assert_eq!(meta, table.meta);
+    let at = 44 + header_len;
+    let values: Vec<f32> = bytes[at..at + 4 * n]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    assert_eq!(values, table.values);
     let crc = crc32fast::hash(&bytes[..bytes.len() - 4]);
     assert_eq!(bytes[bytes.len() - 4..], crc.to_le_bytes());
-    // Header: format_version u32, then tool as u64 length + bytes.
-    assert_eq!(
-        u32::from_le_bytes(bytes[20..24].try_into().unwrap()),
-        FORMAT_VERSION
-    );
-    let tool_len = u64::from_le_bytes(bytes[24..32].try_into().unwrap()) as usize;
-    assert_eq!(&bytes[32..32 + tool_len], b"clothbake 0.1.0");
-    let g = 32 + tool_len;
-    let axes: Vec<u32> = (0..4)
-        .map(|k| u32::from_le_bytes(bytes[g + 4 * k..g + 4 * k + 4].try_into().unwrap()))
-        .collect();
-    assert_eq!(axes, [2, 3, 4, 5]);
 }
 
 #[test]
@@ -299,12 +294,12 @@ fn wrong_magic_and_foreign_files() {
 fn wrong_version_names_the_fix() {
     let d = dir();
     let (path, mut bytes) = write_bin(d.path());
-    bytes[8..12].copy_from_slice(&2u32.to_le_bytes());
+    bytes[8..12].copy_from_slice(&3u32.to_le_bytes());
     fs::write(&path, &bytes).unwrap();
     let e = message(read_table(&path).unwrap_err());
     eprintln!("{e}");
     assert!(
-        e.contains("format version 2") && e.contains("update the loader"),
+        e.contains("format version 3") && e.contains("update the loader"),
         "{e}"
     );
     bytes[8..12].copy_from_slice(&0u32.to_le_bytes());
@@ -313,6 +308,21 @@ fn wrong_version_names_the_fix() {
     eprintln!("{e}");
     assert!(
         e.contains("format version 0") && e.contains("bake the table again"),
+        "{e}"
+    );
+    // A newer table description in a well-formed container (checksum recomputed).
+    bytes[8..12].copy_from_slice(&2u32.to_le_bytes());
+    let from = b"\"format_version\":1";
+    let at = bytes.windows(from.len()).position(|w| w == from).unwrap();
+    bytes[at + from.len() - 1] = b'7';
+    let n = bytes.len();
+    let crc = crc32fast::hash(&bytes[..n - 4]);
+    bytes[n - 4..].copy_from_slice(&crc.to_le_bytes());
+    fs::write(&path, &bytes).unwrap();
+    let e = message(read_table(&path).unwrap_err());
+    assert!(
+        e.contains("table format version 7, but this build reads version 1")
+            && e.contains("update the loader"),
         "{e}"
     );
 }

@@ -3,7 +3,7 @@
 //! (std `atan2`, the unpadded table, pole nodes as ring means), and against each other; the
 //! batched path against single lookups per kernel; odd inputs never panic.
 
-use clothbake_loader::{Brdf, Grid, Kernel, Memory, Metadata, Options, Table};
+use clothbake_loader::{Brdf, Grid, Memory, Metadata, Options, SimdPath, Table};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 mod common;
@@ -24,9 +24,9 @@ fn table() -> Table {
 }
 
 /// Every kernel this processor runs, each on f32 and f16 values.
-fn brdfs(reciprocal: bool) -> Vec<(Kernel, Memory, Brdf)> {
+fn brdfs(reciprocal: bool) -> Vec<(SimdPath, Memory, Brdf)> {
     let mut out = Vec::new();
-    for kernel in [Kernel::Portable, Kernel::Avx2] {
+    for kernel in [SimdPath::Portable, SimdPath::Avx2] {
         for memory in [Memory::F32, Memory::AsStored] {
             let opts = Options {
                 memory,
@@ -39,7 +39,7 @@ fn brdfs(reciprocal: bool) -> Vec<(Kernel, Memory, Brdf)> {
             )
             .unwrap();
             let b = Brdf::from_stored(stored, opts).unwrap();
-            if let Some(b) = b.with_kernel(kernel) {
+            if let Some(b) = b.with_simd_path(kernel) {
                 out.push((kernel, memory, b));
             }
         }
@@ -197,7 +197,7 @@ fn the_kernels_agree_closely_and_each_batch_equals_its_single_lookups() {
     for (kernel, memory, b) in &all {
         let (_, _, p) = all
             .iter()
-            .find(|(k, m, _)| *k == Kernel::Portable && m == memory)
+            .find(|(k, m, _)| *k == SimdPath::Portable && m == memory)
             .unwrap();
         let mut worst = 0f32;
         for k in 0..n {
@@ -219,7 +219,7 @@ fn reciprocal_lookups_agree_across_kernels() {
         for (kernel, memory, b) in &all {
             let portable = all
                 .iter()
-                .find(|(k, m, _)| *k == Kernel::Portable && m == memory);
+                .find(|(k, m, _)| *k == SimdPath::Portable && m == memory);
             let want = portable.unwrap().2.eval(wi, wo);
             let got = b.eval(wi, wo);
             assert_eq!(got, b.eval(wo, wi), "{kernel:?}");

@@ -383,7 +383,7 @@ pub fn write(path: &Path, plot: &Plot, sources: &[Source], overwrite: bool) -> R
                 draw(&root, plot, sources)?;
                 root.present().map_err(err)?;
             }
-            clothbake_loader::write_atomic(path, overwrite, |f| {
+            clothbake_loader::write_atomic_as(path, "SVG plot", overwrite, |f| {
                 std::io::Write::write_all(f, s.as_bytes())
             })
             .map_err(fail)

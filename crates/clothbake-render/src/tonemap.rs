@@ -7,7 +7,7 @@
 //! maps to 1 before the curve. EXR files hold the linear values V themselves (f32, no tone
 //! mapping).
 
-use clothbake_loader::{write_atomic, TableError};
+use clothbake_loader::{write_atomic_as, TableError};
 use std::io::Write;
 use std::path::Path;
 
@@ -92,7 +92,7 @@ pub fn write_png_rgb8(
     rgb: &[u8],
     overwrite: bool,
 ) -> Result<(), TableError> {
-    write_atomic(path, overwrite, |w| {
+    write_atomic_as(path, "PNG image", overwrite, |w| {
         let mut enc = png::Encoder::new(w, width, height);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
@@ -116,7 +116,7 @@ pub fn write_exr(path: &Path, img: &Image, overwrite: bool) -> Result<(), TableE
         }),
     );
     let image = exr::image::Image::from_layer(layer);
-    write_atomic(path, overwrite, |f| {
+    write_atomic_as(path, "OpenEXR image", overwrite, |f| {
         image
             .write()
             .non_parallel()

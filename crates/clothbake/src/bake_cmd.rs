@@ -244,7 +244,7 @@ pub fn preflight(out: &Path, force: bool) -> Result<(), CliError> {
         Err(e) => {
             return Err(TableError::Io {
                 path: dir.to_path_buf(),
-                action: "open the folder",
+                action: "open the folder".into(),
                 source: e,
             }
             .into())
@@ -268,7 +268,7 @@ pub fn preflight(out: &Path, force: bool) -> Result<(), CliError> {
         Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
         Err(e) => Err(TableError::Io {
             path: out.to_path_buf(),
-            action: "create the table",
+            action: "create the table".into(),
             source: e,
         }
         .into()),

@@ -942,7 +942,7 @@ pub fn parse_res(s: &str) -> Result<Grid, String> {
         n_phi_o: n[3],
     };
     let cells: u64 = n.iter().map(|&x| u64::from(x)).product();
-    if cells > clothbake_loader::format::MAX_CELLS {
+    if cells > clothbake_loader::MAX_CELLS {
         return Err(format!(
             "{cells} cells is more than the limit of 2^31; use a coarser grid, e.g. 32,64,32,64"
         ));

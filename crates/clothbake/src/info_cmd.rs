@@ -16,7 +16,7 @@ fn format_name(path: &Path) -> &'static str {
     let ok = std::fs::File::open(path)
         .and_then(|mut f| f.read_exact(&mut head))
         .is_ok();
-    if ok && head == clothbake_loader::format::EXR_MAGIC {
+    if ok && head == clothbake_loader::EXR_MAGIC {
         "OpenEXR"
     } else {
         "binary"

@@ -1,0 +1,212 @@
+//! The binary table: a [`Table`] in the binary container (kind `table`, the [`Metadata`] as
+//! the JSON header, the values as f32), and the read-only reader of version-1 tables (bincode
+//! header). `docs/table-format.md` describes both byte by byte.
+
+use std::path::Path;
+
+use crate::container::{
+    file_version, read_container, write_container, ContainerKind, LEGACY_TABLE_VERSION,
+};
+use crate::error::TableError;
+use crate::table::{Metadata, Table, FORMAT_VERSION};
+
+/// Writes a table in the binary format (a container of kind `table`, see
+/// `docs/table-format.md`), atomically.
+pub fn write_binary(path: &Path, table: &Table, overwrite: bool) -> Result<(), TableError> {
+    table.validate().map_err(|e| e.unwritable(path))?;
+    let header = serde_json::to_value(&table.meta).map_err(|e| TableError::Unwritable {
+        path: path.to_path_buf(),
+        what: "table".into(),
+        reason: format!("the metadata cannot be written as JSON ({e})"),
+    })?;
+    write_container(
+        path,
+        ContainerKind::Table,
+        &header,
+        &table.values,
+        overwrite,
+    )
+}
+
+/// Reads a binary table, checking magic bytes, version, kind, sizes, checksum and contents.
+/// Reads the current container (version 2) and version-1 tables.
+pub fn read_binary(path: &Path) -> Result<Table, TableError> {
+    if file_version(path, &[ContainerKind::Table])? == LEGACY_TABLE_VERSION {
+        return legacy::read(path);
+    }
+    let c = read_container(path, &[ContainerKind::Table])?;
+    // The version first, so that newer tables say "update the loader".
+    if let Some(found) = c.header.get("format_version").and_then(|v| v.as_u64()) {
+        if found != u64::from(FORMAT_VERSION) {
+            return Err(TableError::Version {
+                path: path.to_path_buf(),
+                what: "table",
+                found: u32::try_from(found).unwrap_or(u32::MAX),
+                reads: FORMAT_VERSION,
+            });
+        }
+    }
+    let meta: Metadata = serde_json::from_value(c.header).map_err(|e| TableError::Corrupted {
+        path: path.to_path_buf(),
+        reason: format!("the header does not describe a table ({e})"),
+    })?;
+    Table::new(meta, c.values).map_err(|e| e.in_file(path))
+}
+
+/// Version-1 binary tables: the container's layout before kinds, with the [`Metadata`] in
+/// bincode. Read-only.
+mod legacy {
+    use std::fs::File;
+    use std::io::BufReader;
+    use std::path::Path;
+
+    use bincode::Options;
+
+    use crate::bytes::{hex, read_f32s, read_hashed, read_up_to, Source};
+    use crate::container::{BINARY_MAGIC, LEGACY_TABLE_VERSION};
+    use crate::error::TableError;
+    use crate::table::{Metadata, Table, FORMAT_VERSION};
+
+    /// Layout: magic (8) + version (4) + header length (8).
+    const PREFIX_LEN: u64 = 8 + 4 + 8;
+    /// Layout: everything except the header bytes and the values.
+    const FIXED_LEN: u64 = PREFIX_LEN + 8 + 4;
+
+    /// bincode settings of the header: fixed-width little-endian integers, strings as a u64
+    /// length and UTF-8 bytes (see `docs/table-format.md`).
+    fn bincode_options() -> impl bincode::Options {
+        bincode::DefaultOptions::new()
+            .with_fixint_encoding()
+            .with_little_endian()
+    }
+
+    /// Reads a version-1 binary table, checking magic bytes, version, sizes, checksum and
+    /// contents.
+    pub(super) fn read(path: &Path) -> Result<Table, TableError> {
+        let file = File::open(path).map_err(|e| TableError::io(path, "open the table", e))?;
+        let file_len = file
+            .metadata()
+            .map_err(|e| TableError::io(path, "read the table", e))?
+            .len();
+        let src = Source {
+            path,
+            len: file_len,
+            noun: "table",
+        };
+        if file_len == 0 {
+            return Err(TableError::Empty {
+                path: path.to_path_buf(),
+            });
+        }
+        let mut r = BufReader::with_capacity(1 << 20, file);
+        let mut hasher = crc32fast::Hasher::new();
+
+        let mut magic = [0u8; 8];
+        let n = read_up_to(&mut r, &mut magic).map_err(|e| src.io(e))?;
+        if magic[..n] != BINARY_MAGIC[..n] {
+            return Err(TableError::Foreign {
+                path: path.to_path_buf(),
+                what: "table".into(),
+                reason: format!(
+                    "the first bytes are {}, not the magic bytes \"CLTHBAKE\" of a binary table",
+                    hex(&magic[..n])
+                ),
+            });
+        }
+        if n < magic.len() {
+            return Err(src.ends_inside("magic bytes"));
+        }
+        hasher.update(&magic);
+
+        let mut word = [0u8; 4];
+        read_hashed(&mut r, &mut hasher, &mut word, src, "format version")?;
+        let version = u32::from_le_bytes(word);
+        if version != LEGACY_TABLE_VERSION {
+            return Err(TableError::Version {
+                path: path.to_path_buf(),
+                what: "table",
+                found: version,
+                reads: LEGACY_TABLE_VERSION,
+            });
+        }
+
+        let mut long = [0u8; 8];
+        read_hashed(&mut r, &mut hasher, &mut long, src, "header length")?;
+        let header_len = u64::from_le_bytes(long);
+        let room = file_len.saturating_sub(FIXED_LEN);
+        if header_len > room {
+            return Err(TableError::Truncated {
+                path: path.to_path_buf(),
+                detail: format!(
+                    "the header is {header_len} bytes long, but the file has only {file_len} bytes in all"
+                ),
+            });
+        }
+        let mut header = vec![0u8; header_len as usize];
+        read_hashed(&mut r, &mut hasher, &mut header, src, "header")?;
+
+        read_hashed(&mut r, &mut hasher, &mut long, src, "value count")?;
+        let n_values = u64::from_le_bytes(long);
+        let expected_len = n_values
+            .checked_mul(4)
+            .and_then(|b| b.checked_add(FIXED_LEN + header_len));
+        match expected_len {
+            Some(expected) if expected == file_len => {}
+            Some(expected) if expected > file_len => {
+                return Err(TableError::Truncated {
+                    path: path.to_path_buf(),
+                    detail: format!(
+                        "{n_values} values need a file of {expected} bytes, but it has {file_len}"
+                    ),
+                })
+            }
+            Some(expected) => {
+                return Err(TableError::Corrupted {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "{n_values} values need a file of {expected} bytes, but it has {file_len} (unexpected trailing bytes)"
+                    ),
+                })
+            }
+            None => {
+                return Err(TableError::Corrupted {
+                    path: path.to_path_buf(),
+                    reason: format!("impossible value count {n_values}"),
+                })
+            }
+        }
+
+        // The file size bounds n_values, so this allocation is backed by real bytes.
+        let values = read_f32s(&mut r, &mut hasher, n_values as usize, src)?;
+
+        let computed = hasher.finalize();
+        let mut unused = crc32fast::Hasher::new();
+        read_hashed(&mut r, &mut unused, &mut word, src, "checksum")?;
+        let stored = u32::from_le_bytes(word);
+        if stored != computed {
+            return Err(TableError::Checksum {
+                path: path.to_path_buf(),
+                stored,
+                computed,
+            });
+        }
+
+        let meta: Metadata = bincode_options()
+            .with_limit(header_len)
+            .reject_trailing_bytes()
+            .deserialize(&header)
+            .map_err(|e| TableError::Corrupted {
+                path: path.to_path_buf(),
+                reason: format!("the metadata header cannot be decoded ({e})"),
+            })?;
+        if meta.format_version != FORMAT_VERSION {
+            return Err(TableError::Version {
+                path: path.to_path_buf(),
+                what: "table",
+                found: meta.format_version,
+                reads: FORMAT_VERSION,
+            });
+        }
+        Table::new(meta, values).map_err(|e| e.in_file(path))
+    }
+}

@@ -1,0 +1,152 @@
+//! Byte-level helpers of the file codecs: checksummed writing and reading, bounded reads, hex.
+
+use std::io::{self, Read, Write};
+use std::path::Path;
+
+use crate::error::TableError;
+
+/// Number of `f32` values converted per chunk when reading or writing files.
+pub(crate) const CHUNK_VALUES: usize = 16 * 1024;
+
+/// A writer that computes the CRC-32 of everything written through it.
+pub(crate) struct CrcWriter<W> {
+    pub(crate) inner: W,
+    pub(crate) hasher: crc32fast::Hasher,
+}
+
+impl<W: Write> CrcWriter<W> {
+    /// A writer into `inner`, hashing from here on.
+    pub(crate) fn new(inner: W) -> CrcWriter<W> {
+        CrcWriter {
+            inner,
+            hasher: crc32fast::Hasher::new(),
+        }
+    }
+
+    /// Writes `values` as f32 little-endian, chunk by chunk.
+    pub(crate) fn write_f32s(&mut self, values: &[f32]) -> io::Result<()> {
+        let mut bytes = Vec::with_capacity(CHUNK_VALUES.min(values.len()) * 4);
+        for chunk in values.chunks(CHUNK_VALUES) {
+            bytes.clear();
+            bytes.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
+            self.write_all(&bytes)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the CRC-32 of everything written so far, little-endian, unhashed.
+    pub(crate) fn finish(self) -> io::Result<()> {
+        let crc = self.hasher.finalize();
+        let mut inner = self.inner;
+        inner.write_all(&crc.to_le_bytes())
+    }
+}
+
+impl<W: Write> Write for CrcWriter<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.hasher.update(&buf[..n]);
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+/// The file being read, for error messages: its path, its length and what it should be
+/// (`"table"`, `"shard"`, ...).
+#[derive(Clone, Copy)]
+pub(crate) struct Source<'a> {
+    pub(crate) path: &'a Path,
+    pub(crate) len: u64,
+    pub(crate) noun: &'a str,
+}
+
+impl Source<'_> {
+    /// An I/O error while reading this file.
+    pub(crate) fn io(&self, e: io::Error) -> TableError {
+        TableError::io(self.path, format!("read the {}", self.noun), e)
+    }
+
+    /// The file ends inside `what`.
+    pub(crate) fn ends_inside(&self, what: &str) -> TableError {
+        TableError::Truncated {
+            path: self.path.to_path_buf(),
+            detail: format!(
+                "the file ends inside the {what} ({} bytes in all)",
+                self.len
+            ),
+        }
+    }
+}
+
+/// Reads exactly `buf.len()` bytes, hashing them; a short read is reported as truncation
+/// inside `what`.
+pub(crate) fn read_hashed(
+    r: &mut impl Read,
+    hasher: &mut crc32fast::Hasher,
+    buf: &mut [u8],
+    src: Source<'_>,
+    what: &str,
+) -> Result<(), TableError> {
+    r.read_exact(buf).map_err(|e| {
+        if e.kind() == io::ErrorKind::UnexpectedEof {
+            src.ends_inside(what)
+        } else {
+            src.io(e)
+        }
+    })?;
+    hasher.update(buf);
+    Ok(())
+}
+
+/// Reads `n` f32 little-endian values in chunks, hashing their bytes. The caller bounds `n`
+/// by the file size, so the allocation is backed by real bytes.
+pub(crate) fn read_f32s(
+    r: &mut impl Read,
+    hasher: &mut crc32fast::Hasher,
+    n: usize,
+    src: Source<'_>,
+) -> Result<Vec<f32>, TableError> {
+    let mut values = Vec::with_capacity(n);
+    let mut bytes = vec![0u8; CHUNK_VALUES.min(n) * 4];
+    let mut left = n;
+    while left > 0 {
+        let take = left.min(CHUNK_VALUES);
+        let buf = &mut bytes[..take * 4];
+        read_hashed(r, hasher, buf, src, "values")?;
+        values.extend(
+            buf.chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        );
+        left -= take;
+    }
+    Ok(values)
+}
+
+/// Reads as many bytes as are available, up to `buf.len()`.
+pub(crate) fn read_up_to(r: &mut impl Read, buf: &mut [u8]) -> io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match r.read(&mut buf[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(n)
+}
+
+/// Bytes as lowercase hex pairs separated by spaces, `(none)` for no bytes.
+pub(crate) fn hex(bytes: &[u8]) -> String {
+    if bytes.is_empty() {
+        return "(none)".to_string();
+    }
+    bytes
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}

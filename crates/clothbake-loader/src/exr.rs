@@ -1,0 +1,530 @@
+//! The OpenEXR table: one RGB image of half or float samples, the [`Metadata`] in header
+//! attributes (`docs/table-format.md`). Written byte-reproducibly ([`write_exr`]), read
+//! without trusting the decoder not to panic ([`read_exr`]).
+
+use std::fs;
+use std::io::{self, Cursor, Write};
+use std::path::Path;
+
+use crate::atomic::write_atomic_as;
+use crate::bytes::{hex, CHUNK_VALUES};
+use crate::error::TableError;
+use crate::stored::{Samples, StoredTable};
+use crate::table::{Metadata, Precision, Table, FORMAT_VERSION};
+
+/// The 4 magic bytes that open every OpenEXR file.
+pub const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
+
+/// EXR header attribute holding the [`Metadata`] as JSON.
+pub const ATTR_METADATA: &str = "clothbake.metadata";
+/// EXR header attribute holding the format version as decimal text, for humans and other tools.
+pub const ATTR_FORMAT_VERSION: &str = "clothbake.format_version";
+/// EXR header attribute describing the grid in words.
+pub const ATTR_GRID: &str = "clothbake.grid";
+/// EXR header attribute holding the units of the values.
+pub const ATTR_UNITS: &str = "clothbake.units";
+/// EXR header attribute naming the tool that wrote the file.
+pub const ATTR_TOOL: &str = "clothbake.tool";
+/// EXR header attribute holding a CRC-32, as 8 lowercase hex digits, of the
+/// [`ATTR_METADATA`] text followed by every sample as f32 little-endian, pixels in row-major
+/// order, R, G, B per pixel. Readers verify it when present, as EXR itself has no checksum.
+pub const ATTR_CRC32: &str = "clothbake.crc32";
+
+/// Version-field flags of multi-part and deep EXR files (not written by clothbake).
+const EXR_MULTIPART: u32 = 0x1000;
+const EXR_DEEP: u32 = 0x800;
+
+/// Sorts the header attributes of a single-part EXR file by name, in place. Returns false (and
+/// leaves the bytes alone) for anything else than a well-formed single-part header.
+///
+/// The `exr` crate keeps an image's custom header attributes in a `HashMap` and writes them in
+/// its (randomly seeded) iteration order; [`write_exr`] sorts them by name (as the OpenEXR
+/// library writes them) so the same table always gives the same bytes. Reordering attributes
+/// keeps the header's length, so the offset table after it stays valid.
+fn sort_exr_attributes(bytes: &mut [u8]) -> bool {
+    if bytes.len() < 8 || bytes[..4] != EXR_MAGIC {
+        return false;
+    }
+    let flags = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
+    if flags & (EXR_MULTIPART | EXR_DEEP) != 0 {
+        return false;
+    }
+    let start = 8;
+    let mut pos = start;
+    let mut attrs: Vec<(usize, usize, usize)> = Vec::new(); // (start, name end, end)
+    let cstr_end = |from: usize| bytes[from..].iter().position(|&b| b == 0).map(|i| from + i);
+    loop {
+        let Some(name_end) = cstr_end(pos) else {
+            return false;
+        };
+        if name_end == pos {
+            break; // the empty name that ends the header
+        }
+        let Some(type_end) = cstr_end(name_end + 1) else {
+            return false;
+        };
+        let size_at = type_end + 1;
+        if size_at + 4 > bytes.len() {
+            return false;
+        }
+        let size = i32::from_le_bytes([
+            bytes[size_at],
+            bytes[size_at + 1],
+            bytes[size_at + 2],
+            bytes[size_at + 3],
+        ]);
+        let Ok(size) = usize::try_from(size) else {
+            return false;
+        };
+        let end = size_at + 4 + size;
+        if end > bytes.len() {
+            return false;
+        }
+        attrs.push((pos, name_end, end));
+        pos = end;
+    }
+    let header_end = pos;
+    let mut sorted: Vec<&(usize, usize, usize)> = attrs.iter().collect();
+    sorted.sort_by(|a, b| bytes[a.0..a.1].cmp(&bytes[b.0..b.1]));
+    let mut out = Vec::with_capacity(header_end - start);
+    for &&(s, _, e) in &sorted {
+        out.extend_from_slice(&bytes[s..e]);
+    }
+    bytes[start..header_end].copy_from_slice(&out);
+    true
+}
+
+#[cfg(test)]
+mod sort_tests {
+    use super::sort_exr_attributes;
+
+    #[test]
+    fn malformed_headers_are_left_alone() {
+        let mut junk = b"not an exr".to_vec();
+        assert!(!sort_exr_attributes(&mut junk));
+        let mut cut = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0, b'a', 0, b'b'];
+        let copy = cut.clone();
+        assert!(!sort_exr_attributes(&mut cut));
+        assert_eq!(cut, copy);
+    }
+}
+
+mod exr_io {
+    use super::*;
+    use exr::prelude::{
+        AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image, Layer,
+        LayerAttributes, ReadChannels, ReadLayers, SmallVec, Text, WritableImage,
+    };
+
+    fn text(s: &str) -> AttributeValue {
+        // Our texts are ASCII (see `Metadata::to_ascii_json`); other bytes are kept as they are.
+        AttributeValue::Text(Text::from_slice_unchecked(s.as_bytes()))
+    }
+
+    pub(super) fn write(
+        path: &Path,
+        table: &Table,
+        precision: Precision,
+        overwrite: bool,
+    ) -> Result<(), TableError> {
+        let unwritable = |reason: String| TableError::Unwritable {
+            path: path.to_path_buf(),
+            what: "table".into(),
+            reason,
+        };
+        table.validate().map_err(|e| e.unwritable(path))?;
+        let grid = table.meta.grid;
+        let (width, height) = (grid.exr_width(), grid.exr_height());
+        if width > i32::MAX as u64 || height > i32::MAX as u64 {
+            return Err(unwritable(format!(
+                "the {width} x {height} image is too large for OpenEXR; use the binary format"
+            )));
+        }
+        let (width, height) = (width as usize, height as usize);
+
+        // Channel k, row-major over the 2-D layout.
+        let plane = |k: usize| -> Vec<f32> {
+            let mut out = Vec::with_capacity(width * height);
+            for ti in 0..grid.n_theta_i {
+                for to in 0..grid.n_theta_o {
+                    for pi in 0..grid.n_phi_i {
+                        for po in 0..grid.n_phi_o {
+                            out.push(table.values[3 * grid.index(ti, pi, to, po) + k]);
+                        }
+                    }
+                }
+            }
+            out
+        };
+        let planes = [plane(0), plane(1), plane(2)];
+        if precision == Precision::F16 {
+            let max = half::f16::MAX.to_f32();
+            if let Some(v) = table.values.iter().find(|v| v.abs() > max) {
+                return Err(unwritable(format!(
+                    "value {v} exceeds the half-float range (65504); write with f32 precision"
+                )));
+            }
+        }
+        let stored = |p: &[f32]| -> Vec<f32> {
+            match precision {
+                Precision::F32 => p.to_vec(),
+                Precision::F16 => p.iter().map(|&v| half::f16::from_f32(v).to_f32()).collect(),
+            }
+        };
+        let meta_json = table.meta.to_ascii_json();
+        let kept = [stored(&planes[0]), stored(&planes[1]), stored(&planes[2])];
+        let crc = planes_crc(
+            meta_json.as_bytes(),
+            &[
+                Plane::F32(&kept[0]),
+                Plane::F32(&kept[1]),
+                Plane::F32(&kept[2]),
+            ],
+        );
+        let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+        for (name, p) in ["R", "G", "B"].into_iter().zip(planes) {
+            let samples = match precision {
+                Precision::F32 => FlatSamples::F32(p),
+                Precision::F16 => {
+                    FlatSamples::F16(p.into_iter().map(half::f16::from_f32).collect())
+                }
+            };
+            channels.push(AnyChannel::new(name, samples));
+        }
+
+        let mut attributes = LayerAttributes {
+            software_name: Some(Text::from_slice_unchecked(table.meta.tool.as_bytes())),
+            ..LayerAttributes::default()
+        };
+        let other = &mut attributes.other;
+        other.insert(Text::from(ATTR_METADATA), text(&meta_json));
+        other.insert(
+            Text::from(ATTR_FORMAT_VERSION),
+            text(&table.meta.format_version.to_string()),
+        );
+        other.insert(
+            Text::from(ATTR_GRID),
+            text(&format!("{grid}, cell-centred, degrees")),
+        );
+        other.insert(Text::from(ATTR_UNITS), text(&table.meta.units));
+        other.insert(Text::from(ATTR_TOOL), text(&table.meta.tool));
+        other.insert(Text::from(ATTR_CRC32), text(&format!("{crc:08x}")));
+
+        let layer = Layer::new(
+            (width, height),
+            attributes,
+            Encoding::SMALL_LOSSLESS,
+            AnyChannels::sort(channels),
+        );
+        let image = Image::from_layer(layer);
+        let mut bytes = Vec::new();
+        image
+            .write()
+            .non_parallel()
+            .to_buffered(Cursor::new(&mut bytes))
+            .map_err(|e| unwritable(format!("OpenEXR encoder: {e}")))?;
+        sort_exr_attributes(&mut bytes);
+        write_atomic_as(path, "table", overwrite, |out| out.write_all(&bytes))
+    }
+
+    /// Maps an exr error; a file that ends early is reported as truncated.
+    fn decode_error(path: &Path, what: &str, e: exr::error::Error) -> TableError {
+        let truncated = match &e {
+            exr::error::Error::Io(io) => io.kind() == io::ErrorKind::UnexpectedEof,
+            // exr reports an unexpected end of file as "reference to missing bytes".
+            exr::error::Error::Invalid(m) => m.contains("missing bytes"),
+            _ => false,
+        };
+        if truncated {
+            TableError::Truncated {
+                path: path.to_path_buf(),
+                detail: format!("the OpenEXR {what} ends early ({e})"),
+            }
+        } else {
+            TableError::Corrupted {
+                path: path.to_path_buf(),
+                reason: format!("the OpenEXR {what} cannot be decoded ({e})"),
+            }
+        }
+    }
+
+    fn attribute_text(value: &AttributeValue) -> Option<String> {
+        match value {
+            AttributeValue::Text(t) => Some(String::from_utf8_lossy(t.bytes()).into_owned()),
+            _ => None,
+        }
+    }
+
+    pub(super) fn read(path: &Path) -> Result<StoredTable, TableError> {
+        let bytes = fs::read(path).map_err(|e| TableError::io(path, "read the table", e))?;
+        if bytes.is_empty() {
+            return Err(TableError::Empty {
+                path: path.to_path_buf(),
+            });
+        }
+        if !bytes.starts_with(&EXR_MAGIC) {
+            return Err(TableError::Foreign {
+                path: path.to_path_buf(),
+                what: "table".into(),
+                reason: format!(
+                    "the first bytes are {}, not the OpenEXR magic bytes 76 2f 31 01",
+                    hex(&bytes[..bytes.len().min(4)])
+                ),
+            });
+        }
+        let corrupted = |reason: String| TableError::Corrupted {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let foreign = |reason: String| TableError::Foreign {
+            path: path.to_path_buf(),
+            what: "table".into(),
+            reason,
+        };
+
+        // The exr decoder is not trusted to never panic on damaged files.
+        let guarded = |f: &dyn Fn() -> Result<StoredTable, TableError>| {
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|_| {
+                Err(corrupted(
+                    "the OpenEXR decoder failed on this file".to_string(),
+                ))
+            })
+        };
+
+        guarded(&|| {
+            // Header first: check the attributes and dimensions before decoding any pixels.
+            let meta_data = exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false)
+                .map_err(|e| decode_error(path, "header", e))?;
+            if meta_data.headers.len() != 1 {
+                return Err(foreign(format!(
+                    "the EXR has {} parts, but a table has exactly one",
+                    meta_data.headers.len()
+                )));
+            }
+            let header = &meta_data.headers[0];
+            let attrs = &header.own_attributes.other;
+            let meta_json_bytes = match attrs.get(&Text::from(ATTR_METADATA)) {
+                Some(AttributeValue::Text(t)) => t.bytes().to_vec(),
+                _ => {
+                    return Err(foreign(format!(
+                        "the EXR has no text attribute {ATTR_METADATA:?}; it was not written by clothbake"
+                    )))
+                }
+            };
+            let meta_json = String::from_utf8_lossy(&meta_json_bytes);
+            if let Some(v) = attrs
+                .get(&Text::from(ATTR_FORMAT_VERSION))
+                .and_then(attribute_text)
+            {
+                match v.trim().parse::<u32>() {
+                    Ok(found) if found != FORMAT_VERSION => {
+                        return Err(TableError::Version {
+                            path: path.to_path_buf(),
+                            what: "table",
+                            found,
+                            reads: FORMAT_VERSION,
+                        })
+                    }
+                    Ok(_) => {}
+                    Err(_) => {
+                        return Err(corrupted(format!(
+                            "{ATTR_FORMAT_VERSION} is {v:?}, not a number"
+                        )))
+                    }
+                }
+            }
+            // Look at the version before the rest, so that newer files say "update the loader".
+            let json: serde_json::Value = serde_json::from_str(&meta_json)
+                .map_err(|e| corrupted(format!("{ATTR_METADATA} is not valid JSON ({e})")))?;
+            if let Some(found) = json.get("format_version").and_then(|v| v.as_u64()) {
+                if found != u64::from(FORMAT_VERSION) {
+                    return Err(TableError::Version {
+                        path: path.to_path_buf(),
+                        what: "table",
+                        found: u32::try_from(found).unwrap_or(u32::MAX),
+                        reads: FORMAT_VERSION,
+                    });
+                }
+            }
+            let meta: Metadata = serde_json::from_value(json).map_err(|e| {
+                corrupted(format!("{ATTR_METADATA} does not describe a table ({e})"))
+            })?;
+            meta.validate().map_err(|e| e.in_file(path))?;
+            let grid = meta.grid;
+            let size = header.layer_size;
+            if size.width() as u64 != grid.exr_width() || size.height() as u64 != grid.exr_height()
+            {
+                return Err(corrupted(format!(
+                    "the image is {} x {}, but grid {grid} needs {} x {} (n_phi_i * n_phi_o by n_theta_i * n_theta_o)",
+                    size.width(),
+                    size.height(),
+                    grid.exr_width(),
+                    grid.exr_height()
+                )));
+            }
+            let names: Vec<String> = header
+                .channels
+                .list
+                .iter()
+                .map(|c| String::from_utf8_lossy(c.name.bytes()).into_owned())
+                .collect();
+            if names != ["B", "G", "R"] {
+                return Err(foreign(format!(
+                    "the EXR has channels {names:?}, but a table has exactly R, G and B"
+                )));
+            }
+
+            let image = exr::prelude::read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .all_channels()
+                .all_layers()
+                .all_attributes()
+                .non_parallel()
+                .from_buffered(Cursor::new(&bytes))
+                .map_err(|e| decode_error(path, "pixel data", e))?;
+            let layer = image
+                .layer_data
+                .first()
+                .ok_or_else(|| corrupted("the EXR has no layer".to_string()))?;
+            let (width, height) = (grid.exr_width() as usize, grid.exr_height() as usize);
+            let mut planes: [Option<Plane>; 3] = Default::default();
+            for channel in &layer.channel_data.list {
+                let k = match channel.name.bytes() {
+                    b"R" => 0,
+                    b"G" => 1,
+                    b"B" => 2,
+                    _ => continue,
+                };
+                let plane = match &channel.sample_data {
+                    FlatSamples::F16(v) => Plane::F16(v),
+                    FlatSamples::F32(v) => Plane::F32(v),
+                    FlatSamples::U32(_) => {
+                        return Err(foreign(
+                            "channel samples are u32; a table has f16 or f32 samples".to_string(),
+                        ))
+                    }
+                };
+                if plane.len() != width * height {
+                    return Err(corrupted(format!(
+                        "channel has {} samples, expected {}",
+                        plane.len(),
+                        width * height
+                    )));
+                }
+                planes[k] = Some(plane);
+            }
+            let [Some(r), Some(g), Some(b)] = planes else {
+                return Err(foreign(
+                    "the EXR lacks one of the channels R, G and B".to_string(),
+                ));
+            };
+            let planes = [r, g, b];
+            if let Some(stored) = attrs.get(&Text::from(ATTR_CRC32)).and_then(attribute_text) {
+                let computed = planes_crc(&meta_json_bytes, &planes);
+                if u32::from_str_radix(stored.trim(), 16).ok() != Some(computed) {
+                    return Err(TableError::Checksum {
+                        path: path.to_path_buf(),
+                        stored: u32::from_str_radix(stored.trim(), 16).unwrap_or(0),
+                        computed,
+                    });
+                }
+            }
+            // Pixel of each cell, in cell order (see `docs/table-format.md`).
+            let pixels = || {
+                (0..grid.n_theta_i).flat_map(move |ti| {
+                    (0..grid.n_phi_i).flat_map(move |pi| {
+                        (0..grid.n_theta_o).flat_map(move |to| {
+                            (0..grid.n_phi_o).map(move |po| {
+                                let y = (ti * grid.n_theta_o + to) as usize;
+                                y * width + (pi * grid.n_phi_o + po) as usize
+                            })
+                        })
+                    })
+                })
+            };
+            let samples = match &planes {
+                [Plane::F16(r), Plane::F16(g), Plane::F16(b)] => {
+                    Samples::F16(pixels().flat_map(|x| [r[x], g[x], b[x]]).collect())
+                }
+                _ => Samples::F32(
+                    pixels()
+                        .flat_map(|x| [planes[0].get(x), planes[1].get(x), planes[2].get(x)])
+                        .collect(),
+                ),
+            };
+            StoredTable::new(meta.clone(), samples).map_err(|e| e.in_file(path))
+        })
+    }
+
+    /// One channel's samples as decoded, borrowed from the image.
+    enum Plane<'a> {
+        F16(&'a [half::f16]),
+        F32(&'a [f32]),
+    }
+
+    impl Plane<'_> {
+        fn len(&self) -> usize {
+            match self {
+                Plane::F16(v) => v.len(),
+                Plane::F32(v) => v.len(),
+            }
+        }
+
+        fn get(&self, i: usize) -> f32 {
+            match self {
+                Plane::F16(v) => v[i].to_f32(),
+                Plane::F32(v) => v[i],
+            }
+        }
+    }
+
+    /// The [`ATTR_CRC32`] checksum of a metadata text and three row-major planes, widened to
+    /// f32 chunk by chunk (no full f32 copy).
+    fn planes_crc(meta_json: &[u8], planes: &[Plane; 3]) -> u32 {
+        let mut hasher = crc32fast::Hasher::new();
+        hasher.update(meta_json);
+        let mut bytes = Vec::with_capacity(CHUNK_VALUES * 12);
+        let n = planes[0].len();
+        for start in (0..n).step_by(CHUNK_VALUES) {
+            bytes.clear();
+            for i in start..n.min(start + CHUNK_VALUES) {
+                for p in planes {
+                    bytes.extend_from_slice(&p.get(i).to_le_bytes());
+                }
+            }
+            hasher.update(&bytes);
+        }
+        hasher.finalize()
+    }
+}
+
+/// Writes a table as an OpenEXR image (see `docs/table-format.md`), atomically.
+///
+/// One RGB layer of f16 or f32 samples, `n_phi_i * n_phi_o` wide and `n_theta_i * n_theta_o`
+/// high: pixel `(pi * n_phi_o + po, ti * n_theta_o + to)` holds cell `(ti, pi, to, po)`. The
+/// header carries the [`Metadata`] as JSON in [`ATTR_METADATA`] and, for humans and other tools,
+/// [`ATTR_FORMAT_VERSION`], [`ATTR_GRID`], [`ATTR_UNITS`] and [`ATTR_TOOL`], and a checksum
+/// in [`ATTR_CRC32`]. With [`Precision::F16`], values beyond the half-float range (65504) are
+/// an error.
+pub fn write_exr(
+    path: &Path,
+    table: &Table,
+    precision: Precision,
+    overwrite: bool,
+) -> Result<(), TableError> {
+    exr_io::write(path, table, precision, overwrite)
+}
+
+/// Reads a table from an OpenEXR image written by [`write_exr`] (f16 or f32 samples), checking
+/// the metadata, the image size against the grid, the channels and, when present, the
+/// [`ATTR_CRC32`] checksum.
+pub fn read_exr(path: &Path) -> Result<Table, TableError> {
+    exr_io::read(path).map(StoredTable::into_table)
+}
+
+/// Reads an OpenEXR table like [`read_exr`], keeping the samples at their stored precision
+/// (half samples stay half: half the memory).
+pub fn read_exr_stored(path: &Path) -> Result<StoredTable, TableError> {
+    exr_io::read(path)
+}

@@ -1,0 +1,46 @@
+//! Reading a table in either format, recognised by its first bytes.
+
+use std::fs::File;
+use std::path::Path;
+
+use crate::binary::read_binary;
+use crate::bytes::{hex, read_up_to};
+use crate::container::BINARY_MAGIC;
+use crate::error::TableError;
+use crate::exr::{read_exr_stored, EXR_MAGIC};
+use crate::stored::StoredTable;
+use crate::table::Table;
+
+/// Reads a table in either format, recognised by its first bytes.
+pub fn read_table(path: &Path) -> Result<Table, TableError> {
+    read_table_stored(path).map(StoredTable::into_table)
+}
+
+/// Reads a table in either format like [`read_table`], keeping the samples at their stored
+/// precision: half for half-float EXR tables, f32 otherwise.
+pub fn read_table_stored(path: &Path) -> Result<StoredTable, TableError> {
+    let mut file = File::open(path).map_err(|e| TableError::io(path, "open the table", e))?;
+    let mut head = [0u8; 8];
+    let n =
+        read_up_to(&mut file, &mut head).map_err(|e| TableError::io(path, "read the table", e))?;
+    drop(file);
+    let head = &head[..n];
+    if head.is_empty() {
+        Err(TableError::Empty {
+            path: path.to_path_buf(),
+        })
+    } else if head.starts_with(&EXR_MAGIC) {
+        read_exr_stored(path)
+    } else if BINARY_MAGIC.starts_with(head) || head.starts_with(&BINARY_MAGIC[..4]) {
+        read_binary(path).map(StoredTable::from)
+    } else {
+        Err(TableError::Foreign {
+            path: path.to_path_buf(),
+            what: "table".into(),
+            reason: format!(
+                "the first bytes are {}; a table starts with \"CLTHBAKE\" (binary) or 76 2f 31 01 (OpenEXR)",
+                hex(head)
+            ),
+        })
+    }
+}

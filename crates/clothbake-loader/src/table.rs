@@ -1,0 +1,329 @@
+//! The table in memory: its [`Grid`] of directions, its [`Metadata`] and its values
+//! ([`Table`]), and the rules every table obeys ([`Table::new`]).
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::TableError;
+
+/// Version of the table description: the [`Metadata`] record, the grid layout and the OpenEXR
+/// format (`docs/table-format.md`). Readers reject any other version. The binary container
+/// has a version of its own, [`crate::CONTAINER_VERSION`].
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Largest number of cells a grid may have (2^31).
+pub const MAX_CELLS: u64 = 1 << 31;
+
+/// The 4-D grid of incident and outgoing directions, cell-centred, in degrees.
+///
+/// Polar angles cover [0, 90] degrees from +Z, azimuths [0, 360) degrees from +X toward +Y.
+/// Cell `k` of a polar axis with `n` cells is centred on `(k + 0.5) * 90 / n` degrees; cell `k`
+/// of an azimuth axis on `(k + 0.5) * 360 / n` degrees. Cells are ordered theta_i, phi_i,
+/// theta_o, phi_o, the last varying fastest (see [`Grid::index`]).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Grid {
+    /// Number of cells of the incident polar angle.
+    pub n_theta_i: u32,
+    /// Number of cells of the incident azimuth.
+    pub n_phi_i: u32,
+    /// Number of cells of the outgoing polar angle.
+    pub n_theta_o: u32,
+    /// Number of cells of the outgoing azimuth.
+    pub n_phi_o: u32,
+}
+
+impl Grid {
+    /// Number of cells. Saturates at `usize::MAX` for absurd grids that [`Grid::validate`]
+    /// rejects.
+    pub fn len(&self) -> usize {
+        usize::try_from(self.cells()).unwrap_or(usize::MAX)
+    }
+
+    /// True when the grid has no cells (an invalid grid).
+    pub fn is_empty(&self) -> bool {
+        self.cells() == 0
+    }
+
+    /// Number of cells as `u64`, saturating.
+    fn cells(&self) -> u64 {
+        [self.n_theta_i, self.n_phi_i, self.n_theta_o, self.n_phi_o]
+            .iter()
+            .fold(1u64, |acc, &n| acc.saturating_mul(u64::from(n)))
+    }
+
+    /// Index of a cell: `((ti * n_phi_i + pi) * n_theta_o + to) * n_phi_o + po`.
+    pub fn index(&self, ti: u32, pi: u32, to: u32, po: u32) -> usize {
+        debug_assert!(ti < self.n_theta_i && pi < self.n_phi_i);
+        debug_assert!(to < self.n_theta_o && po < self.n_phi_o);
+        let (ti, pi, to, po) = (ti as usize, pi as usize, to as usize, po as usize);
+        ((ti * self.n_phi_i as usize + pi) * self.n_theta_o as usize + to) * self.n_phi_o as usize
+            + po
+    }
+
+    /// Centre of incident polar cell `k`, degrees from +Z.
+    pub fn theta_i_deg(&self, k: u32) -> f64 {
+        Grid::polar_centre_deg(k, self.n_theta_i)
+    }
+
+    /// Centre of incident azimuth cell `k`, degrees from +X toward +Y.
+    pub fn phi_i_deg(&self, k: u32) -> f64 {
+        Grid::azimuth_centre_deg(k, self.n_phi_i)
+    }
+
+    /// Centre of outgoing polar cell `k`, degrees from +Z.
+    pub fn theta_o_deg(&self, k: u32) -> f64 {
+        Grid::polar_centre_deg(k, self.n_theta_o)
+    }
+
+    /// Centre of outgoing azimuth cell `k`, degrees from +X toward +Y.
+    pub fn phi_o_deg(&self, k: u32) -> f64 {
+        Grid::azimuth_centre_deg(k, self.n_phi_o)
+    }
+
+    /// Width of the EXR image: `n_phi_i * n_phi_o`.
+    pub fn exr_width(&self) -> u64 {
+        u64::from(self.n_phi_i) * u64::from(self.n_phi_o)
+    }
+
+    /// Height of the EXR image: `n_theta_i * n_theta_o`.
+    pub fn exr_height(&self) -> u64 {
+        u64::from(self.n_theta_i) * u64::from(self.n_theta_o)
+    }
+
+    /// Checks that every axis has cells and that the grid has at most [`MAX_CELLS`] cells.
+    pub fn validate(&self) -> Result<(), TableError> {
+        let axes = [
+            ("n_theta_i", self.n_theta_i),
+            ("n_phi_i", self.n_phi_i),
+            ("n_theta_o", self.n_theta_o),
+            ("n_phi_o", self.n_phi_o),
+        ];
+        for (name, n) in axes {
+            if n == 0 {
+                return Err(TableError::InvalidTable {
+                    reason: format!("grid {self}: {name} is 0; every axis needs at least 1 cell"),
+                });
+            }
+        }
+        if self.cells() > MAX_CELLS {
+            return Err(TableError::InvalidTable {
+                reason: format!(
+                    "grid {self}: {} cells is more than the limit of {MAX_CELLS} (2^31); use a coarser grid",
+                    self.cells()
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Centre of cell `k` of a polar axis of `n` cells, degrees from +Z:
+    /// `(k + 0.5) * 90 / n`.
+    pub fn polar_centre_deg(k: u32, n: u32) -> f64 {
+        (f64::from(k) + 0.5) * 90.0 / f64::from(n)
+    }
+
+    /// Centre of cell `k` of an azimuth axis of `n` cells, degrees from +X toward +Y:
+    /// `(k + 0.5) * 360 / n`.
+    pub fn azimuth_centre_deg(k: u32, n: u32) -> f64 {
+        (f64::from(k) + 0.5) * 360.0 / f64::from(n)
+    }
+}
+
+impl fmt::Display for Grid {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "theta_i {} phi_i {} theta_o {} phi_o {}",
+            self.n_theta_i, self.n_phi_i, self.n_theta_o, self.n_phi_o
+        )
+    }
+}
+
+/// What a table holds and how it was made. Stored in both formats.
+///
+/// The field order is part of the version-1 binary format, which the loader still reads (see
+/// `docs/table-format.md`): do not reorder.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct Metadata {
+    /// Version of the table description: [`FORMAT_VERSION`].
+    pub format_version: u32,
+    /// The tool that wrote the table, e.g. `"clothbake 0.1.0"`.
+    pub tool: String,
+    /// The grid of directions.
+    pub grid: Grid,
+    /// Where samples sit in their cells: always `"cell"` (cell centres).
+    pub centring: String,
+    /// The tabulated quantity: `"f_r"`, the BRDF.
+    pub quantity: String,
+    /// Units of the values: `"1/sr"`.
+    pub units: String,
+    /// The full fabric file, as JSON text.
+    pub fabric_json: String,
+    /// The bake options, as JSON text.
+    pub options_json: String,
+    /// The symmetry the baker exploited, in words, e.g. `"mirror x, mirror y"` or `"none"`.
+    pub symmetry: String,
+}
+
+impl Metadata {
+    /// Metadata of the current format version for a cell-centred table of `f_r` in `1/sr`.
+    pub fn new(
+        tool: impl Into<String>,
+        grid: Grid,
+        fabric_json: impl Into<String>,
+        options_json: impl Into<String>,
+        symmetry: impl Into<String>,
+    ) -> Metadata {
+        Metadata {
+            format_version: FORMAT_VERSION,
+            tool: tool.into(),
+            grid,
+            centring: "cell".to_string(),
+            quantity: "f_r".to_string(),
+            units: "1/sr".to_string(),
+            fabric_json: fabric_json.into(),
+            options_json: options_json.into(),
+            symmetry: symmetry.into(),
+        }
+    }
+
+    /// Checks the format version, the grid and the centring.
+    pub fn validate(&self) -> Result<(), TableError> {
+        if self.format_version != FORMAT_VERSION {
+            return Err(TableError::InvalidTable {
+                reason: format!(
+                    "metadata says format version {}, but this is version {FORMAT_VERSION}",
+                    self.format_version
+                ),
+            });
+        }
+        self.grid.validate()?;
+        if self.centring != "cell" {
+            return Err(TableError::InvalidTable {
+                reason: format!(
+                    "centring is {:?}, but only \"cell\" (cell-centred samples) is supported",
+                    self.centring
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// The metadata as JSON text with every non-ASCII character escaped (`\uXXXX`), so that
+    /// it survives any tool that treats EXR text attributes as bytes or as Latin-1.
+    pub fn to_ascii_json(&self) -> String {
+        let json = serde_json::to_string(self).expect("Metadata serialises to JSON");
+        escape_non_ascii(&json)
+    }
+}
+
+/// Replaces every non-ASCII character of a JSON text by `\uXXXX` escapes (UTF-16 surrogate
+/// pairs above U+FFFF). Valid because non-ASCII characters only occur inside JSON strings.
+fn escape_non_ascii(json: &str) -> String {
+    if json.is_ascii() {
+        return json.to_string();
+    }
+    let mut out = String::with_capacity(json.len() + 16);
+    for c in json.chars() {
+        if c.is_ascii() {
+            out.push(c);
+        } else {
+            let mut units = [0u16; 2];
+            for unit in c.encode_utf16(&mut units) {
+                out.push_str(&format!("\\u{unit:04x}"));
+            }
+        }
+    }
+    out
+}
+
+/// A baked table: metadata and RGB values, interleaved, one triple per grid cell.
+///
+/// The value of cell `c` (see [`Grid::index`]) and channel `k` (0 = R, 1 = G, 2 = B) is
+/// `values[3 * c + k]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    /// What the table holds.
+    pub meta: Metadata,
+    /// RGB values, interleaved; `values.len() == 3 * meta.grid.len()`.
+    pub values: Vec<f32>,
+}
+
+impl Table {
+    /// A table, after checking the metadata, the number of values and that every value is
+    /// finite.
+    pub fn new(meta: Metadata, values: Vec<f32>) -> Result<Table, TableError> {
+        let table = Table { meta, values };
+        table.validate()?;
+        Ok(table)
+    }
+
+    /// Checks what [`Table::new`] checks; the writers call it, as the fields are public.
+    pub fn validate(&self) -> Result<(), TableError> {
+        let bad = self.values.iter().position(|v| !v.is_finite());
+        check_values(
+            &self.meta,
+            self.values.len(),
+            bad.map(|i| (i, self.values[i])),
+        )
+    }
+
+    /// The grid of the table.
+    pub fn grid(&self) -> &Grid {
+        &self.meta.grid
+    }
+
+    /// The RGB value of a cell.
+    pub fn rgb(&self, ti: u32, pi: u32, to: u32, po: u32) -> [f32; 3] {
+        let c = self.meta.grid.index(ti, pi, to, po);
+        [
+            self.values[3 * c],
+            self.values[3 * c + 1],
+            self.values[3 * c + 2],
+        ]
+    }
+}
+
+/// Checks a table's metadata, its number of values (`len`) and the first non-finite value, if
+/// any (its index and value): the rules of [`Table::new`], for any sample type.
+pub(crate) fn check_values(
+    meta: &Metadata,
+    len: usize,
+    non_finite: Option<(usize, f32)>,
+) -> Result<(), TableError> {
+    meta.validate()?;
+    let expected = meta.grid.len() * 3;
+    if len != expected {
+        return Err(TableError::InvalidTable {
+            reason: format!(
+                "grid {} has {} cells and needs {expected} values (RGB), but there are {len}",
+                meta.grid,
+                meta.grid.len(),
+            ),
+        });
+    }
+    if let Some((i, v)) = non_finite {
+        return Err(TableError::InvalidTable {
+            reason: format!(
+                "value {} of cell {} (channel {}) is {}; every value must be finite",
+                i,
+                i / 3,
+                ['R', 'G', 'B'][i % 3],
+                v
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Sample type of the EXR channels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Precision {
+    /// 16-bit half floats (the default): half the size, about 3 significant digits, at most
+    /// 65504.
+    #[default]
+    F16,
+    /// 32-bit floats: exact.
+    F32,
+}
