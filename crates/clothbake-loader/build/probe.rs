@@ -129,8 +129,8 @@ fn python_imports(code: &str) -> Result<(), String> {
             .trim()
             .lines()
             .last()
-            .unwrap_or("the import failed")
-            .to_string()),
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("python3 -c \"{code}\" failed ({})", out.status))),
         Err(e) => Err(format!("python3 cannot be run: {e}")),
     }
 }
