@@ -13,6 +13,28 @@ pub fn temp_dir(name: &str) -> PathBuf {
     d
 }
 
+/// Builds `packages` in release mode with a nested cargo and returns the folder of their
+/// artefacts (target/release). Release, not the running test's profile: the running `cargo
+/// test` holds the lock of target/debug, so a nested build there would wait forever.
+pub fn release_build(packages: &[&str]) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut cmd = std::process::Command::new(env!("CARGO"));
+    cmd.current_dir(&root)
+        .args(["build", "--quiet", "--release"]);
+    for p in packages {
+        cmd.args(["-p", p]);
+    }
+    let status = cmd.status().expect("cargo runs");
+    assert!(
+        status.success(),
+        "cargo build --release {packages:?} failed"
+    );
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("target"))
+        .join("release")
+}
+
 /// The shipped twill (`tables/twill.json`) with the albedo (0.6, 0.3, 0.12) on both groups, so
 /// that the three channels differ.
 pub fn coloured_twill() -> Fabric {

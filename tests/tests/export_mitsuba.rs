@@ -7,14 +7,16 @@
 //! with the two directions Mitsuba reports for the ray through the pixel's centre, in the
 //! surface frame its BSDF sees. Relative RMSE under 5%.
 //!
-//! Skipped with a message when `python3` cannot import mitsuba and numpy, except under `CI`
-//! (CI installs them, see .ci/run). With `CLOTHBAKE_FIGURES=DIR` the two images of each test
+//! Ignored, with the reason, when `python3` cannot import mitsuba and numpy (the build script
+//! probes them); under `CI` they run and fail without them (.ci/run and `cargo xtask test`
+//! install them). With `CLOTHBAKE_FIGURES=DIR` the two images of each test
 //! are also written as PNG into DIR (docs/figures/ holds the committed ones).
 
 use clothbake_core::{AnalyticBsdf, Bsdf};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Vec3};
 use clothbake_export::rgl;
 use clothbake_tests::fixtures::{bake_and_open, coloured_twill, temp_dir};
+use clothbake_tests::probe::MITSUBA;
 use std::path::Path;
 use std::process::Command;
 
@@ -23,38 +25,6 @@ const RES: usize = 48;
 /// Samples per pixel of the spectral render: each carries 4 wavelengths, and the colour noise
 /// of wavelength sampling is several percent per pixel at the RGB render's 16.
 const SPECTRAL_SPP: u32 = 256;
-
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
-}
-
-fn mitsuba_available() -> bool {
-    let probe = Command::new("python3")
-        .args([
-            "-c",
-            "import mitsuba, numpy; mitsuba.set_variant('scalar_rgb')",
-        ])
-        .output();
-    let why = match probe {
-        Ok(out) if out.status.success() => return true,
-        Ok(out) => String::from_utf8_lossy(&out.stderr)
-            .trim()
-            .lines()
-            .last()
-            .unwrap_or("import failed")
-            .to_string(),
-        Err(e) => format!("cannot run python3: {e}"),
-    };
-    assert!(
-        !in_ci(),
-        "CI is set, but Mitsuba 3 is not usable ({why}); install it with: python3 -m pip \
-         install mitsuba numpy"
-    );
-    eprintln!(
-        "skipped: the mitsuba Python package is not installed (pip install mitsuba numpy): {why}"
-    );
-    false
-}
 
 fn read_le<const N: usize, T>(path: &Path, f: fn([u8; N]) -> T) -> Vec<T> {
     std::fs::read(path)
@@ -193,10 +163,12 @@ fn report(what: &str, c: &Compared) {
 }
 
 #[test]
+#[cfg_attr(
+    missing_mitsuba,
+    ignore = "needs the mitsuba and numpy Python packages: python3 -m pip install mitsuba numpy, or run `cargo xtask test`"
+)]
 fn mitsuba_renders_the_exported_bsdf_like_the_model() {
-    if !mitsuba_available() {
-        return;
-    }
+    MITSUBA.require();
     let f = fabric();
     let model = AnalyticModel::new(&f, FacetModel::Huo);
     let c = render_and_compare(
@@ -211,12 +183,14 @@ fn mitsuba_renders_the_exported_bsdf_like_the_model() {
 }
 
 #[test]
+#[cfg_attr(
+    missing_mitsuba,
+    ignore = "needs the mitsuba and numpy Python packages: python3 -m pip install mitsuba numpy, or run `cargo xtask test`"
+)]
 fn mitsuba_spectral_renders_the_spectral_bsdf_like_the_model() {
     // The spectral file: Mitsuba samples wavelengths, interpolates `spectra` between our nodes,
     // multiplies by its D65 light and integrates against the CIE curves into sRGB.
-    if !mitsuba_available() {
-        return;
-    }
+    MITSUBA.require();
     let f = fabric();
     let model = AnalyticModel::new(&f, FacetModel::Huo);
     let c = render_and_compare(
@@ -231,11 +205,13 @@ fn mitsuba_spectral_renders_the_spectral_bsdf_like_the_model() {
 }
 
 #[test]
+#[cfg_attr(
+    missing_mitsuba,
+    ignore = "needs the mitsuba and numpy Python packages: python3 -m pip install mitsuba numpy, or run `cargo xtask test`"
+)]
 fn mitsuba_renders_the_export_of_a_baked_table_like_the_model() {
     // The twill baked at the default grid (f16 EXR), exported through the loader's lookup.
-    if !mitsuba_available() {
-        return;
-    }
+    MITSUBA.require();
     let dir = temp_dir("baked-table");
     let lookup = bake_and_open(&fabric(), &dir.join("twill.exr"));
     let source = lookup;

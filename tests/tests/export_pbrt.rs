@@ -7,32 +7,18 @@
 //! projects every spectrum back to sRGB with Mitsuba's own CIE tables and compares with the RGB
 //! file of the same export.
 //!
-//! Skipped with a message when python3 cannot import numpy, except under `CI`.
+//! Ignored, with the reason, when python3 cannot import numpy (the projection: mitsuba); under
+//! `CI` they run and fail without them (.ci/run and `cargo xtask test` install them).
 
 use clothbake_core::AnalyticBsdf;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel};
 use clothbake_export::rgl;
 use clothbake_tests::fixtures::temp_dir;
+use clothbake_tests::probe::{MITSUBA, NUMPY};
 use std::path::Path;
 use std::process::Command;
 
 const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/python/rgl_check.py");
-
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
-}
-
-fn imports(module: &str) -> bool {
-    let ok = Command::new("python3")
-        .args(["-c", &format!("import {module}")])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        assert!(!in_ci(), "CI is set, but python3 cannot import {module}");
-        eprintln!("skipped: python3 cannot import {module} (pip install {module})");
-    }
-    ok
-}
 
 fn check(args: &[&str]) -> serde_json::Value {
     let out = Command::new("python3")
@@ -49,11 +35,8 @@ fn check(args: &[&str]) -> serde_json::Value {
     serde_json::from_str(text.trim()).unwrap()
 }
 
-#[test]
-fn the_spectral_file_meets_pbrt_v4s_reader_and_projects_back_to_the_rgb_file() {
-    if !imports("numpy") {
-        return;
-    }
+/// The denim draft exported as a spectral and an RGB RGL file into a fresh folder `name`.
+fn export(name: &str) -> (std::path::PathBuf, std::path::PathBuf, std::path::PathBuf) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/denim.wif");
     let fabric = Fabric::from_path(&path).unwrap();
     let model = AnalyticModel::new(&fabric, FacetModel::Huo);
@@ -63,12 +46,23 @@ fn the_spectral_file_meets_pbrt_v4s_reader_and_projects_back_to_the_rgb_file() {
         n_phi: 8,
         n_slice: 12,
     };
-    let dir = temp_dir("pbrt");
+    let dir = temp_dir(name);
     let (spec, rgb) = (dir.join("denim_spec.bsdf"), dir.join("denim_rgb.bsdf"));
     for (p, c) in [(&spec, rgl::Colour::Spectral), (&rgb, rgl::Colour::Rgb)] {
         let fields = rgl::rgl_fields(&brdf, &grid, "clothbake test: denim", c);
         clothbake_export::write_file(p, &rgl::tensor_file(&fields), true).unwrap();
     }
+    (dir, spec, rgb)
+}
+
+#[test]
+#[cfg_attr(
+    missing_numpy,
+    ignore = "needs python3 with numpy: python3 -m pip install numpy, or run `cargo xtask test`"
+)]
+fn the_spectral_file_meets_pbrt_v4s_reader() {
+    NUMPY.require();
+    let (dir, spec, rgb) = export("pbrt-reader");
     let s = check(&["pbrt", spec.to_str().unwrap()]);
     eprintln!("pbrt-v4 reader conditions: {s}");
     assert_eq!(s["ok"], true);
@@ -81,10 +75,19 @@ fn the_spectral_file_meets_pbrt_v4s_reader_and_projects_back_to_the_rgb_file() {
         .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("missing field spectra"));
-    if imports("mitsuba") {
-        let p = check(&["project", spec.to_str().unwrap(), rgb.to_str().unwrap()]);
-        eprintln!("spectra projected back with Mitsuba's CIE tables: {p}");
-        assert!(p["max_error_rel_to_max"].as_f64().unwrap() < 1e-4, "{p}");
-    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+#[cfg_attr(
+    missing_mitsuba,
+    ignore = "needs the mitsuba and numpy Python packages: python3 -m pip install mitsuba numpy, or run `cargo xtask test`"
+)]
+fn the_spectral_file_projects_back_to_the_rgb_file_with_mitsubas_cie_tables() {
+    MITSUBA.require();
+    let (dir, spec, rgb) = export("pbrt-projection");
+    let p = check(&["project", spec.to_str().unwrap(), rgb.to_str().unwrap()]);
+    eprintln!("spectra projected back with Mitsuba's CIE tables: {p}");
+    assert!(p["max_error_rel_to_max"].as_f64().unwrap() < 1e-4, "{p}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,5 +1,7 @@
 //! Project chores: `cargo xtask <task>`.
 //!
+//! * `test [ARGS]`: the whole suite on a fresh machine: a local `.venv` with numpy, pytest,
+//!   OpenEXR and mitsuba, then fmt, clippy and `cargo test --workspace [ARGS]` (see `test.rs`).
 //! * `ch5`: the comparisons of thesis sec. 5.4 (sphere, disk, convergence) into
 //!   `docs/interreflection-results.md`.
 //! * `figures`: the thesis's rendered scenes (Figs 4.5, 5.10, 5.11, 5.17) into `docs/figures/`.
@@ -21,6 +23,7 @@ use clothbake_bake::{bake, BakeOptions};
 mod ch5;
 mod figures;
 mod ir_accuracy;
+mod test;
 
 use clothbake_core::validate::{compare_with, direction_set, Report};
 use clothbake_core::{Caps, Fabric, FacetModel, Variant};
@@ -40,6 +43,7 @@ fn root() -> PathBuf {
 fn main() {
     let task = std::env::args().nth(1).unwrap_or_default();
     match task.as_str() {
+        "test" => test::run_all(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
         "validate" => validate(),
         "ch5" => ch5::run(&root()),
         "figures" => figures::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
@@ -52,7 +56,7 @@ fn main() {
         "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask validate | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
+                "usage: cargo xtask test [CARGO TEST ARGS] | validate | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
             );
             std::process::exit(2);
         }

@@ -4,7 +4,7 @@
 use crate::analytic::{AnalyticModel, Variant};
 use crate::fabric::Fabric;
 use crate::facet::FacetModel;
-use crate::raytrace::{Caps, RayTracer};
+use crate::truth::{Caps, RayTracer};
 use crate::vec3::UnitVec3;
 
 /// A direction pair: toward the light, toward the eye.

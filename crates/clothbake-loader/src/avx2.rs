@@ -412,6 +412,11 @@ mod tests {
     use super::*;
     use crate::table::Grid;
 
+    /// The probes of the build script, to fail with its message when run without AVX2.
+    mod probe {
+        include!("../build/probe.rs");
+    }
+
     /// The documented position in cells (as `nodes::polar_axis`/`azimuth_axis` before
     /// clamping) of an angle in f64 on axis `k` of `n` cells.
     fn position(k: usize, n: u32, angle: f64) -> f64 {
@@ -425,10 +430,13 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(
+        missing_avx2,
+        ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
+    )]
     fn positions_match_f64_angles_over_the_hemisphere() {
-        if !available() {
-            return;
-        }
+        probe::AVX2.require();
+        assert!(available());
         let g = Grid {
             n_theta_i: 32,
             n_phi_i: 64,

@@ -13,8 +13,8 @@ pub mod angles;
 mod atomic;
 #[cfg(target_arch = "x86_64")]
 mod avx2;
-mod bsdf;
 mod binary;
+mod bsdf;
 mod bytes;
 pub mod container;
 mod error;
@@ -26,9 +26,9 @@ pub mod sampling;
 pub mod stored;
 mod table;
 
-pub use clothbake_bsdf::{Bsdf, BsdfSample, UnitVec3};
 pub use atomic::{write_atomic, write_atomic_as};
 pub use binary::{read_binary, write_binary};
+pub use clothbake_bsdf::{Bsdf, BsdfSample, UnitVec3};
 pub use container::{
     read_container, write_container, write_container_chunks, Container, ContainerKind,
     BINARY_MAGIC, CONTAINER_VERSION,

@@ -1,13 +1,22 @@
-//! Both lookup kernels (portable and AVX2 + FMA + F16C, where the processor has them) against
-//! a straightforward f64 quadrilinear interpolation written here from the documented rules
-//! (std `atan2`, the unpadded table, pole nodes as ring means), and against each other; the
-//! batched path against single lookups per kernel; odd inputs never panic.
+//! Both lookup kernels (portable and AVX2 + FMA + F16C) against a straightforward f64
+//! quadrilinear interpolation written here from the documented rules (std `atan2`, the unpadded
+//! table, pole nodes as ring means), and against each other; the batched path against single
+//! lookups per kernel; odd inputs never panic.
+//!
+//! The AVX2 cases are tests of their own, ignored (with the reason) on a processor without
+//! AVX2, FMA and F16C (the build script probes it); under `CI` they run and fail there.
 
 use clothbake_loader::{Brdf, Grid, Memory, Metadata, Options, SimdPath, Table};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 mod common;
 use common::Rng;
+
+/// The probes of the build script (build/probe.rs), to fail with its message when the AVX2
+/// cases run without AVX2 (under `CI`).
+mod probe {
+    include!("../build/probe.rs");
+}
 
 const GRID: Grid = Grid {
     n_theta_i: 5,
@@ -23,26 +32,23 @@ fn table() -> Table {
     Table::new(Metadata::new("kernels", GRID, "{}", "{}", "none"), values).unwrap()
 }
 
-/// Every kernel this processor runs, each on f32 and f16 values.
-fn brdfs(reciprocal: bool) -> Vec<(SimdPath, Memory, Brdf)> {
+/// `kernel` on f32 and f16 values; panics when this processor cannot run it.
+fn brdfs(kernel: SimdPath, reciprocal: bool) -> Vec<(Memory, Brdf)> {
     let mut out = Vec::new();
-    for kernel in [SimdPath::Portable, SimdPath::Avx2] {
-        for memory in [Memory::F32, Memory::AsStored] {
-            let opts = Options {
-                memory,
-                reciprocal,
-                sampling: false,
-            };
-            let stored = clothbake_loader::StoredTable::from_table(
-                table(),
-                clothbake_loader::Precision::F16,
-            )
-            .unwrap();
-            let b = Brdf::from_stored(stored, opts).unwrap();
-            if let Some(b) = b.with_simd_path(kernel) {
-                out.push((kernel, memory, b));
-            }
-        }
+    for memory in [Memory::F32, Memory::AsStored] {
+        let opts = Options {
+            memory,
+            reciprocal,
+            sampling: false,
+        };
+        let stored =
+            clothbake_loader::StoredTable::from_table(table(), clothbake_loader::Precision::F16)
+                .unwrap();
+        let b = Brdf::from_stored(stored, opts).unwrap();
+        let b = b.with_simd_path(kernel).unwrap_or_else(|| {
+            panic!("the {kernel:?} kernel cannot run on this processor (AVX2, FMA and F16C needed)")
+        });
+        out.push((memory, b));
     }
     out
 }
@@ -133,8 +139,7 @@ fn direction(rng: &mut Rng) -> [f32; 3] {
     ]
 }
 
-#[test]
-fn every_kernel_matches_an_f64_quadrilinear_reference() {
+fn matches_an_f64_quadrilinear_reference(kernel: SimdPath) {
     let t = table();
     // The table's values rounded to half (the f16 memory reads those).
     let half = Table::new(
@@ -149,7 +154,7 @@ fn every_kernel_matches_an_f64_quadrilinear_reference() {
     let pairs: Vec<_> = (0..4000)
         .map(|_| (direction(&mut rng), direction(&mut rng)))
         .collect();
-    for (kernel, memory, b) in brdfs(false) {
+    for (memory, b) in brdfs(kernel, false) {
         let mut worst = 0f64;
         for &(wi, wo) in &pairs {
             let ((ti, pi), (to, po)) = (angles(wi), angles(wo));
@@ -172,16 +177,16 @@ fn every_kernel_matches_an_f64_quadrilinear_reference() {
     }
 }
 
-#[test]
-fn the_kernels_agree_closely_and_each_batch_equals_its_single_lookups() {
-    let all = brdfs(false);
+/// Each batch equals its single lookups, and the kernel agrees with the portable one.
+fn batches_equal_single_lookups_and_agree_with_portable(kernel: SimdPath) {
     let mut rng = Rng(5);
     let n = 1001; // not a multiple of the batch group
     let wi: Vec<[f32; 3]> = (0..n).map(|_| direction(&mut rng)).collect();
     let mut wo: Vec<[f32; 3]> = (0..n).map(|_| direction(&mut rng)).collect();
     wo[10] = [0.3, 0.2, -0.5]; // below the horizon, inside a batch group
     wo[11] = [f32::NAN, 0.0, 1.0];
-    for (kernel, memory, b) in &all {
+    let portable = brdfs(SimdPath::Portable, false);
+    for ((memory, b), (_, p)) in brdfs(kernel, false).iter().zip(&portable) {
         let mut out = vec![[9f32; 3]; n];
         b.eval_batch(&wi, &wo, &mut out).unwrap();
         for k in 0..n {
@@ -193,12 +198,6 @@ fn the_kernels_agree_closely_and_each_batch_equals_its_single_lookups() {
         }
         assert_eq!(out[10], [0.0; 3]);
         assert_eq!(out[11], [0.0; 3]);
-    }
-    for (kernel, memory, b) in &all {
-        let (_, _, p) = all
-            .iter()
-            .find(|(k, m, _)| *k == SimdPath::Portable && m == memory)
-            .unwrap();
         let mut worst = 0f32;
         for k in 0..n {
             let (x, y) = (b.eval(wi[k], wo[k]), p.eval(wi[k], wo[k]));
@@ -210,31 +209,28 @@ fn the_kernels_agree_closely_and_each_batch_equals_its_single_lookups() {
     }
 }
 
-#[test]
-fn reciprocal_lookups_agree_across_kernels() {
-    let all = brdfs(true);
+/// Reciprocal lookups are symmetric and agree with the portable kernel's.
+fn reciprocal_lookups_agree_with_portable(kernel: SimdPath) {
+    let all = brdfs(kernel, true);
+    let portable = brdfs(SimdPath::Portable, true);
     let mut rng = Rng(8);
     for _ in 0..500 {
         let (wi, wo) = (direction(&mut rng), direction(&mut rng));
-        for (kernel, memory, b) in &all {
-            let portable = all
-                .iter()
-                .find(|(k, m, _)| *k == SimdPath::Portable && m == memory);
-            let want = portable.unwrap().2.eval(wi, wo);
+        for ((memory, b), (_, p)) in all.iter().zip(&portable) {
+            let want = p.eval(wi, wo);
             let got = b.eval(wi, wo);
-            assert_eq!(got, b.eval(wo, wi), "{kernel:?}");
+            assert_eq!(got, b.eval(wo, wi), "{kernel:?} {memory:?}");
             for c in 0..3 {
                 assert!(
                     (got[c] - want[c]).abs() <= 1e-5 * want[c].abs(),
-                    "{kernel:?}"
+                    "{kernel:?} {memory:?}"
                 );
             }
         }
     }
 }
 
-#[test]
-fn odd_inputs_give_finite_values_and_nan_gives_zero() {
+fn odd_inputs_give_finite_values_and_nan_gives_zero(kernel: SimdPath) {
     let big = 1e30f32;
     let odd = [
         [0.0, 0.0, 1.0],
@@ -248,7 +244,7 @@ fn odd_inputs_give_finite_values_and_nan_gives_zero() {
         [0.0, 0.0, f32::INFINITY],
         [f32::MIN_POSITIVE, 0.0, f32::MIN_POSITIVE],
     ];
-    for (kernel, memory, b) in brdfs(false) {
+    for (memory, b) in brdfs(kernel, false) {
         for &a in &odd {
             for &c in &odd {
                 let f = b.eval(a, c);
@@ -280,4 +276,64 @@ fn odd_inputs_give_finite_values_and_nan_gives_zero() {
         assert_eq!(b.eval_deg(90.0, 0.0, 10.0, 0.0), [0.0; 3]);
         assert_eq!(b.eval_deg(f32::NAN, 0.0, 10.0, 0.0), [0.0; 3]);
     }
+}
+
+#[test]
+fn portable_kernel_matches_an_f64_quadrilinear_reference() {
+    matches_an_f64_quadrilinear_reference(SimdPath::Portable);
+}
+
+#[test]
+fn portable_batches_equal_single_lookups() {
+    batches_equal_single_lookups_and_agree_with_portable(SimdPath::Portable);
+}
+
+#[test]
+fn portable_reciprocal_lookups_are_symmetric() {
+    reciprocal_lookups_agree_with_portable(SimdPath::Portable);
+}
+
+#[test]
+fn portable_odd_inputs_give_finite_values_and_nan_gives_zero() {
+    odd_inputs_give_finite_values_and_nan_gives_zero(SimdPath::Portable);
+}
+
+#[test]
+#[cfg_attr(
+    missing_avx2,
+    ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
+)]
+fn avx2_kernel_matches_an_f64_quadrilinear_reference() {
+    probe::AVX2.require();
+    matches_an_f64_quadrilinear_reference(SimdPath::Avx2);
+}
+
+#[test]
+#[cfg_attr(
+    missing_avx2,
+    ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
+)]
+fn avx2_batches_equal_single_lookups_and_agree_with_the_portable_kernel() {
+    probe::AVX2.require();
+    batches_equal_single_lookups_and_agree_with_portable(SimdPath::Avx2);
+}
+
+#[test]
+#[cfg_attr(
+    missing_avx2,
+    ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
+)]
+fn avx2_reciprocal_lookups_are_symmetric_and_agree_with_the_portable_kernel() {
+    probe::AVX2.require();
+    reciprocal_lookups_agree_with_portable(SimdPath::Avx2);
+}
+
+#[test]
+#[cfg_attr(
+    missing_avx2,
+    ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
+)]
+fn avx2_odd_inputs_give_finite_values_and_nan_gives_zero() {
+    probe::AVX2.require();
+    odd_inputs_give_finite_values_and_nan_gives_zero(SimdPath::Avx2);
 }

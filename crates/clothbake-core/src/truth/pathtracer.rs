@@ -12,9 +12,10 @@
 //! carries the thesis's extra factor pi (N . w) (see [`crate::interreflection`]), and only the
 //! first two orders are meaningful. Russian roulette from order `roulette_from` on.
 
-use crate::facet::Facet;
+use super::estimate::{batch_ratio, BATCHES};
+use super::intersect::Surface;
+use super::raytracer::{Caps, RayTracer};
 use crate::interreflection::{Kernel, Secondary};
-use crate::raytrace::{batch_ratio, Caps, RayTracer, Surface, BATCHES};
 use crate::rng::Rng;
 use crate::vec3::{UnitVec3, Vec3};
 use std::f64::consts::PI;
@@ -128,43 +129,20 @@ impl RayTracer {
         rng: &mut Rng,
         acc: &mut Acc,
     ) {
-        let (px, py) = self.geometry.period;
         let d = -wo.get();
-        let Some(mut hit) = self.trace(o, d, 0.0, o.z / -d.z, false, None) else {
+        let Some(mut at) = self.first_contact(o, d) else {
             return;
         };
-        if self.caps == Caps::Excluded && hit.surface != Surface::Side {
-            return;
-        }
         acc.hits += 1;
-        let mut pos = o + d * hit.t;
         let mut out = wo.get();
         let mut thr = [1.0; 3];
         let mut first: ([f64; 3], f64) = ([0.0; 3], 0.0);
         for k in 1..=k_max {
-            let prim = &self.grid.prims[hit.prim as usize];
-            let local = Vec3::new(
-                pos.x - hit.tile.0 as f64 * px,
-                pos.y - hit.tile.1 as f64 * py,
-                pos.z,
-            );
-            let n = prim.normal(local, hit.surface);
-            let mat = self.materials[prim.seg as usize];
-            let key = prim.copy_key(hit.tile.0, hit.tile.1);
+            let n = at.normal;
+            let mat = self.cylinder(&at).finish;
             // Next-event estimation toward the light.
-            let f = self.facet.intensity(&mat, n, wi.get(), out);
-            if (f.diffuse > 0.0 || f.specular > 0.0)
-                && self
-                    .trace(
-                        pos,
-                        wi.get(),
-                        0.0,
-                        (self.z_top - pos.z) / wi.z,
-                        true,
-                        Some(key),
-                    )
-                    .is_none()
-            {
+            let f = self.terms.shade(&mat, n, wi.get(), out);
+            if (f.diffuse > 0.0 || f.specular > 0.0) && self.lit(&at, wi) {
                 let fd: [f64; 3] = std::array::from_fn(|c| f.diffuse * mat.albedo[c]);
                 for c in 0..3 {
                     acc.orders[k - 1][c] += thr[c] * (fd[c] + f.specular);
@@ -184,7 +162,7 @@ impl RayTracer {
             }
             // Continue the path: uniform over the hemisphere, weight 2 I_F (thesis units).
             let w = uniform_hemisphere(n, rng.next_f64(), rng.next_f64());
-            let g = self.facet.intensity(&mat, n, w, out);
+            let g = self.terms.shade(&mat, n, w, out);
             let mut tw = 2.0;
             if k == 1 && opts.kernel == Kernel::Thesis {
                 tw *= PI * n.dot(w);
@@ -206,20 +184,20 @@ impl RayTracer {
             if thr.iter().all(|&x| x == 0.0) {
                 break;
             }
+            let pos = at.point;
             let t_max = if w.z > 0.0 {
                 (self.z_top - pos.z) / w.z
             } else {
                 pos.z / -w.z
             };
-            let Some(h) = self.trace(pos, w, 0.0, t_max, false, Some(key)) else {
+            let Some(h) = self.trace(pos, w, 0.0, t_max, false, Some(at.key)) else {
                 break;
             };
             if self.caps == Caps::Excluded && h.surface != Surface::Side {
                 break;
             }
-            pos = pos + w * h.t;
+            at = self.contact(pos, w, &h);
             out = -w;
-            hit = h;
         }
     }
 }

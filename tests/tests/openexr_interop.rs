@@ -2,51 +2,20 @@
 //! by the PyPI `OpenEXR` package (tests/python/read_exr.py) and must give the same dimensions,
 //! metadata and every value.
 //!
-//! Skipped with a message when `python3` cannot import OpenEXR and numpy, except when the `CI`
-//! environment variable is set: CI installs them (see .ci/run), so there it must run.
+//! Ignored, with the reason, when `python3` cannot import OpenEXR and numpy (the build script
+//! probes them); under `CI` it runs and fails without them (.ci/run and `cargo xtask test`
+//! install them). It lives here, not in the loader, so that building the loader never runs a
+//! probe of Python.
 
 use std::path::Path;
 use std::process::Command;
 
 use clothbake_loader::{write_exr, Grid, Metadata, Precision, Table};
+use clothbake_tests::fixtures::temp_dir;
+use clothbake_tests::probe::OPENEXR;
 use serde_json::Value;
 
-const SCRIPT: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../tests/python/read_exr.py"
-);
-
-/// True when running under CI (`CI` set to anything but empty, "0" or "false").
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
-}
-
-/// Whether the Python side can run; panics under CI when it cannot.
-fn openexr_available() -> bool {
-    let probe = Command::new("python3")
-        .args(["-c", "import OpenEXR, numpy"])
-        .output();
-    let why = match probe {
-        Ok(out) if out.status.success() => return true,
-        Ok(out) => {
-            let err = String::from_utf8_lossy(&out.stderr);
-            err.trim()
-                .lines()
-                .last()
-                .unwrap_or("import failed")
-                .to_string()
-        }
-        Err(e) => format!("cannot run python3: {e}"),
-    };
-    if in_ci() {
-        panic!(
-            "CI is set, but the OpenEXR Python package is not usable ({why}); \
-             install it with: python3 -m pip install OpenEXR numpy"
-        );
-    }
-    eprintln!("skipped: OpenEXR Python package not installed (pip install OpenEXR numpy): {why}");
-    false
-}
+const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/python/read_exr.py");
 
 fn sample_table() -> Table {
     let grid = Grid {
@@ -86,11 +55,12 @@ fn run_script(path: &Path) -> Value {
 }
 
 fn check(precision: Precision) {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("interop.exr");
+    let dir = temp_dir(&format!("openexr-{precision:?}"));
+    let path = dir.join("interop.exr");
     let table = sample_table();
     write_exr(&path, &table, precision, false).unwrap();
     let got = run_script(&path);
+    std::fs::remove_dir_all(&dir).unwrap();
     let grid = table.meta.grid;
 
     let (width, height) = (15u64, 8u64);
@@ -149,10 +119,12 @@ fn check(precision: Precision) {
 }
 
 #[test]
+#[cfg_attr(
+    missing_openexr,
+    ignore = "needs the OpenEXR and numpy Python packages: python3 -m pip install OpenEXR numpy, or run `cargo xtask test`"
+)]
 fn openexr_reads_what_we_write() {
-    if !openexr_available() {
-        return;
-    }
+    OPENEXR.require();
     check(Precision::F32);
     check(Precision::F16);
 }

@@ -1,0 +1,304 @@
+//! Acceleration over the periodic tiling: [`CellIndex`] (a uniform grid over one period listing
+//! the segment copies, [`Prim`]s, whose bounding boxes overlap each cell) and [`CellWalk`] (the
+//! 2-D DDA that visits, in order, every cell of the unbounded tiling a ray's xy path crosses).
+
+use super::intersect::{LocalRay, SegmentShape, Surface};
+use super::yarns::Yarns;
+use crate::vec3::Vec3;
+use crate::weave::Group;
+
+/// One cell of the walk over the periodic grid: unwrapped cell indices and the ray parameter at
+/// which the ray leaves it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CellVisit {
+    /// Unwrapped cell index along x (cell `ix` covers `[ix cx, (ix + 1) cx)`).
+    pub ix: i64,
+    /// Unwrapped cell index along y.
+    pub iy: i64,
+    /// Ray parameter at which the ray leaves the cell (capped at `t_max`).
+    pub t_exit: f64,
+}
+
+/// The period-copy enumeration: the cells of an unbounded grid of cell size (`cx`, `cy`) that
+/// the xy path `(ox, oy) + t (dx, dy)`, `0 <= t <= t_max`, crosses, in order (a 2-D DDA after
+/// Amanatides & Woo). With cells that divide the period, cell (ix, iy) belongs to period copy
+/// (ix div nx, iy div ny) and is that copy's local cell (ix mod nx, iy mod ny), so every
+/// copy of every segment the path could hit is visited, however long (grazing) the path is.
+#[derive(Clone, Debug)]
+pub struct CellWalk {
+    ix: i64,
+    iy: i64,
+    step_x: i64,
+    step_y: i64,
+    next_x: f64,
+    next_y: f64,
+    delta_x: f64,
+    delta_y: f64,
+    t_max: f64,
+    done: bool,
+}
+
+impl CellWalk {
+    /// Starts the walk at the cell containing (`ox`, `oy`).
+    pub fn new(ox: f64, oy: f64, dx: f64, dy: f64, cx: f64, cy: f64, t_max: f64) -> CellWalk {
+        let ix = (ox / cx).floor() as i64;
+        let iy = (oy / cy).floor() as i64;
+        let axis = |i: i64, o: f64, d: f64, c: f64| -> (i64, f64, f64) {
+            if d > 0.0 {
+                (1, ((i + 1) as f64 * c - o) / d, c / d)
+            } else if d < 0.0 {
+                (-1, (i as f64 * c - o) / d, -c / d)
+            } else {
+                (0, f64::INFINITY, f64::INFINITY)
+            }
+        };
+        let (step_x, next_x, delta_x) = axis(ix, ox, dx, cx);
+        let (step_y, next_y, delta_y) = axis(iy, oy, dy, cy);
+        CellWalk {
+            ix,
+            iy,
+            step_x,
+            step_y,
+            next_x: next_x.max(0.0),
+            next_y: next_y.max(0.0),
+            delta_x,
+            delta_y,
+            t_max,
+            done: false,
+        }
+    }
+}
+
+impl Iterator for CellWalk {
+    type Item = CellVisit;
+
+    fn next(&mut self) -> Option<CellVisit> {
+        if self.done {
+            return None;
+        }
+        let t_exit = self.next_x.min(self.next_y);
+        let visit = CellVisit {
+            ix: self.ix,
+            iy: self.iy,
+            t_exit: t_exit.min(self.t_max),
+        };
+        if t_exit >= self.t_max {
+            self.done = true;
+        } else if self.next_x <= self.next_y {
+            self.ix += self.step_x;
+            self.next_x += self.delta_x;
+        } else {
+            self.iy += self.step_y;
+            self.next_y += self.delta_y;
+        }
+        Some(visit)
+    }
+}
+
+/// One copy of a segment of the period, placed so that it overlaps the period's base cell.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Prim {
+    /// Index of the segment in [`Yarns::cylinders`].
+    pub(crate) seg: u32,
+    /// Warp (axis along y; u = x, v = y) or weft (axis along x; u = y, v = x).
+    warp: bool,
+    /// The solid, in coordinates of the base period.
+    pub(crate) shape: SegmentShape,
+    /// Offset of this copy in periods (x, y); the along-axis part is 0 for endless segments.
+    shift: (i64, i64),
+}
+
+impl Prim {
+    /// The ray `o + t d` (base-period coordinates) in this segment's own frame.
+    pub(crate) fn local(&self, o: Vec3, d: Vec3) -> LocalRay {
+        if self.warp {
+            LocalRay {
+                o: [o.x, o.y, o.z],
+                d: [d.x, d.y, d.z],
+            }
+        } else {
+            LocalRay {
+                o: [o.y, o.x, o.z],
+                d: [d.y, d.x, d.z],
+            }
+        }
+    }
+
+    /// Outward normal at the point `p` (base-period coordinates) of the given surface.
+    pub(crate) fn normal(&self, p: Vec3, surface: Surface) -> Vec3 {
+        let s = &self.shape;
+        let (u, z) = if self.warp { (p.x, p.z) } else { (p.y, p.z) };
+        let (nu, nv, nz) = match surface {
+            Surface::Side => {
+                let (a, b) = (u - s.axis, z - s.height);
+                let l = (a * a + b * b).sqrt();
+                (a / l, 0.0, b / l)
+            }
+            Surface::CapLo => (0.0, -1.0, 0.0),
+            Surface::CapHi => (0.0, 1.0, 0.0),
+        };
+        if self.warp {
+            Vec3::new(nu, nv, nz)
+        } else {
+            Vec3::new(nv, nu, nz)
+        }
+    }
+
+    /// Identity of the physical segment copy when this prim is seen from period copy (tx, ty).
+    pub(crate) fn copy_key(&self, tx: i64, ty: i64) -> (u32, i64, i64) {
+        let endless = self.shape.extent.is_none();
+        let kx = if endless && !self.warp {
+            0
+        } else {
+            tx + self.shift.0
+        };
+        let ky = if endless && self.warp {
+            0
+        } else {
+            ty + self.shift.1
+        };
+        (self.seg, kx, ky)
+    }
+}
+
+/// Uniform grid of cells over one period: for each cell the prims whose bounding boxes overlap
+/// it (the acceleration structure; not the table grid of the baker).
+#[derive(Clone, Debug)]
+pub(crate) struct CellIndex {
+    nx: i64,
+    ny: i64,
+    /// Cell size (x, y).
+    cx: f64,
+    cy: f64,
+    period: (f64, f64),
+    pub(crate) prims: Vec<Prim>,
+    /// `items[starts[c]..starts[c + 1]]` are the prims of cell c = ly * nx + lx.
+    starts: Vec<u32>,
+    items: Vec<u32>,
+}
+
+/// Most cells the index may have.
+const MAX_CELLS: usize = 1 << 20;
+
+impl CellIndex {
+    /// The index of the segments of `g`, cells about the smallest radius wide.
+    pub(crate) fn new(g: &Yarns) -> CellIndex {
+        let (px, py) = g.period;
+        let target = g
+            .cylinders
+            .iter()
+            .map(|s| s.radius)
+            .fold(f64::INFINITY, f64::min);
+        let count = |p: f64| -> i64 {
+            if target.is_finite() {
+                ((p / target).ceil() as i64).clamp(1, 4096)
+            } else {
+                1
+            }
+        };
+        let (mut nx, mut ny) = (count(px), count(py));
+        while (nx * ny) as usize > MAX_CELLS {
+            nx = (nx / 2).max(1);
+            ny = (ny / 2).max(1);
+        }
+        let (cx, cy) = (px / nx as f64, py / ny as f64);
+        let eps = 1e-9 * (px + py);
+        let mut prims = Vec::new();
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); (nx * ny) as usize];
+        for (k, s) in g.cylinders.iter().enumerate() {
+            let warp = s.group == Group::Warp;
+            let (p_across, p_along) = if warp { (px, py) } else { (py, px) };
+            let across = (s.axis - s.radius - eps, s.axis + s.radius + eps);
+            let along = match s.extent {
+                Some((lo, hi)) => (lo - eps, hi + eps),
+                None => (0.0, p_along), // one copy covers the whole period along the axis
+            };
+            let shifts = |(lo, hi): (f64, f64), p: f64, endless: bool| -> Vec<i64> {
+                if endless {
+                    return vec![0];
+                }
+                let first = ((-hi) / p).floor() as i64;
+                let last = ((p - lo) / p).ceil() as i64;
+                (first..=last)
+                    .filter(|&i| lo + i as f64 * p < p && hi + i as f64 * p > 0.0)
+                    .collect()
+            };
+            for sa in shifts(across, p_across, false) {
+                for sl in shifts(along, p_along, s.extent.is_none()) {
+                    let (off_a, off_l) = (sa as f64 * p_across, sl as f64 * p_along);
+                    let (xr, yr, shift) = if warp {
+                        (
+                            (across.0 + off_a, across.1 + off_a),
+                            (along.0 + off_l, along.1 + off_l),
+                            (sa, sl),
+                        )
+                    } else {
+                        (
+                            (along.0 + off_l, along.1 + off_l),
+                            (across.0 + off_a, across.1 + off_a),
+                            (sl, sa),
+                        )
+                    };
+                    let id = prims.len() as u32;
+                    prims.push(Prim {
+                        seg: k as u32,
+                        warp,
+                        shape: SegmentShape {
+                            axis: s.axis + off_a,
+                            height: s.height,
+                            radius: s.radius,
+                            extent: s.extent.map(|(lo, hi)| (lo + off_l, hi + off_l)),
+                        },
+                        shift,
+                    });
+                    let cells = |(lo, hi): (f64, f64), c: f64, n: i64| {
+                        let a = ((lo / c).floor() as i64).clamp(0, n - 1);
+                        let b = ((hi / c).floor() as i64).clamp(0, n - 1);
+                        a..=b
+                    };
+                    for ly in cells(yr, cy, ny) {
+                        for lx in cells(xr, cx, nx) {
+                            lists[(ly * nx + lx) as usize].push(id);
+                        }
+                    }
+                }
+            }
+        }
+        let mut starts = Vec::with_capacity(lists.len() + 1);
+        let mut items = Vec::new();
+        for l in &lists {
+            starts.push(items.len() as u32);
+            items.extend_from_slice(l);
+        }
+        starts.push(items.len() as u32);
+        CellIndex {
+            nx,
+            ny,
+            cx,
+            cy,
+            period: (px, py),
+            prims,
+            starts,
+            items,
+        }
+    }
+
+    /// The walk over the cells that the xy path of `o + t d`, `0 <= t <= t_max`, crosses.
+    pub(crate) fn walk(&self, o: Vec3, d: Vec3, t_max: f64) -> CellWalk {
+        CellWalk::new(o.x, o.y, d.x, d.y, self.cx, self.cy, t_max)
+    }
+
+    /// The period copy (tx, ty) an unwrapped cell belongs to, the ray origin `o` moved into the
+    /// base period by that copy's offset, and the ids of the prims listed in the cell.
+    pub(crate) fn visit(&self, cell: &CellVisit, o: Vec3) -> ((i64, i64), Vec3, &[u32]) {
+        let (tx, ty) = (cell.ix.div_euclid(self.nx), cell.iy.div_euclid(self.ny));
+        let c = (cell.iy.rem_euclid(self.ny) * self.nx + cell.ix.rem_euclid(self.nx)) as usize;
+        let items = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
+        let local = Vec3::new(
+            o.x - tx as f64 * self.period.0,
+            o.y - ty as f64 * self.period.1,
+            o.z,
+        );
+        ((tx, ty), local, items)
+    }
+}

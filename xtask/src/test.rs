@@ -1,0 +1,124 @@
+//! `cargo xtask test [ARGS]`: the whole suite on a fresh machine, nothing skipped that pip can
+//! install. Creates the virtual environment `.venv` in the repository root (once, with
+//! `python3 -m venv`), installs numpy, pytest, OpenEXR and mitsuba into it (the first time takes
+//! minutes), then runs `cargo fmt --all -- --check`, `cargo clippy --workspace --all-targets --
+//! -D warnings` and `cargo test --workspace [ARGS]` with the environment's `bin` first on PATH
+//! and VIRTUAL_ENV set, so that the Python, Mitsuba and OpenEXR tests run. SLURM is not a pip
+//! package: `.ci/run` installs it with apt and then runs this with `CI=true`.
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The Python packages the tests import.
+const PACKAGES: [&str; 4] = ["numpy", "pytest", "OpenEXR", "mitsuba"];
+
+/// Runs `cmd`, printing it first; exits with its status when it fails.
+fn run(what: &str, cmd: &mut Command) {
+    println!("==> {what}");
+    let status = cmd
+        .status()
+        .unwrap_or_else(|e| fail(&format!("{what}: cannot start: {e}")));
+    if !status.success() {
+        fail(&format!("{what} failed ({status})"));
+    }
+}
+
+fn fail(msg: &str) -> ! {
+    eprintln!("cargo xtask test: {msg}");
+    std::process::exit(1);
+}
+
+/// The virtual environment, created when absent; returns its folder.
+fn venv(root: &Path) -> PathBuf {
+    let dir = root.join(".venv");
+    let python = dir.join("bin/python3");
+    if !python.exists() {
+        run(
+            "python3 -m venv .venv (a local Python environment for the tests, once)",
+            Command::new("python3")
+                .current_dir(root)
+                .args(["-m", "venv", ".venv"]),
+        );
+        if !python.exists() {
+            fail(
+                "python3 -m venv did not create .venv/bin/python3; on Debian or Ubuntu install \
+                 python3-venv (apt-get install python3-venv), then rerun",
+            );
+        }
+    }
+    let imports = format!("import {}", PACKAGES.join(", "));
+    let ready = Command::new(&python)
+        .args(["-c", &imports])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if ready {
+        println!("==> .venv has {}", PACKAGES.join(", "));
+    } else {
+        run(
+            &format!(
+                "pip install {} into .venv (quietly; the first time installs about 300 MB, \
+                 up to a few minutes)",
+                PACKAGES.join(" ")
+            ),
+            Command::new(&python)
+                .args([
+                    "-m",
+                    "pip",
+                    "install",
+                    "--quiet",
+                    "--disable-pip-version-check",
+                ])
+                .args(PACKAGES),
+        );
+    }
+    dir
+}
+
+/// PATH with `bin` first.
+fn path_with(bin: &Path) -> OsString {
+    let mut dirs = vec![bin.to_path_buf()];
+    if let Some(p) = std::env::var_os("PATH") {
+        dirs.extend(std::env::split_paths(&p));
+    }
+    std::env::join_paths(dirs).unwrap_or_else(|e| fail(&format!("cannot build PATH: {e}")))
+}
+
+/// The task: see the module documentation. `args` go to `cargo test` after `--workspace`.
+pub fn run_all(root: &Path, args: &[String]) {
+    let venv = venv(root);
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let path = path_with(&venv.join("bin"));
+    let cargo_cmd = |a: &[&str]| {
+        let mut c = Command::new(&cargo);
+        c.current_dir(root)
+            .env("PATH", &path)
+            .env("VIRTUAL_ENV", &venv)
+            .env_remove("PYTHONHOME")
+            .args(a);
+        c
+    };
+    run(
+        "cargo fmt --all -- --check",
+        &mut cargo_cmd(&["fmt", "--all", "--", "--check"]),
+    );
+    run(
+        "cargo clippy --workspace --all-targets -- -D warnings",
+        &mut cargo_cmd(&[
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ]),
+    );
+    let mut test = cargo_cmd(&["test", "--workspace"]);
+    test.args(args);
+    let label: Vec<&str> = ["cargo test --workspace"]
+        .into_iter()
+        .chain(args.iter().map(String::as_str))
+        .collect();
+    run(&label.join(" "), &mut test);
+    println!("==> all passed");
+}
