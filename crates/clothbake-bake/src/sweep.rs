@@ -572,10 +572,7 @@ mod tests {
         assert_eq!(v["secondary"]["method"], "analytic");
         assert_eq!(v["secondary"]["kernel"], "radiometric");
         assert_eq!(v["secondary"]["ranges"], "full");
-        assert_eq!(
-            v["secondary"]["orders"]["theta"],
-            clothbake_core::interreflection::Orders::default().theta
-        );
+        assert_eq!(v["secondary"]["orders"]["theta"], Orders::default().theta);
         let o = BakeOptions {
             bounces: 2,
             secondary: SecondaryOptions {

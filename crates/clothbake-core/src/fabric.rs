@@ -282,7 +282,7 @@ impl Fabric {
         Fabric::from_raw(raw, &cx)
     }
 
-    fn from_raw(raw: FabricFile, cx: &Ctx) -> Result<Fabric, FabricError> {
+    fn from_raw(raw: FabricFile, cx: &Ctx<'_>) -> Result<Fabric, FabricError> {
         let _ = &raw.description;
         if raw.pattern.is_empty() || raw.pattern[0].is_empty() {
             return Err(cx.err(
@@ -623,7 +623,7 @@ impl Naming for JsonNaming<'_> {
 }
 
 /// Parses one group's fields (numbers and shapes); ranges are checked by [`Fabric::new`].
-fn group(cx: &Ctx, name: &str, g: &GroupFile, n: usize) -> Result<YarnGroup, FabricError> {
+fn group(cx: &Ctx<'_>, name: &str, g: &GroupFile, n: usize) -> Result<YarnGroup, FabricError> {
     let radius = cx.per_thread(&format!("{name}.radius"), &g.radius, n)?;
     let height = match &g.height {
         Some(v) => cx.per_thread(&format!("{name}.height"), v, n)?,
@@ -672,7 +672,7 @@ fn group(cx: &Ctx, name: &str, g: &GroupFile, n: usize) -> Result<YarnGroup, Fab
 }
 
 /// Parses a group's material; unset values keep the thesis's defaults.
-fn material(cx: &Ctx, name: &str, m: Option<&MaterialFile>) -> Result<Material, FabricError> {
+fn material(cx: &Ctx<'_>, name: &str, m: Option<&MaterialFile>) -> Result<Material, FabricError> {
     let mut out = Material::default();
     let Some(m) = m else { return Ok(out) };
     if let Some(a) = &m.albedo {

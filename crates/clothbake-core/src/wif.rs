@@ -672,7 +672,7 @@ impl Naming for WifNaming<'_> {
 
 /// The threads of one group: colours and sizes, per thread of the whole draft.
 fn threads(
-    d: &Draft,
+    d: &Draft<'_>,
     g: &str,
     n: usize,
     what: &str,
@@ -769,7 +769,7 @@ fn threads(
 }
 
 /// `[G] Units`, `Spacing`, `Thickness`, in mm.
-fn group_sizes(d: &Draft, g: &str) -> Result<GroupSizes, WifError> {
+fn group_sizes(d: &Draft<'_>, g: &str) -> Result<GroupSizes, WifError> {
     let unit = match d.value(g, "Units") {
         Some(e) => unit_mm(&e.value).ok_or_else(|| {
             d.err(
@@ -795,7 +795,7 @@ fn group_sizes(d: &Draft, g: &str) -> Result<GroupSizes, WifError> {
 }
 
 /// `[COLOR TABLE]` as albedos, scaled by the `[COLOR PALETTE]` range.
-fn colours(d: &Draft) -> Result<Vec<(usize, [f64; 3])>, WifError> {
+fn colours(d: &Draft<'_>) -> Result<Vec<(usize, [f64; 3])>, WifError> {
     let (lo, hi) = match d.value("COLOR PALETTE", "Range") {
         Some(e) => {
             let v: Vec<Option<f64>> = bare(&e.value)
@@ -861,7 +861,7 @@ fn colours(d: &Draft) -> Result<Vec<(usize, [f64; 3])>, WifError> {
 }
 
 /// The clothbake yarn group of one period of threads: radii, centre-to-centre spacings, colours.
-fn group(d: &Draft, g: &str, t: &[Thread]) -> Result<YarnGroup, WifError> {
+fn group(d: &Draft<'_>, g: &str, t: &[Thread]) -> Result<YarnGroup, WifError> {
     let n = t.len();
     let mut threads = Vec::with_capacity(n);
     for i in 0..n {

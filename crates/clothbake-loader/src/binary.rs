@@ -74,7 +74,7 @@ mod legacy {
 
     /// bincode settings of the header: fixed-width little-endian integers, strings as a u64
     /// length and UTF-8 bytes (see `docs/table-format.md`).
-    fn bincode_options() -> impl bincode::Options {
+    fn bincode_options() -> impl Options {
         bincode::DefaultOptions::new()
             .with_fixint_encoding()
             .with_little_endian()

@@ -388,7 +388,7 @@ mod exr_io {
                 .first()
                 .ok_or_else(|| corrupted("the EXR has no layer".to_string()))?;
             let (width, height) = (grid.exr_width() as usize, grid.exr_height() as usize);
-            let mut planes: [Option<Plane>; 3] = Default::default();
+            let mut planes: [Option<Plane<'_>>; 3] = Default::default();
             for channel in &layer.channel_data.list {
                 let k = match channel.name.bytes() {
                     b"R" => 0,
@@ -481,7 +481,7 @@ mod exr_io {
 
     /// The [`ATTR_CRC32`] checksum of a metadata text and three row-major planes, widened to
     /// f32 chunk by chunk (no full f32 copy).
-    fn planes_crc(meta_json: &[u8], planes: &[Plane; 3]) -> u32 {
+    fn planes_crc(meta_json: &[u8], planes: &[Plane<'_>; 3]) -> u32 {
         let mut hasher = crc32fast::Hasher::new();
         hasher.update(meta_json);
         let mut bytes = Vec::with_capacity(CHUNK_VALUES * 12);

@@ -131,7 +131,7 @@ impl SimdPath {
         match self {
             SimdPath::Portable => true,
             #[cfg(target_arch = "x86_64")]
-            SimdPath::Avx2 => crate::avx2::available(),
+            SimdPath::Avx2 => avx2::available(),
             #[cfg(not(target_arch = "x86_64"))]
             SimdPath::Avx2 => false,
         }

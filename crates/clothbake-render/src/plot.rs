@@ -144,7 +144,7 @@ fn err<E: std::fmt::Debug>(e: E) -> String {
 pub fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     plot: &Plot,
-    sources: &[Source],
+    sources: &[Source<'_>],
 ) -> DrawResult<()> {
     register_font();
     root.fill(&WHITE).map_err(err)?;
@@ -158,7 +158,7 @@ fn draw_slices<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     theta_i: &[f64],
     phi_i: &[f64],
-    sources: &[Source],
+    sources: &[Source<'_>],
 ) -> DrawResult<()> {
     let panels = root.split_evenly((1, phi_i.len().max(1)));
     for (panel, &phi) in panels.iter().zip(phi_i) {
@@ -242,7 +242,7 @@ fn draw_hemisphere<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     theta_i: f64,
     phi_i: f64,
-    sources: &[Source],
+    sources: &[Source<'_>],
 ) -> DrawResult<()> {
     let maps: Vec<Vec<f64>> = sources
         .iter()
@@ -359,7 +359,12 @@ fn draw_hemisphere<DB: DrawingBackend>(
 }
 
 /// Draws `plot` into `path` (PNG or SVG, by its extension), atomically.
-pub fn write(path: &Path, plot: &Plot, sources: &[Source], overwrite: bool) -> Result<(), String> {
+pub fn write(
+    path: &Path,
+    plot: &Plot,
+    sources: &[Source<'_>],
+    overwrite: bool,
+) -> Result<(), String> {
     let (w, h) = size(plot, sources.len());
     let ext = path
         .extension()

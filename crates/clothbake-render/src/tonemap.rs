@@ -115,7 +115,7 @@ pub fn write_exr(path: &Path, img: &Image, overwrite: bool) -> Result<(), TableE
             (v[0], v[1], v[2])
         }),
     );
-    let image = exr::image::Image::from_layer(layer);
+    let image = Image::from_layer(layer);
     write_atomic_as(path, "OpenEXR image", overwrite, |f| {
         image
             .write()

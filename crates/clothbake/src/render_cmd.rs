@@ -256,7 +256,7 @@ pub fn run_plot(a: &PlotArgs) -> Result<String, CliError> {
         preflight(o, a.force)?;
     }
     let srcs = sources(&a.brdf, 2)?;
-    let sources: Vec<Source> = srcs
+    let sources: Vec<Source<'_>> = srcs
         .iter()
         .map(|(name, s)| Source {
             name: name.clone(),

@@ -612,7 +612,7 @@ fn export_from_a_table_and_spectral_export() {
     let spec_bytes = std::fs::read(spec).unwrap();
     let has = |b: &[u8], s: &str| b.windows(s.len()).any(|x| x == s.as_bytes());
     let fabric_json = std::fs::read_to_string(table("plain")).unwrap();
-    let fabric: serde_json::Value = serde_json::from_str(&fabric_json).unwrap();
+    let fabric: Value = serde_json::from_str(&fabric_json).unwrap();
     let name = fabric["name"].as_str().unwrap_or("plain");
     for b in [&rgb_bytes, &spec_bytes] {
         assert!(has(b, "looked up") && has(b, "plain.bin") && has(b, name));
