@@ -8,7 +8,7 @@ use crate::container::{
     file_version, read_container, write_container, ContainerKind, LEGACY_TABLE_VERSION,
 };
 use crate::error::TableError;
-use crate::table::{Metadata, Table, FORMAT_VERSION};
+use crate::table::{check_format_version, Metadata, Table};
 
 /// Writes a table in the binary format (a container of kind `table`, see
 /// `docs/table-format.md`), atomically.
@@ -36,16 +36,7 @@ pub fn read_binary(path: &Path) -> Result<Table, TableError> {
     }
     let c = read_container(path, &[ContainerKind::Table])?;
     // The version first, so that newer tables say "update the loader".
-    if let Some(found) = c.header.get("format_version").and_then(|v| v.as_u64()) {
-        if found != u64::from(FORMAT_VERSION) {
-            return Err(TableError::Version {
-                path: path.to_path_buf(),
-                what: "table",
-                found: u32::try_from(found).unwrap_or(u32::MAX),
-                reads: FORMAT_VERSION,
-            });
-        }
-    }
+    check_format_version(path, &c.header)?;
     let meta: Metadata = serde_json::from_value(c.header).map_err(|e| TableError::Corrupted {
         path: path.to_path_buf(),
         reason: format!("the header does not describe a table ({e})"),
@@ -56,13 +47,12 @@ pub fn read_binary(path: &Path) -> Result<Table, TableError> {
 /// Version-1 binary tables: the container's layout before kinds, with the [`Metadata`] in
 /// bincode. Read-only.
 mod legacy {
-    use std::fs::File;
     use std::io::BufReader;
     use std::path::Path;
 
     use bincode::Options;
 
-    use crate::bytes::{hex, read_f32s, read_hashed, read_up_to, Source};
+    use crate::bytes::{hex, open_sized, read_f32s, read_hashed, read_up_to};
     use crate::container::{BINARY_MAGIC, LEGACY_TABLE_VERSION};
     use crate::error::TableError;
     use crate::table::{Metadata, Table, FORMAT_VERSION};
@@ -83,21 +73,8 @@ mod legacy {
     /// Reads a version-1 binary table, checking magic bytes, version, sizes, checksum and
     /// contents.
     pub(super) fn read(path: &Path) -> Result<Table, TableError> {
-        let file = File::open(path).map_err(|e| TableError::io(path, "open the table", e))?;
-        let file_len = file
-            .metadata()
-            .map_err(|e| TableError::io(path, "read the table", e))?
-            .len();
-        let src = Source {
-            path,
-            len: file_len,
-            noun: "table",
-        };
-        if file_len == 0 {
-            return Err(TableError::Empty {
-                path: path.to_path_buf(),
-            });
-        }
+        let (file, src) = open_sized(path, "table")?;
+        let file_len = src.len;
         let mut r = BufReader::with_capacity(1 << 20, file);
         let mut hasher = crc32fast::Hasher::new();
 
@@ -150,31 +127,7 @@ mod legacy {
         let expected_len = n_values
             .checked_mul(4)
             .and_then(|b| b.checked_add(FIXED_LEN + header_len));
-        match expected_len {
-            Some(expected) if expected == file_len => {}
-            Some(expected) if expected > file_len => {
-                return Err(TableError::Truncated {
-                    path: path.to_path_buf(),
-                    detail: format!(
-                        "{n_values} values need a file of {expected} bytes, but it has {file_len}"
-                    ),
-                })
-            }
-            Some(expected) => {
-                return Err(TableError::Corrupted {
-                    path: path.to_path_buf(),
-                    reason: format!(
-                        "{n_values} values need a file of {expected} bytes, but it has {file_len} (unexpected trailing bytes)"
-                    ),
-                })
-            }
-            None => {
-                return Err(TableError::Corrupted {
-                    path: path.to_path_buf(),
-                    reason: format!("impossible value count {n_values}"),
-                })
-            }
-        }
+        src.expect_len(expected_len, &format!("{n_values} values"))?;
 
         // The file size bounds n_values, so this allocation is backed by real bytes.
         let values = read_f32s(&mut r, &mut hasher, n_values as usize, src)?;

@@ -64,6 +64,29 @@ pub(crate) struct Source<'a> {
 }
 
 impl Source<'_> {
+    /// Checks, before anything is allocated, that the file is exactly `expected` bytes long
+    /// (`None`: beyond any file): `needs` says what needs them, e.g. "12 values".
+    pub(crate) fn expect_len(&self, expected: Option<u64>, needs: &str) -> Result<(), TableError> {
+        let (path, len) = (self.path.to_path_buf(), self.len);
+        match expected {
+            Some(e) if e == len => Ok(()),
+            Some(e) if e > len => Err(TableError::Truncated {
+                path,
+                detail: format!("{needs} need a file of {e} bytes, but it has {len}"),
+            }),
+            Some(e) => Err(TableError::Corrupted {
+                path,
+                reason: format!(
+                    "{needs} need a file of {e} bytes, but it has {len} (unexpected trailing bytes)"
+                ),
+            }),
+            None => Err(TableError::Truncated {
+                path,
+                detail: format!("{needs} are far beyond the file's {len} bytes"),
+            }),
+        }
+    }
+
     /// An I/O error while reading this file.
     pub(crate) fn io(&self, e: io::Error) -> TableError {
         TableError::io(self.path, format!("read the {}", self.noun), e)
@@ -83,6 +106,26 @@ impl Source<'_> {
 
 /// Reads exactly `buf.len()` bytes, hashing them; a short read is reported as truncation
 /// inside `what`.
+/// Opens `path` for reading and measures it; an empty file is refused. `noun` names it in
+/// errors ("table", "shard", ...).
+pub(crate) fn open_sized<'a>(
+    path: &'a Path,
+    noun: &'a str,
+) -> Result<(std::fs::File, Source<'a>), TableError> {
+    let file = std::fs::File::open(path)
+        .map_err(|e| TableError::io(path, format!("open the {noun}"), e))?;
+    let len = file
+        .metadata()
+        .map_err(|e| TableError::io(path, format!("read the {noun}"), e))?
+        .len();
+    if len == 0 {
+        return Err(TableError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok((file, Source { path, len, noun }))
+}
+
 pub(crate) fn read_hashed(
     r: &mut impl Read,
     hasher: &mut crc32fast::Hasher,

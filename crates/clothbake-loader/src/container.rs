@@ -15,12 +15,11 @@
 
 use std::borrow::Cow;
 use std::fmt;
-use std::fs::File;
 use std::io::{BufReader, Write};
 use std::path::Path;
 
 use crate::atomic::write_atomic_as;
-use crate::bytes::{hex, read_f32s, read_hashed, read_up_to, CrcWriter, Source};
+use crate::bytes::{hex, open_sized, read_f32s, read_hashed, read_up_to, CrcWriter, Source};
 use crate::error::TableError;
 
 /// The 8 magic bytes that open every binary container file.
@@ -190,17 +189,7 @@ fn sorted_keys(v: &serde_json::Value) -> serde_json::Value {
 /// the cause and the fix.
 pub fn read_container(path: &Path, accepted: &[ContainerKind]) -> Result<Container, TableError> {
     let noun = accepted.first().map_or("file", |k| k.tag());
-    let file = File::open(path).map_err(|e| TableError::io(path, format!("open the {noun}"), e))?;
-    let len = file
-        .metadata()
-        .map_err(|e| TableError::io(path, format!("read the {noun}"), e))?
-        .len();
-    let src = Source { path, len, noun };
-    if len == 0 {
-        return Err(TableError::Empty {
-            path: path.to_path_buf(),
-        });
-    }
+    let (file, src) = open_sized(path, noun)?;
     let mut r = BufReader::with_capacity(1 << 16, file);
     let mut prefix = [0u8; PREFIX_LEN];
     let n = read_up_to(&mut r, &mut prefix).map_err(|e| src.io(e))?;
@@ -248,31 +237,10 @@ pub fn read_container(path: &Path, accepted: &[ContainerKind]) -> Result<Contain
     let expected = count
         .checked_mul(4)
         .and_then(|b| b.checked_add(PREFIX_LEN as u64 + header_len + 4));
-    match expected {
-        Some(e) if e == len => {}
-        Some(e) if e > len => {
-            return Err(TableError::Truncated {
-                path: path.to_path_buf(),
-                detail: format!(
-                    "a {header_len}-byte header and {count} values need a file of {e} bytes, but it has {len}"
-                ),
-            })
-        }
-        Some(e) => {
-            return Err(TableError::Corrupted {
-                path: path.to_path_buf(),
-                reason: format!(
-                    "a {header_len}-byte header and {count} values need a file of {e} bytes, but it has {len} (unexpected trailing bytes)"
-                ),
-            })
-        }
-        None => {
-            return Err(TableError::Truncated {
-                path: path.to_path_buf(),
-                detail: format!("the value count {count} is far beyond the file's {len} bytes"),
-            })
-        }
-    }
+    src.expect_len(
+        expected,
+        &format!("a {header_len}-byte header and {count} values"),
+    )?;
 
     let mut hasher = crc32fast::Hasher::new();
     hasher.update(&prefix);
@@ -333,18 +301,7 @@ pub fn read_container(path: &Path, accepted: &[ContainerKind]) -> Result<Contain
 /// `accepted`, after checking that it is not empty and starts with [`BINARY_MAGIC`].
 pub(crate) fn file_version(path: &Path, accepted: &[ContainerKind]) -> Result<u32, TableError> {
     let noun = accepted.first().map_or("file", |k| k.tag());
-    let mut file =
-        File::open(path).map_err(|e| TableError::io(path, format!("open the {noun}"), e))?;
-    let len = file
-        .metadata()
-        .map_err(|e| TableError::io(path, format!("read the {noun}"), e))?
-        .len();
-    let src = Source { path, len, noun };
-    if len == 0 {
-        return Err(TableError::Empty {
-            path: path.to_path_buf(),
-        });
-    }
+    let (mut file, src) = open_sized(path, noun)?;
     let mut start = [0u8; 12];
     let n = read_up_to(&mut file, &mut start).map_err(|e| src.io(e))?;
     check_start(&start[..n], src, accepted)

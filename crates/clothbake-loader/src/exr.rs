@@ -10,7 +10,7 @@ use crate::atomic::write_atomic_as;
 use crate::bytes::{hex, CHUNK_VALUES};
 use crate::error::TableError;
 use crate::stored::{Samples, StoredTable};
-use crate::table::{Metadata, Precision, Table, FORMAT_VERSION};
+use crate::table::{check_format_version, Metadata, Precision, Table, FORMAT_VERSION};
 
 /// The 4 magic bytes that open every OpenEXR file.
 pub const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
@@ -336,16 +336,7 @@ mod exr_io {
             // Look at the version before the rest, so that newer files say "update the loader".
             let json: serde_json::Value = serde_json::from_str(&meta_json)
                 .map_err(|e| corrupted(format!("{ATTR_METADATA} is not valid JSON ({e})")))?;
-            if let Some(found) = json.get("format_version").and_then(|v| v.as_u64()) {
-                if found != u64::from(FORMAT_VERSION) {
-                    return Err(TableError::Version {
-                        path: path.to_path_buf(),
-                        what: "table",
-                        found: u32::try_from(found).unwrap_or(u32::MAX),
-                        reads: FORMAT_VERSION,
-                    });
-                }
-            }
+            check_format_version(path, &json)?;
             let meta: Metadata = serde_json::from_value(json).map_err(|e| {
                 corrupted(format!("{ATTR_METADATA} does not describe a table ({e})"))
             })?;

@@ -327,3 +327,20 @@ pub enum Precision {
     /// 32-bit floats: exact.
     F32,
 }
+
+/// Refuses a table whose metadata (`meta`, as JSON) names another [`FORMAT_VERSION`]: checked
+/// before the rest, so that a newer table says "update the loader" (both formats).
+pub(crate) fn check_format_version(
+    path: &std::path::Path,
+    meta: &serde_json::Value,
+) -> Result<(), TableError> {
+    match meta.get("format_version").and_then(|v| v.as_u64()) {
+        Some(found) if found != u64::from(FORMAT_VERSION) => Err(TableError::Version {
+            path: path.to_path_buf(),
+            what: "table",
+            found: u32::try_from(found).unwrap_or(u32::MAX),
+            reads: FORMAT_VERSION,
+        }),
+        _ => Ok(()),
+    }
+}
