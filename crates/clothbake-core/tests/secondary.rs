@@ -105,6 +105,23 @@ fn analytic_within_5_percent_of_two_level_sampling() {
     }
 }
 
+/// The path tracer's second order I_2 (red channel) with its standard error: 100 000 paths of
+/// at most two bounces weighted by `kernel`.
+fn path_i2(rt: &RayTracer, wi: UnitVec3, wo: UnitVec3, seed: u64, kernel: Kernel) -> (f64, f64) {
+    let p = rt.render_paths(
+        wi,
+        wo,
+        100_000,
+        seed,
+        PathOptions {
+            max_bounces: 2,
+            kernel,
+            roulette_from: 9,
+        },
+    );
+    (p.orders[1][0], p.std_err[1][0])
+}
+
 #[test]
 fn two_level_sampling_matches_the_path_tracer_second_bounce() {
     let f = pf(10.0);
@@ -120,18 +137,7 @@ fn two_level_sampling_matches_the_path_tracer_second_bounce() {
     for kernel in [Kernel::Thesis, Kernel::Radiometric] {
         for (k, (wi, wo)) in pairs().into_iter().enumerate().take(4) {
             let a = i2(&m, wi, wo, sampling, kernel);
-            let p = rt.render_paths(
-                wi,
-                wo,
-                100_000,
-                17 + k as u64,
-                PathOptions {
-                    max_bounces: 2,
-                    kernel,
-                    roulette_from: 9,
-                },
-            );
-            let (b, e) = (p.orders[1][0], p.std_err[1][0]);
+            let (b, e) = path_i2(&rt, wi, wo, 17 + k as u64, kernel);
             // Within the path tracer's noise (4 sigma) plus the sampling's own discretisation (1%).
             assert!(
                 (a - b).abs() < 4.0 * e + 0.01 * a,
@@ -149,18 +155,7 @@ fn near_normal_directions_match_the_path_tracer() {
     let (wi, wo) = pairs()[4];
     for kernel in [Kernel::Thesis, Kernel::Radiometric] {
         let a = i2(&m, wi, wo, analytic(), kernel);
-        let p = rt.render_paths(
-            wi,
-            wo,
-            100_000,
-            29,
-            PathOptions {
-                max_bounces: 2,
-                kernel,
-                roulette_from: 9,
-            },
-        );
-        let (b, e) = (p.orders[1][0], p.std_err[1][0]);
+        let (b, e) = path_i2(&rt, wi, wo, 29, kernel);
         assert!(
             (a - b).abs() < 4.0 * e + 0.01 * a,
             "{kernel:?}: analytic {a} vs path {b} ± {e}"

@@ -111,17 +111,7 @@ pub(crate) struct Prim {
 impl Prim {
     /// The ray `o + t d` (base-period coordinates) in this segment's own frame.
     pub(crate) fn local(&self, o: Vec3, d: Vec3) -> LocalRay {
-        if self.warp {
-            LocalRay {
-                o: [o.x, o.y, o.z],
-                d: [d.x, d.y, d.z],
-            }
-        } else {
-            LocalRay {
-                o: [o.y, o.x, o.z],
-                d: [d.y, d.x, d.z],
-            }
-        }
+        LocalRay::in_frame(self.warp, o, d)
     }
 
     /// Outward normal at the point `p` (base-period coordinates) of the given surface.

@@ -69,6 +69,24 @@ pub struct LocalRay {
     pub d: [f64; 3],
 }
 
+impl LocalRay {
+    /// The ray `o + t d` (period coordinates) in the frame of a warp segment (`warp`: u = x,
+    /// v = y) or a weft one (u = y, v = x).
+    pub fn in_frame(warp: bool, o: crate::vec3::Vec3, d: crate::vec3::Vec3) -> LocalRay {
+        if warp {
+            LocalRay {
+                o: [o.x, o.y, o.z],
+                d: [d.x, d.y, d.z],
+            }
+        } else {
+            LocalRay {
+                o: [o.y, o.x, o.z],
+                d: [d.y, d.x, d.z],
+            }
+        }
+    }
+}
+
 /// The solid of one segment in its own frame: the cylinder about the axis at u = `axis`, z =
 /// `height`, within `extent` along v (`None`: endless), cut by the floor (z >= 0).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -625,17 +625,7 @@ mod tests {
             for i in -k..=k {
                 for j in -k..=k {
                     let ol = Vec3::new(o.x - i as f64 * px, o.y - j as f64 * py, o.z);
-                    let ray = if s.group == Group::Warp {
-                        LocalRay {
-                            o: [ol.x, ol.y, ol.z],
-                            d: [d.x, d.y, d.z],
-                        }
-                    } else {
-                        LocalRay {
-                            o: [ol.y, ol.x, ol.z],
-                            d: [d.y, d.x, d.z],
-                        }
-                    };
+                    let ray = LocalRay::in_frame(s.group == Group::Warp, ol, d);
                     if let Some((t, _)) = segment_entry(&ray, &shape, 0.0, best.unwrap_or(t_max)) {
                         best = Some(t);
                     }
