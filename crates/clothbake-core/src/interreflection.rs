@@ -35,6 +35,7 @@
 use crate::arc::Arc;
 use crate::facet::{CosineFacet, Facet, FacetModel};
 use crate::lanes::{F64x2, Real};
+use crate::quad::{adapt, gk15_components, Components};
 use crate::trig::{round_nearest, sin_cos};
 use crate::vec3::Vec3;
 use crate::yarn::Material;
@@ -340,35 +341,6 @@ fn illinois(f: &impl Fn(f64) -> f64, a: (f64, f64), b: (f64, f64)) -> f64 {
     b
 }
 
-/// Gauss-Legendre nodes and weights on [-1, 1] (Golub-Welsch by Newton on P_n).
-pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    (0..n)
-        .map(|i| {
-            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 1.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                if n == 1 {
-                    p0 = 1.0;
-                    p1 = x;
-                }
-                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / dp;
-                x -= dx;
-                if dx.abs() < 1e-15 {
-                    break;
-                }
-            }
-            (x, 2.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
-}
-
 /// Integration ranges of the analytic solution.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -510,18 +482,21 @@ fn graded_panels(
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Parts([f64; 4]);
 
-impl Parts {
+impl Components for Parts {
     fn add_scaled(&mut self, o: &Parts, w: f64) {
         for k in 0..4 {
             self.0[k] += w * o.0[k];
         }
     }
+    fn sum(&self) -> f64 {
+        self.0.iter().sum()
+    }
+}
+
+impl Parts {
     fn scaled(mut self, w: f64) -> Parts {
         self.0.iter_mut().for_each(|x| *x *= w);
         self
-    }
-    fn sum(&self) -> f64 {
-        self.0.iter().sum()
     }
     /// The four components with their albedos.
     fn colour(&self, a1: [f64; 3], a2: [f64; 3]) -> Secondary {
@@ -1032,10 +1007,10 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
             .enumerate()
             .map(|(i, w)| {
                 if i == 0 && near_contact {
-                    let (v, e) = gk15(&graded, 0.0, 1.0);
+                    let (v, e) = gk15_components(&graded, 0.0, 1.0);
                     (v, e, 0.0, 1.0)
                 } else {
-                    let (v, e) = gk15(&inner, w[0], w[1]);
+                    let (v, e) = gk15_components(&inner, w[0], w[1]);
                     (v, e, w[0], w[1])
                 }
             })
@@ -1087,49 +1062,6 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
         }
     }
     out.colour(pair.m1.albedo, pair.m2.albedo)
-}
-
-/// One G7/K15 panel: (Kronrod estimate, error estimate on the sum of the parts).
-fn gk15(f: &impl Fn(f64) -> Parts, a: f64, b: f64) -> (Parts, f64) {
-    let mut k = Parts::default();
-    let mut g = Parts::default();
-    let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
-    let fc = f(c);
-    k.add_scaled(&fc, crate::quad::WK[7] * h);
-    g.add_scaled(&fc, crate::quad::WG[3] * h);
-    for i in 0..7 {
-        let x = h * crate::quad::XK[i];
-        let (f1, f2) = (f(c - x), f(c + x));
-        k.add_scaled(&f1, crate::quad::WK[i] * h);
-        k.add_scaled(&f2, crate::quad::WK[i] * h);
-        if i % 2 == 1 {
-            g.add_scaled(&f1, crate::quad::WG[i / 2] * h);
-            g.add_scaled(&f2, crate::quad::WG[i / 2] * h);
-        }
-    }
-    let err = (k.sum() - g.sum()).abs();
-    (k, err)
-}
-
-/// Bisects [a, b] until the G7/K15 error estimate is below `tol` (absolute, shared by halves).
-fn adapt(
-    f: &impl Fn(f64) -> Parts,
-    a: f64,
-    b: f64,
-    v: Parts,
-    err: f64,
-    tol: f64,
-    depth: u32,
-) -> Parts {
-    if err <= tol || depth == 0 {
-        return v;
-    }
-    let m = 0.5 * (a + b);
-    let (l, el) = gk15(f, a, m);
-    let (r, er) = gk15(f, m, b);
-    let mut out = adapt(f, a, m, l, el, 0.5 * tol, depth - 1);
-    out.add_scaled(&adapt(f, m, b, r, er, 0.5 * tol, depth - 1), 1.0);
-    out
 }
 
 /// Parameters of the two-level ray-traced sampling (sec. 5.2).
@@ -1309,15 +1241,6 @@ mod tests {
             vis1: arc(e),
             lit2: arc(l),
             axial: (f64::NEG_INFINITY, f64::INFINITY),
-        }
-    }
-
-    #[test]
-    fn gauss_legendre_integrates_polynomials() {
-        for n in [1, 3, 8, 16] {
-            let r = gauss_legendre(n);
-            let s: f64 = r.iter().map(|(x, w)| w * x.powi(2 * n as i32 - 2)).sum();
-            assert!((s - 2.0 / (2 * n - 1) as f64).abs() < 1e-13, "{n}: {s}");
         }
     }
 
