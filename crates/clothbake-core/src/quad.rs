@@ -1,7 +1,7 @@
 //! Numerical quadrature: adaptive Gauss-Kronrod (G7/K15), accurate where the thesis used
 //! adaptive Simpson, for scalar integrands ([`integrate`]) and for integrands of several
-//! components ([`gk15_components`], [`adapt`]: the secondary reflection's parts), and the
-//! tabulated Gauss-Legendre rules ([`gl_rule`]) of the composite panels.
+//! components (`gk15_components`, `adapt`: the secondary reflection's parts), and the
+//! tabulated Gauss-Legendre rules (`gl_rule`) of the composite panels.
 
 const XK: [f64; 8] = [
     0.991_455_371_120_812_6,
