@@ -62,26 +62,13 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
     if s.vis1.is_empty() || s.lit2.is_empty() {
         return Secondary::default();
     }
-    let e = s.e;
-    // The panels of C1's visible arc between the kinks of the integrand where P_i sees a lit
-    // part of C2 (the support's ends are kinks): only they get nodes, and the maximum reflection
-    // point is searched there.
-    let lit_at = |t: f64| normal(t).dot(e) > 0.0 && !pair.lit_seen_arc(t, s.lit2).0.is_empty();
     let mut kinks = Vec::with_capacity(16);
     theta_kinks(pair, s.lit2, s.vis1, &mut kinks);
-    let mut buf = [0.0f64; 20];
-    let n = cut_points(s.vis1.lo, s.vis1.hi, &kinks, &mut buf);
-    let mut live = [(0.0f64, 0.0f64); 20];
-    let mut n_live = 0;
-    for w in buf[..n].windows(2) {
-        if w[1] > w[0] && lit_at(0.5 * (w[0] + w[1])) {
-            live[n_live] = (w[0], w[1]);
-            n_live += 1;
-        }
-    }
+    let (live, n_live) = live_panels(pair, s, &kinks);
     if n_live == 0 {
         return Secondary::default();
     }
+    let live = &live[..n_live];
     let support = Arc {
         lo: live[0].0,
         hi: live[n_live - 1].1,
@@ -90,104 +77,222 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
         Ranges::Full => peak_in(pair, s, support),
         Ranges::Thesis { .. } => peak(pair, s),
     };
-    // Sharper lobes need more nodes across C2 and along the axis: scale the orders by
-    // sqrt(n / 15) beyond n = 15 (the lobe width goes as 1 / sqrt(n)).
+    let (nt, nb, nu) = scaled_orders(pair, orders);
+    let Some(window) = Window::of(s, ranges, pk) else {
+        return Secondary::default();
+    };
+    if window.theta.is_empty() {
+        return Secondary::default();
+    }
+    let (ylo, yhi) = (s.axial.0.max(-window.l0), s.axial.1.min(window.l0));
+    if ylo >= yhi {
+        return Secondary::default();
+    }
+    let over_c2 = OverC2::new(pair, s, window.beta, pk, (nb, nu), (ylo, yhi));
+    let inner = |t: f64| over_c2.at(t);
+    let out = if orders.tol > 0.0 {
+        adaptive_along_c1(pair, window.theta, &kinks, pk, orders.tol, &inner)
+    } else {
+        panels_along_c1(pair, live, window.theta, pk, nt, &inner)
+    };
+    out.colour(pair.m1.albedo, pair.m2.albedo)
+}
+
+/// The panels of C1's visible arc between the kinks of the integrand where P_i sees a lit
+/// part of C2 (the support's ends are kinks): only they get nodes, and the maximum reflection
+/// point is searched there. Returns the panels and how many.
+fn live_panels(pair: &Pair, s: &Setting, kinks: &[f64]) -> ([(f64, f64); 20], usize) {
+    let lit_at = |t: f64| normal(t).dot(s.e) > 0.0 && !pair.lit_seen_arc(t, s.lit2).0.is_empty();
+    let mut buf = [0.0f64; 20];
+    let n = cut_points(s.vis1.lo, s.vis1.hi, kinks, &mut buf);
+    let mut live = [(0.0f64, 0.0f64); 20];
+    let mut n_live = 0;
+    for w in buf[..n].windows(2) {
+        if w[1] > w[0] && lit_at(0.5 * (w[0] + w[1])) {
+            live[n_live] = (w[0], w[1]);
+            n_live += 1;
+        }
+    }
+    (live, n_live)
+}
+
+/// The orders (theta, beta, axial) for the sharper of the two lobes: sharper lobes need more
+/// nodes across C2 and along the axis, so the orders scale by sqrt(n / 15) beyond n = 15 (the
+/// lobe width goes as 1 / sqrt(n)).
+fn scaled_orders(pair: &Pair, orders: Orders) -> (usize, usize, usize) {
     let boost = (pair.m1.exponent.max(pair.m2.exponent) / 15.0)
         .sqrt()
         .max(1.0);
     let scaled = |o: usize| (o as f64 * boost).ceil() as usize;
-    let (nt, nb, nu) = (
+    (
         scaled(orders.theta),
         scaled(orders.beta),
         scaled(orders.axial),
-    );
-    let (theta_range, beta_window, l0) = match ranges {
-        Ranges::Full => (s.vis1, None, f64::INFINITY),
-        Ranges::Thesis { c_max, l0 } => {
-            let Some((t1, b2)) = pk else {
-                return Secondary::default();
-            };
-            // Stay on one side of the top of each cylinder (fig. 5.7).
-            let side = |a: f64| {
-                if a <= FRAC_PI_2 {
-                    Arc {
-                        lo: -PI,
-                        hi: FRAC_PI_2,
+    )
+}
+
+/// Where the integral runs: the range of theta on C1, the window of beta on C2 (thesis ranges
+/// only) and the axial half-length.
+struct Window {
+    theta: Arc,
+    beta: Option<Arc>,
+    l0: f64,
+}
+
+impl Window {
+    /// The whole visible arc for [`Ranges::Full`]; for [`Ranges::Thesis`], the pseudocode after
+    /// eq. 5.31: c_max around the maximum reflection point and the peak line `pk` (none without
+    /// a peak), on one side of the top of each cylinder (fig. 5.7).
+    fn of(s: &Setting, ranges: Ranges, pk: Option<(f64, f64)>) -> Option<Window> {
+        match ranges {
+            Ranges::Full => Some(Window {
+                theta: s.vis1,
+                beta: None,
+                l0: f64::INFINITY,
+            }),
+            Ranges::Thesis { c_max, l0 } => {
+                let (t1, b2) = pk?;
+                // Stay on one side of the top of each cylinder (fig. 5.7).
+                let side = |a: f64| {
+                    if a <= FRAC_PI_2 {
+                        Arc {
+                            lo: -PI,
+                            hi: FRAC_PI_2,
+                        }
+                    } else {
+                        Arc {
+                            lo: FRAC_PI_2,
+                            hi: 2.0 * PI,
+                        }
                     }
-                } else {
-                    Arc {
-                        lo: FRAC_PI_2,
-                        hi: 2.0 * PI,
-                    }
+                };
+                let (side1, side2) = (side(t1), side(b2));
+                let ta = Arc {
+                    lo: t1 - c_max,
+                    hi: t1 + c_max,
                 }
-            };
-            let (side1, side2) = (side(t1), side(b2));
-            let ta = Arc {
-                lo: t1 - c_max,
-                hi: t1 + c_max,
+                .meet(s.vis1)
+                .meet(side1);
+                let bw = Arc {
+                    lo: b2 - c_max,
+                    hi: b2 + c_max,
+                }
+                .meet(side2);
+                Some(Window {
+                    theta: ta,
+                    beta: Some(bw),
+                    l0,
+                })
             }
-            .meet(s.vis1)
-            .meet(side1);
-            let bw = Arc {
-                lo: b2 - c_max,
-                hi: b2 + c_max,
-            }
-            .meet(side2);
-            (ta, Some(bw), l0)
         }
-    };
-    if theta_range.is_empty() {
-        return Secondary::default();
     }
-    let (ylo, yhi) = (s.axial.0.max(-l0), s.axial.1.min(l0));
-    if ylo >= yhi {
-        return Secondary::default();
+}
+
+/// The inner double integral over C2 (across its arc, then along its generator lines) for one
+/// point of C1, with everything that does not depend on that point.
+struct OverC2<'a> {
+    pair: &'a Pair,
+    s: &'a Setting,
+    /// The thesis ranges' window of beta.
+    beta_window: Option<Arc>,
+    /// The maximum reflection point and the peak line.
+    pk: Option<(f64, f64)>,
+    /// Nodes across C2 and per axial lobe panel.
+    nb: usize,
+    nu: usize,
+    /// The axial extent.
+    ylo: f64,
+    yhi: f64,
+    /// The lobe centres along every line, in u.
+    centres: [Lobe; 2],
+    /// Whether the lines are endless (one shared axial rule).
+    endless: bool,
+    /// The diffuse-diffuse part's cos^2 u or cos^3 u integrated over an endless line.
+    whole: f64,
+    facets: (CosineFacet, CosineFacet),
+    /// The axial rule of endless lines.
+    shared: AxialNodes,
+    /// The rule of a line of finite extent, rebuilt for every line: one buffer for the call
+    /// ([`OverC2::at`] runs one point at a time, so the borrow never overlaps).
+    own_rule: std::cell::RefCell<AxialNodes>,
+}
+
+impl<'a> OverC2<'a> {
+    fn new(
+        pair: &'a Pair,
+        s: &'a Setting,
+        beta_window: Option<Arc>,
+        pk: Option<(f64, f64)>,
+        (nb, nu): (usize, usize),
+        (ylo, yhi): (f64, f64),
+    ) -> OverC2<'a> {
+        // The lobe centres along every line, in u: reflection on a cylinder keeps the axial
+        // component, so the mirror direction of E at P_i has w_y = -E_y, that of L at P_j
+        // w_y = L_y.
+        let centres = [
+            Lobe {
+                centre: (-s.e.y).clamp(-1.0, 1.0).asin(),
+                width: lobe_width(pair.facet, pair.m1.exponent),
+            },
+            Lobe {
+                centre: s.l.y.clamp(-1.0, 1.0).asin(),
+                width: lobe_width(pair.facet, pair.m2.exponent),
+            },
+        ];
+        // Endless lines share one rule; lines of finite extent get their own (per line).
+        let endless = ylo == f64::NEG_INFINITY && yhi == f64::INFINITY;
+        let mut shared = AxialNodes::new();
+        if endless {
+            axial_nodes(-FRAC_PI_2, FRAC_PI_2, centres, nu, true, &mut shared);
+        }
+        let own_rule = std::cell::RefCell::new(AxialNodes::with_capacity(if endless {
+            0
+        } else {
+            4 * nu + 4
+        }));
+        let mut c2 = OverC2 {
+            pair,
+            s,
+            beta_window,
+            pk,
+            nb,
+            nu,
+            ylo,
+            yhi,
+            centres,
+            endless,
+            whole: 0.0,
+            facets: (
+                CosineFacet::new(pair.facet, &pair.m1),
+                CosineFacet::new(pair.facet, &pair.m2),
+            ),
+            shared,
+            own_rule,
+        };
+        c2.whole = c2.cos_power(AxialEnd::of(f64::NEG_INFINITY), AxialEnd::of(f64::INFINITY));
+        c2
     }
-    // The lobe centres along every line, in u: reflection on a cylinder keeps the axial
-    // component, so the mirror direction of E at P_i has w_y = -E_y, that of L at P_j w_y = L_y.
-    let centres = [
-        Lobe {
-            centre: (-s.e.y).clamp(-1.0, 1.0).asin(),
-            width: lobe_width(pair.facet, pair.m1.exponent),
-        },
-        Lobe {
-            centre: s.l.y.clamp(-1.0, 1.0).asin(),
-            width: lobe_width(pair.facet, pair.m2.exponent),
-        },
-    ];
-    // Endless lines share one rule; lines of finite extent get their own (per line).
-    let endless = ylo == f64::NEG_INFINITY && yhi == f64::INFINITY;
-    // The integral of the diffuse-diffuse part's cos^2 u (radiometric) or cos^3 u (thesis).
-    let cos_power = |a: AxialEnd, b: AxialEnd| match pair.kernel {
-        Kernel::Radiometric => int_cos2(a, b),
-        Kernel::Thesis => int_cos3(a, b),
-    };
-    let whole = cos_power(AxialEnd::of(f64::NEG_INFINITY), AxialEnd::of(f64::INFINITY));
-    let facets = (
-        CosineFacet::new(pair.facet, &pair.m1),
-        CosineFacet::new(pair.facet, &pair.m2),
-    );
-    let mut shared = AxialNodes::new();
-    if endless {
-        axial_nodes(-FRAC_PI_2, FRAC_PI_2, centres, nu, true, &mut shared);
+
+    /// The integral of the diffuse-diffuse part's cos^2 u (radiometric) or cos^3 u (thesis).
+    fn cos_power(&self, a: AxialEnd, b: AxialEnd) -> f64 {
+        match self.pair.kernel {
+            Kernel::Radiometric => int_cos2(a, b),
+            Kernel::Thesis => int_cos3(a, b),
+        }
     }
-    // The rule of a line of finite extent, rebuilt for every line: one buffer for the call
-    // (`inner` runs one point at a time, so the borrow never overlaps).
-    let own_rule = std::cell::RefCell::new(AxialNodes::with_capacity(if endless {
-        0
-    } else {
-        4 * nu + 4
-    }));
-    // J(theta) times (N_i . E) r1: the inner double integral over C2 for one point of C1.
-    let inner = |t: f64| -> Parts {
+
+    /// J(theta) times (N_i . E) r1: the inner double integral over C2 for the point of C1 at
+    /// angle `t`.
+    fn at(&self, t: f64) -> Parts {
+        let (pair, s) = (self.pair, self.s);
         let mut acc = Parts::default();
         let ni = normal(t);
-        let ne = ni.dot(e);
+        let ne = ni.dot(s.e);
         if ne <= 0.0 {
             return acc;
         }
         let (mut barc, gamma, dist) = pair.lit_seen_arc(t, s.lit2);
-        if let Some(bw) = beta_window {
+        if let Some(bw) = self.beta_window {
             barc = barc.meet(shift_near(bw, 0.5 * (barc.lo + barc.hi)));
         }
         if barc.is_empty() {
@@ -202,126 +307,160 @@ pub fn analytic(pair: &Pair, s: &Setting, ranges: Ranges, orders: Orders) -> Sec
         // Grade toward the nearest point by its angular distance: the kernel there is a peak
         // of width ~ the gap between P_i and C2.
         let gap = (dist - pair.r2).max(0.0) / pair.r2;
-        let bcuts = [pk.map_or(f64::NAN, |p| near(p.1))];
-        let mut own = own_rule.borrow_mut();
+        let bcuts = [self.pk.map_or(f64::NAN, |p| near(p.1))];
+        let mut own = self.own_rule.borrow_mut();
         graded_panels(
             barc.lo,
             barc.hi,
             nearest,
             gap.clamp(1e-9, 4.0),
             &bcuts,
-            nb,
+            self.nb,
             1,
             |b, wb| {
-                let nj = normal(b);
-                let (dx, dz) = (
-                    pair.d + pair.r2 * nj.x - pi_.x,
-                    pair.h2 + pair.r2 * nj.z - pi_.z,
-                );
-                let d = (dx * dx + dz * dz).sqrt();
-                if d <= 0.0 {
-                    return;
+                if let Some(line) = self.line((ni, ne, pi_), b, &mut own) {
+                    acc.add_scaled(&line, wb);
                 }
-                let wp = Vec3::new(dx / d, 0.0, dz / d);
-                let ln = Line {
-                    a: ni.dot(wp),
-                    c: -nj.dot(wp),
-                    ne,
-                    nl: nj.dot(s.l),
-                    pe: wp.dot(e),
-                    pl: wp.dot(s.l),
-                    d,
-                };
-                if ln.a <= 0.0 || ln.c <= 0.0 || ln.nl <= 0.0 {
-                    return;
-                }
-                let (cos_int, nodes) = if endless {
-                    (whole, &shared)
-                } else {
-                    let (a, b) = (AxialEnd::of(ylo / d), AxialEnd::of(yhi / d));
-                    axial_nodes(a.u, b.u, centres, nu, false, &mut own);
-                    (cos_power(a, b), &*own)
-                };
-                acc.add_scaled(&line_integral(pair, s, &ln, facets, cos_int, nodes), wb);
             },
         );
         acc.scaled(ne * pair.r1 * pair.r2)
-    };
-    let mut out = Parts::default();
-    if orders.tol > 0.0 {
-        // The kinks found over C1's visible arc (cut_points keeps those inside theta_range).
-        let mut tcuts = kinks.clone();
-        tcuts.extend(pk.map(|p| p.0));
-        // Adaptive G7/K15 along C1, split at the maximum reflection point. Where the arc starts
-        // near the point of C1 closest to C2 and the cylinders (nearly) touch, a point there sees
-        // C2 under almost a hemisphere and the integrand grows like a logarithm: the first panel
-        // is integrated in s with theta = lo + (hi - lo) s^2, which removes that.
-        let closest = (pair.h2 - pair.h1).atan2(pair.d);
-        let near_contact = theta_range.lo < closest + 0.5
-            && pair.d - pair.r1 - pair.r2 < 0.5 * pair.r1.min(pair.r2);
-        let mut buf = [0.0f64; 20];
-        let n = cut_points(theta_range.lo, theta_range.hi, &tcuts, &mut buf);
-        let pts = &buf[..n];
-        let (lo0, hi0) = (pts[0], pts[1]);
-        let graded = |x: f64| inner(lo0 + (hi0 - lo0) * x * x).scaled(2.0 * (hi0 - lo0) * x);
-        let first: Vec<(Parts, f64, f64, f64)> = pts
-            .windows(2)
-            .enumerate()
-            .map(|(i, w)| {
-                if i == 0 && near_contact {
-                    let (v, e) = gk15_components(&graded, 0.0, 1.0);
-                    (v, e, 0.0, 1.0)
-                } else {
-                    let (v, e) = gk15_components(&inner, w[0], w[1]);
-                    (v, e, w[0], w[1])
-                }
-            })
-            .collect();
-        let scale: f64 = first.iter().map(|(v, ..)| v.sum()).sum::<f64>().abs();
-        let tol = orders.tol * scale.max(1e-12);
-        for (i, (v, err, a, b)) in first.into_iter().enumerate() {
-            let part = if i == 0 && near_contact {
-                adapt(&graded, a, b, v, err, tol, 6)
-            } else {
-                adapt(&inner, a, b, v, err, tol, 6)
-            };
-            out.add_scaled(&part, 1.0);
+    }
+
+    /// The generator line of C2 at angle `b` seen from P_i (normal `ni`, N_i . E = `ne`,
+    /// position `pi_`): its integral ([`line_integral`]), none where the two do not face each
+    /// other or C2 is not lit there. `own` holds the rule of a line of finite extent.
+    fn line(
+        &self,
+        (ni, ne, pi_): (Vec3, f64, Vec3),
+        b: f64,
+        own: &mut AxialNodes,
+    ) -> Option<Parts> {
+        let (pair, s) = (self.pair, self.s);
+        let nj = normal(b);
+        let (dx, dz) = (
+            pair.d + pair.r2 * nj.x - pi_.x,
+            pair.h2 + pair.r2 * nj.z - pi_.z,
+        );
+        let d = (dx * dx + dz * dz).sqrt();
+        if d <= 0.0 {
+            return None;
         }
-    } else {
-        // The live panels (Full ranges: those found above; thesis ranges: their part inside
-        // theta_range), split at the maximum reflection point; `nt` nodes shared in proportion
-        // to their lengths, each graded toward that point by the in-plane width of the lobes
-        // (the mirror direction turns twice as fast as the normal).
-        let mut panels_t = [(0.0f64, 0.0f64); 21];
-        let mut m_t = 0;
-        for &(a, b) in &live[..n_live] {
-            let (a, b) = (a.max(theta_range.lo), b.min(theta_range.hi));
-            if b <= a {
-                continue;
-            }
-            match pk {
-                Some((t, _)) if t > a + 1e-9 * (b - a) && t < b - 1e-9 * (b - a) => {
-                    panels_t[m_t] = (a, t);
-                    panels_t[m_t + 1] = (t, b);
-                    m_t += 2;
-                }
-                _ => {
-                    panels_t[m_t] = (a, b);
-                    m_t += 1;
-                }
-            }
-        }
-        let live = &panels_t[..m_t];
-        let total: f64 = live.iter().map(|(a, b)| b - a).sum();
-        let n = pair.m1.exponent.max(pair.m2.exponent);
-        let (c, w) = match pk {
-            Some(p) => (p.0, 0.5 * lobe_width(pair.facet, n)),
-            None => (0.0, 1e3),
+        let wp = Vec3::new(dx / d, 0.0, dz / d);
+        let ln = Line {
+            a: ni.dot(wp),
+            c: -nj.dot(wp),
+            ne,
+            nl: nj.dot(s.l),
+            pe: wp.dot(s.e),
+            pl: wp.dot(s.l),
+            d,
         };
-        for &(a, b) in live {
-            let m = share(nt as f64 * (b - a) / total).max(2);
-            graded_panels(a, b, c, w, &[], m, m, |t, wt| out.add_scaled(&inner(t), wt));
+        if ln.a <= 0.0 || ln.c <= 0.0 || ln.nl <= 0.0 {
+            return None;
+        }
+        let (cos_int, nodes) = if self.endless {
+            (self.whole, &self.shared)
+        } else {
+            let (a, b) = (AxialEnd::of(self.ylo / d), AxialEnd::of(self.yhi / d));
+            axial_nodes(a.u, b.u, self.centres, self.nu, false, own);
+            (self.cos_power(a, b), &*own)
+        };
+        Some(line_integral(pair, s, &ln, self.facets, cos_int, nodes))
+    }
+}
+
+/// The outer integral along C1 by adaptive G7/K15 to relative tolerance `tol`, over `range`
+/// split at the `kinks` (those inside it) and the maximum reflection point of `pk`. Where the
+/// arc starts near the point of C1 closest to C2 and the cylinders (nearly) touch, a point there
+/// sees C2 under almost a hemisphere and the integrand grows like a logarithm: the first panel
+/// is integrated in s with theta = lo + (hi - lo) s^2, which removes that.
+fn adaptive_along_c1(
+    pair: &Pair,
+    range: Arc,
+    kinks: &[f64],
+    pk: Option<(f64, f64)>,
+    tol: f64,
+    inner: &impl Fn(f64) -> Parts,
+) -> Parts {
+    let mut out = Parts::default();
+    let mut tcuts = kinks.to_vec();
+    tcuts.extend(pk.map(|p| p.0));
+    let closest = (pair.h2 - pair.h1).atan2(pair.d);
+    let near_contact =
+        range.lo < closest + 0.5 && pair.d - pair.r1 - pair.r2 < 0.5 * pair.r1.min(pair.r2);
+    let mut buf = [0.0f64; 20];
+    let n = cut_points(range.lo, range.hi, &tcuts, &mut buf);
+    let pts = &buf[..n];
+    let (lo0, hi0) = (pts[0], pts[1]);
+    let graded = |x: f64| inner(lo0 + (hi0 - lo0) * x * x).scaled(2.0 * (hi0 - lo0) * x);
+    let first: Vec<(Parts, f64, f64, f64)> = pts
+        .windows(2)
+        .enumerate()
+        .map(|(i, w)| {
+            if i == 0 && near_contact {
+                let (v, e) = gk15_components(&graded, 0.0, 1.0);
+                (v, e, 0.0, 1.0)
+            } else {
+                let (v, e) = gk15_components(inner, w[0], w[1]);
+                (v, e, w[0], w[1])
+            }
+        })
+        .collect();
+    let scale: f64 = first.iter().map(|(v, ..)| v.sum()).sum::<f64>().abs();
+    let tol = tol * scale.max(1e-12);
+    for (i, (v, err, a, b)) in first.into_iter().enumerate() {
+        let part = if i == 0 && near_contact {
+            adapt(&graded, a, b, v, err, tol, 6)
+        } else {
+            adapt(inner, a, b, v, err, tol, 6)
+        };
+        out.add_scaled(&part, 1.0);
+    }
+    out
+}
+
+/// The outer integral along C1 by fixed Gauss-Legendre panels: the `live` panels (their part
+/// inside `range`), split at the maximum reflection point of `pk`; `nt` nodes shared in
+/// proportion to their lengths, each panel graded toward that point by the in-plane width of
+/// the lobes (the mirror direction turns twice as fast as the normal).
+fn panels_along_c1(
+    pair: &Pair,
+    live: &[(f64, f64)],
+    range: Arc,
+    pk: Option<(f64, f64)>,
+    nt: usize,
+    inner: &impl Fn(f64) -> Parts,
+) -> Parts {
+    let mut out = Parts::default();
+    let mut panels_t = [(0.0f64, 0.0f64); 21];
+    let mut m_t = 0;
+    for &(a, b) in live {
+        let (a, b) = (a.max(range.lo), b.min(range.hi));
+        if b <= a {
+            continue;
+        }
+        match pk {
+            Some((t, _)) if t > a + 1e-9 * (b - a) && t < b - 1e-9 * (b - a) => {
+                panels_t[m_t] = (a, t);
+                panels_t[m_t + 1] = (t, b);
+                m_t += 2;
+            }
+            _ => {
+                panels_t[m_t] = (a, b);
+                m_t += 1;
+            }
         }
     }
-    out.colour(pair.m1.albedo, pair.m2.albedo)
+    let live = &panels_t[..m_t];
+    let total: f64 = live.iter().map(|(a, b)| b - a).sum();
+    let n = pair.m1.exponent.max(pair.m2.exponent);
+    let (c, w) = match pk {
+        Some(p) => (p.0, 0.5 * lobe_width(pair.facet, n)),
+        None => (0.0, 1e3),
+    };
+    for &(a, b) in live {
+        let m = share(nt as f64 * (b - a) / total).max(2);
+        graded_panels(a, b, c, w, &[], m, m, |t, wt| out.add_scaled(&inner(t), wt));
+    }
+    out
 }
