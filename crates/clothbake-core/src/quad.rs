@@ -1,7 +1,9 @@
 //! Numerical quadrature: adaptive Gauss-Kronrod (G7/K15), accurate where the thesis used
-//! adaptive Simpson.
+//! adaptive Simpson, for scalar integrands ([`integrate`]) and for integrands of several
+//! components (`gk15_components`, `adapt`: the secondary reflection's parts), and the
+//! tabulated Gauss-Legendre rules (`gl_rule`) of the composite panels.
 
-pub(crate) const XK: [f64; 8] = [
+const XK: [f64; 8] = [
     0.991_455_371_120_812_6,
     0.949_107_912_342_758_5,
     0.864_864_423_359_769_1,
@@ -11,7 +13,7 @@ pub(crate) const XK: [f64; 8] = [
     0.207_784_955_007_898_5,
     0.0,
 ];
-pub(crate) const WK: [f64; 8] = [
+const WK: [f64; 8] = [
     0.022_935_322_010_529_22,
     0.063_092_092_629_978_55,
     0.104_790_010_322_250_2,
@@ -21,7 +23,7 @@ pub(crate) const WK: [f64; 8] = [
     0.204_432_940_075_298_9,
     0.209_482_141_084_727_8,
 ];
-pub(crate) const WG: [f64; 4] = [
+const WG: [f64; 4] = [
     0.129_484_966_168_869_7,
     0.279_705_391_489_276_7,
     0.381_830_050_505_118_9,
@@ -63,12 +65,67 @@ pub fn integrate(f: &mut impl FnMut(f64) -> f64, a: f64, b: f64, tol: f64) -> f6
     rec(f, a, b, tol, 20)
 }
 
+/// A value of several components integrated together (the parts of an integrand): summed
+/// with weights, and its components' sum is what the error estimate of
+/// [`gk15_components`] looks at.
+pub(crate) trait Components: Default {
+    /// `self += w * o`, component by component.
+    fn add_scaled(&mut self, o: &Self, w: f64);
+    /// The sum of the components.
+    fn sum(&self) -> f64;
+}
+
+/// One G7/K15 panel of a vector-valued `f`: (Kronrod estimate, error estimate on the sum of
+/// the components).
+pub(crate) fn gk15_components<T: Components>(f: &impl Fn(f64) -> T, a: f64, b: f64) -> (T, f64) {
+    let mut k = T::default();
+    let mut g = T::default();
+    let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
+    let fc = f(c);
+    k.add_scaled(&fc, WK[7] * h);
+    g.add_scaled(&fc, WG[3] * h);
+    for i in 0..7 {
+        let x = h * XK[i];
+        let (f1, f2) = (f(c - x), f(c + x));
+        k.add_scaled(&f1, WK[i] * h);
+        k.add_scaled(&f2, WK[i] * h);
+        if i % 2 == 1 {
+            g.add_scaled(&f1, WG[i / 2] * h);
+            g.add_scaled(&f2, WG[i / 2] * h);
+        }
+    }
+    let err = (k.sum() - g.sum()).abs();
+    (k, err)
+}
+
+/// Bisects [a, b], whose [`gk15_components`] panel gave `v` and `err`, until the error
+/// estimate is below `tol` (absolute, shared by halves), at most `depth` levels.
+pub(crate) fn adapt<T: Components>(
+    f: &impl Fn(f64) -> T,
+    a: f64,
+    b: f64,
+    v: T,
+    err: f64,
+    tol: f64,
+    depth: u32,
+) -> T {
+    if err <= tol || depth == 0 {
+        return v;
+    }
+    let m = 0.5 * (a + b);
+    let (l, el) = gk15_components(f, a, m);
+    let (r, er) = gk15_components(f, m, b);
+    let mut out = adapt(f, a, m, l, el, 0.5 * tol, depth - 1);
+    out.add_scaled(&adapt(f, m, b, r, er, 0.5 * tol, depth - 1), 1.0);
+    out
+}
+
 /// Largest tabulated Gauss-Legendre rule ([`gl_rule`]).
 pub(crate) const GL_MAX: usize = 16;
 
 /// Gauss-Legendre rules on [-1, 1] of 1 to 16 nodes, (node, weight), as constant data
 /// (generated with numpy.polynomial.legendre.leggauss and checked against
-/// [`crate::interreflection::gauss_legendre`] in the tests): rule `n` starts at `(n - 1) n / 2`.
+/// the Newton rule `gauss_legendre` in the tests): rule `n` starts at `(n - 1) n / 2`.
 const GL_NODES: [(f64, f64); 136] = [
     (0.0, 2.0),
     (-0.5773502691896257, 1.0),
@@ -220,10 +277,48 @@ pub(crate) fn gl_rule(n: usize) -> &'static [(f64, f64)] {
 mod tests {
     use super::*;
 
+    /// Gauss-Legendre nodes and weights on [-1, 1] (Golub-Welsch by Newton on P_n).
+    fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+        (0..n)
+            .map(|i| {
+                let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+                let mut dp = 1.0;
+                for _ in 0..100 {
+                    let (mut p0, mut p1) = (1.0, x);
+                    for k in 2..=n {
+                        let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                        p0 = p1;
+                        p1 = p2;
+                    }
+                    if n == 1 {
+                        p0 = 1.0;
+                        p1 = x;
+                    }
+                    dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                    let dx = p1 / dp;
+                    x -= dx;
+                    if dx.abs() < 1e-15 {
+                        break;
+                    }
+                }
+                (x, 2.0 / ((1.0 - x * x) * dp * dp))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials() {
+        for n in [1, 3, 8, 16] {
+            let r = gauss_legendre(n);
+            let s: f64 = r.iter().map(|(x, w)| w * x.powi(2 * n as i32 - 2)).sum();
+            assert!((s - 2.0 / (2 * n - 1) as f64).abs() < 1e-13, "{n}: {s}");
+        }
+    }
+
     #[test]
     fn tabulated_gauss_legendre_rules_match_newton_on_legendre_polynomials() {
         for n in 1..=GL_MAX {
-            let mut newton = crate::interreflection::gauss_legendre(n);
+            let mut newton = gauss_legendre(n);
             newton.sort_by(|a, b| a.0.total_cmp(&b.0));
             for (a, b) in gl_rule(n).iter().zip(&newton) {
                 assert!(
