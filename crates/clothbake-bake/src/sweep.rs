@@ -191,8 +191,8 @@ pub struct Baked {
 /// The grid's direction for polar index `k` of `n` and azimuth index `m` of `nm`: the centre
 /// of the cell.
 pub fn direction(k: u32, n: u32, m: u32, nm: u32) -> UnitVec3 {
-    let theta = (k as f64 + 0.5) * 90.0 / n as f64;
-    let phi = (m as f64 + 0.5) * 360.0 / nm as f64;
+    let theta = Grid::polar_centre_deg(k, n);
+    let phi = Grid::azimuth_centre_deg(m, nm);
     UnitVec3::from_degrees(theta, phi)
 }
 

@@ -14,6 +14,7 @@
 //! DejaVu Sans font built into the program (no system fonts are needed).
 
 use crate::shade::Shader;
+use clothbake_loader::Grid;
 use clothbake_core::UnitVec3;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -96,8 +97,8 @@ pub fn hemisphere(s: &Shader, theta_i: f64, phi_i: f64) -> Vec<f64> {
 
 fn cell_centre(r: usize, p: usize) -> (f64, f64) {
     (
-        (r as f64 + 0.5) * 90.0 / RINGS as f64,
-        (p as f64 + 0.5) * 360.0 / SECTORS as f64,
+        Grid::polar_centre_deg(r as u32, RINGS as u32),
+        Grid::azimuth_centre_deg(p as u32, SECTORS as u32),
     )
 }
 
