@@ -19,32 +19,23 @@ fn pf(n: f64) -> Fabric {
 }
 
 fn pairs() -> Vec<(UnitVec3, UnitVec3)> {
-    vec![
-        (
-            UnitVec3::from_degrees(30.0, 180.0),
-            UnitVec3::from_degrees(40.0, 0.0),
-        ),
-        (
-            UnitVec3::from_degrees(15.0, 90.0),
-            UnitVec3::from_degrees(45.0, 30.0),
-        ),
-        (
-            UnitVec3::from_degrees(60.0, 200.0),
-            UnitVec3::from_degrees(20.0, 340.0),
-        ),
-        (
-            UnitVec3::from_degrees(45.0, 0.0),
-            UnitVec3::from_degrees(45.0, 0.0),
-        ),
-        (
-            UnitVec3::from_degrees(5.0, 0.0),
-            UnitVec3::from_degrees(5.0, 180.0),
-        ),
-        (
-            UnitVec3::from_degrees(70.0, 150.0),
-            UnitVec3::from_degrees(50.0, 60.0),
-        ),
+    // (theta_i, phi_i, theta_o, phi_o) in degrees.
+    [
+        [30.0, 180.0, 40.0, 0.0],
+        [15.0, 90.0, 45.0, 30.0],
+        [60.0, 200.0, 20.0, 340.0],
+        [45.0, 0.0, 45.0, 0.0],
+        [5.0, 0.0, 5.0, 180.0],
+        [70.0, 150.0, 50.0, 60.0],
     ]
+    .iter()
+    .map(|&[ti, pi, to, po]| {
+        (
+            UnitVec3::from_degrees(ti, pi),
+            UnitVec3::from_degrees(to, po),
+        )
+    })
+    .collect()
 }
 
 fn i2(

@@ -132,17 +132,7 @@ mod legacy {
         // The file size bounds n_values, so this allocation is backed by real bytes.
         let values = read_f32s(&mut r, &mut hasher, n_values as usize, src)?;
 
-        let computed = hasher.finalize();
-        let mut unused = crc32fast::Hasher::new();
-        read_hashed(&mut r, &mut unused, &mut word, src, "checksum")?;
-        let stored = u32::from_le_bytes(word);
-        if stored != computed {
-            return Err(TableError::Checksum {
-                path: path.to_path_buf(),
-                stored,
-                computed,
-            });
-        }
+        src.check_crc(&mut r, hasher.finalize())?;
 
         let meta: Metadata = bincode_options()
             .with_limit(header_len)

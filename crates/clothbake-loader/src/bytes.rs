@@ -87,6 +87,27 @@ impl Source<'_> {
         }
     }
 
+    /// Reads the stored CRC-32 that ends the file and compares it with `computed`.
+    pub(crate) fn check_crc(&self, r: &mut impl Read, computed: u32) -> Result<(), TableError> {
+        let mut word = [0u8; 4];
+        read_hashed(
+            r,
+            &mut crc32fast::Hasher::new(),
+            &mut word,
+            *self,
+            "checksum",
+        )?;
+        let stored = u32::from_le_bytes(word);
+        if stored != computed {
+            return Err(TableError::Checksum {
+                path: self.path.to_path_buf(),
+                stored,
+                computed,
+            });
+        }
+        Ok(())
+    }
+
     /// An I/O error while reading this file.
     pub(crate) fn io(&self, e: io::Error) -> TableError {
         TableError::io(self.path, format!("read the {}", self.noun), e)

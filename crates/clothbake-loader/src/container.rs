@@ -251,23 +251,7 @@ pub fn read_container(path: &Path, accepted: &[ContainerKind]) -> Result<Contain
         reason: format!("{count} values do not fit in this machine's memory"),
     })?;
     let values = read_f32s(&mut r, &mut hasher, count, src)?;
-    let computed = hasher.finalize();
-    let mut word = [0u8; 4];
-    read_hashed(
-        &mut r,
-        &mut crc32fast::Hasher::new(),
-        &mut word,
-        src,
-        "checksum",
-    )?;
-    let stored = u32::from_le_bytes(word);
-    if stored != computed {
-        return Err(TableError::Checksum {
-            path: path.to_path_buf(),
-            stored,
-            computed,
-        });
-    }
+    src.check_crc(&mut r, hasher.finalize())?;
 
     // The checksum holds: the tag is what the writer wrote.
     let Some(kind) = kind else {

@@ -14,8 +14,8 @@
 //! DejaVu Sans font built into the program (no system fonts are needed).
 
 use crate::shade::Shader;
-use clothbake_loader::Grid;
 use clothbake_core::UnitVec3;
+use clothbake_loader::Grid;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
