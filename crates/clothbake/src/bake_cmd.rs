@@ -327,7 +327,7 @@ fn load_checkpoint(
 ) -> Result<BTreeMap<usize, bake::Row>, CliError> {
     let part = read_part(path, merge::orbits_of).map_err(|e| {
         CliError::new(
-            e.to_string(),
+            table_error(&e).to_string(),
             format!("or delete {} to start the bake again", path.display()),
         )
     })?;

@@ -24,7 +24,7 @@ pub fn run(a: &MergeArgs) -> Result<String, CliError> {
     preflight(&a.output, a.force)?;
     let mut parts = Vec::with_capacity(a.shards.len());
     for p in &a.shards {
-        let part = read_part(p, orbits_of).map_err(|e| CliError::line(e.to_string()))?;
+        let part = read_part(p, orbits_of)?;
         parts.push((p.clone(), part));
     }
     let table = merge(&parts).map_err(|e| CliError::line(e.to_string()))?;
