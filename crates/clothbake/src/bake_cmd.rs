@@ -7,14 +7,14 @@
 //! stops and nothing is written (exit 130; a second Ctrl-C exits at once).
 
 use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg, ShardArg};
-use crate::cli::{DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::{table_error, CliError};
 use crate::eval_cmd::load_fabric;
 use clothbake_bake::checkpoint::DEFAULT_INTERVAL;
 use clothbake_bake::job::{self, Hooks, Job, JobError, Target};
 use clothbake_bake::output::Format;
+use clothbake_bake::settings::{Naming, Settings};
 use clothbake_bake::shard::{describe_rows, shard_from_env, ShardId};
-use clothbake_bake::{self as bake, BakeOptions, Method, DEFAULT_GRID};
+use clothbake_bake::BakeOptions;
 use clothbake_core::{Caps, Variant};
 use clothbake_loader::Precision;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -108,27 +108,17 @@ pub fn plan_with_env(
     o: &BakeOpts,
     env: &dyn Fn(&str) -> Option<String>,
 ) -> Result<Plan, CliError> {
-    let raytrace = o.method == MethodArg::Raytrace;
-    if !raytrace && (o.samples.is_some() || o.seed.is_some() || o.caps.is_some()) {
-        return Err(CliError::new(
-            "--samples, --seed and --caps apply only to the ray tracer",
-            "add --method raytrace or drop them",
-        ));
-    }
-    if raytrace && o.variant.is_some() {
-        return Err(CliError::new(
-            "--variant applies only to the analytic model",
-            "drop --variant or use --method analytic",
-        ));
-    }
-    let secondary = o.bounces.options()?;
-    if o.bounces.bounces == 2 && raytrace {
-        return Err(CliError::new(
-            "--bounces 2 needs the analytic model: the ray tracer bakes the direct reflection only",
-            "use --method analytic with --bounces 2 (--secondary raytrace selects the thesis's \
-             two-level sampling of the secondary reflection)",
-        ));
-    }
+    let settings = Settings {
+        grid: o.res,
+        facet: o.facet.into(),
+        raytrace: o.method == MethodArg::Raytrace,
+        variant: o.variant.map(Variant::from),
+        samples: o.samples,
+        seed: o.seed,
+        caps: o.caps.map(Caps::from),
+        bounces: o.bounces.settings(),
+    };
+    let options = settings.options(Naming::Cli).map_err(CliError::line)?;
     let shard = match (o.shard, o.shards) {
         (None, None) => None,
         (None, Some(_)) | (Some(ShardArg::Fixed(_)), Some(_)) => {
@@ -177,25 +167,6 @@ pub fn plan_with_env(
         ));
     }
     let threads = thread_count(o.threads);
-    let method = if raytrace {
-        Method::Raytrace {
-            samples: o.samples.unwrap_or(DEFAULT_SAMPLES),
-            seed: o.seed.unwrap_or(DEFAULT_SEED),
-            caps: o.caps.map_or(Caps::Excluded, Caps::from),
-        }
-    } else {
-        Method::Analytic {
-            variant: o.variant.map_or(Variant::Refined, Variant::from),
-        }
-    };
-    let options = BakeOptions {
-        grid: o.res.unwrap_or(DEFAULT_GRID),
-        facet: o.facet.into(),
-        method,
-        bounces: o.bounces.bounces,
-        secondary,
-    };
-    bake::check_options(&options).map_err(|e| CliError::line(e.to_string()))?;
     Ok(Plan {
         weave: weave.to_path_buf(),
         output,
