@@ -135,7 +135,7 @@ pub enum JobError {
         error: TableError,
     },
     /// Cancelled; the rows done so far are saved where a checkpoint is kept.
-    Interrupted(Interrupted),
+    Interrupted(Box<Interrupted>),
 }
 
 impl std::fmt::Display for Interrupted {
@@ -347,13 +347,13 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
                 Ok(n) => (n, None),
                 Err(e) => (0, Some(e)),
             };
-            return Err(JobError::Interrupted(Interrupted {
+            return Err(JobError::Interrupted(Box::new(Interrupted {
                 what: if shard.is_some() { "shard" } else { "table" },
                 saved,
                 rows: rows.len(),
                 checkpoint: ck_path,
                 save_error,
-            }));
+            })));
         }
         Err(e) => return Err(bake_error(e)),
     }
