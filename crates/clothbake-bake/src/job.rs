@@ -262,7 +262,8 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
         Target::Shard { path, id } => (Some(path.as_path()), Some(*id)),
     };
     if let Some(out) = output {
-        preflight(out, job.overwrite)?;
+        let what = if shard.is_some() { "shard" } else { "table" };
+        preflight(out, what, job.overwrite)?;
     }
     let baker = Baker::new(job.fabric, &job.options).map_err(bake_error)?;
     let orbits = baker.orbits();

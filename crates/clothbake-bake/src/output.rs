@@ -6,8 +6,9 @@ use std::path::Path;
 
 /// Refuses an output that would fail only after the work: an existing file unless
 /// `overwrite`, a missing folder, a folder that is not one or that may not be written into
-/// (probed by creating and removing a hidden file next to `out`).
-pub fn preflight(out: &Path, overwrite: bool) -> Result<(), TableError> {
+/// (probed by creating and removing a hidden file next to `out`). `what` names the file in
+/// errors (`table`, `shard`, `PNG image`).
+pub fn preflight(out: &Path, what: &str, overwrite: bool) -> Result<(), TableError> {
     if !overwrite && std::fs::symlink_metadata(out).is_ok() {
         return Err(TableError::AlreadyExists {
             path: out.to_path_buf(),
@@ -22,7 +23,7 @@ pub fn preflight(out: &Path, overwrite: bool) -> Result<(), TableError> {
         Ok(_) => {
             return Err(TableError::Unwritable {
                 path: out.to_path_buf(),
-                what: "file".into(),
+                what: what.to_string().into(),
                 reason: format!(
                     "{} is not a folder; give an output path inside a folder",
                     dir.display()
@@ -61,7 +62,7 @@ pub fn preflight(out: &Path, overwrite: bool) -> Result<(), TableError> {
         Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
         Err(e) => Err(TableError::Io {
             path: out.to_path_buf(),
-            action: "create the table".into(),
+            action: format!("create the {what}").into(),
             source: e,
         }),
     }

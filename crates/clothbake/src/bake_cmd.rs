@@ -181,10 +181,11 @@ pub fn plan_with_env(
     })
 }
 
-/// Refuses an output that would fail only after the bake: an existing file without --force, a
-/// missing folder, a folder we may not write into (the library's check, as one line).
-pub fn preflight(out: &Path, force: bool) -> Result<(), CliError> {
-    clothbake_bake::output::preflight(out, force).map_err(|e| table_error(&e))
+/// Refuses an output that would fail only after the work (bake, merge, render, plot, export):
+/// an existing file without --force, a missing folder, a folder we may not write into (the
+/// library's check, as one line); `what` names the file (`table`, `PNG image`).
+pub fn preflight(out: &Path, what: &str, force: bool) -> Result<(), CliError> {
+    clothbake_bake::output::preflight(out, what, force).map_err(|e| table_error(&e))
 }
 
 fn install_ctrlc() {
@@ -198,23 +199,27 @@ fn install_ctrlc() {
     });
 }
 
-fn progress_bar(quiet: bool) -> Option<ProgressBar> {
+/// The bake's progress line: cells evaluated, with their rate.
+const BAKE_BAR: &str = "{elapsed_precise} [{wide_bar}] {percent:>3}% {human_pos}/{human_len} \
+                        cells evaluated, {rate}, ETA {eta}";
+
+/// A progress bar of `total` steps drawn with `template` on stderr, or none with --quiet or
+/// when stderr is not a terminal (shared by bake and render). `{rate}` in the template shows
+/// the steps per second with thousands grouped.
+pub fn progress_bar(total: u64, template: &str, quiet: bool) -> Option<ProgressBar> {
     if quiet || !std::io::stderr().is_terminal() {
         return None;
     }
-    let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
-    let style = ProgressStyle::with_template(
-        "{elapsed_precise} [{wide_bar}] {percent:>3}% {human_pos}/{human_len} cells evaluated, \
-         {rate}, ETA {eta}",
-    )
-    .expect("valid template")
-    .with_key(
-        "rate",
-        |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
-            let _ = write!(w, "{} cells/s", thousands(s.per_sec().round() as u64));
-        },
-    )
-    .progress_chars("=> ");
+    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+    let style = ProgressStyle::with_template(template)
+        .expect("valid template")
+        .with_key(
+            "rate",
+            |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = write!(w, "{} cells/s", thousands(s.per_sec().round() as u64));
+            },
+        )
+        .progress_chars("=> ");
     bar.set_style(style);
     Some(bar)
 }
@@ -275,7 +280,12 @@ fn job_error(e: JobError) -> CliError {
 pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     let plan = plan(weave, o)?;
     let fabric = load_fabric(&plan.weave, &o.draft, &o.material)?;
-    preflight(&plan.output, o.force)?;
+    let what = if plan.shard.is_some() {
+        "shard"
+    } else {
+        "table"
+    };
+    preflight(&plan.output, what, o.force)?;
     if let Some((_, Some(how))) = &plan.shard {
         if !o.quiet {
             eprintln!("clothbake: {how}");
@@ -305,7 +315,7 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     install_ctrlc();
     let start = Instant::now();
     let pool = thread_pool(plan.threads)?;
-    let bar = progress_bar(o.quiet);
+    let bar = progress_bar(0, BAKE_BAR, o.quiet);
     let progress = |done: u64, total: u64| {
         if let Some(b) = &bar {
             b.set_length(total);

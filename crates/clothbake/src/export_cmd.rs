@@ -3,13 +3,13 @@
 //! pbrt-v4 and Mitsuba's spectral variants) and/or a MERL binary, each written atomically.
 //! Formats and conventions: `docs/export.md`.
 
+use crate::bake_cmd::preflight;
 use crate::cli::ExportArgs;
 use crate::error::CliError;
 use crate::eval_cmd::apply_material;
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel};
 use clothbake_export::{self as export, merl, rgl, spectrum, Bsdf};
-use clothbake_loader::TableError;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -123,15 +123,13 @@ fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
     }
 }
 
-/// Refuses to replace an existing output unless --force (before any work is done).
+/// Checks every output before any work is done ([`preflight`]).
 fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
     for out in [&args.rgl, &args.rgl_spectral, &args.merl]
         .into_iter()
         .flatten()
     {
-        if !args.force && std::fs::symlink_metadata(out).is_ok() {
-            return Err(TableError::AlreadyExists { path: out.clone() }.into());
-        }
+        preflight(out, "export", args.force)?;
     }
     Ok(())
 }

@@ -21,7 +21,7 @@ pub fn run(a: &MergeArgs) -> Result<String, CliError> {
             "give a file name with -o TABLE, e.g. -o twill.exr",
         ));
     }
-    preflight(&a.output, a.force)?;
+    preflight(&a.output, "table", a.force)?;
     let mut parts = Vec::with_capacity(a.shards.len());
     for p in &a.shards {
         let part = read_part(p, orbits_of)?;
