@@ -166,7 +166,7 @@ pub fn plan_with_env(
             "give a file name with -o PATH, e.g. -o twill.exr",
         ));
     }
-    let threads = thread_count(o.threads);
+    let threads = thread_count(o.run.threads);
     Ok(Plan {
         weave: weave.to_path_buf(),
         output,
@@ -285,9 +285,9 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     } else {
         "table"
     };
-    preflight(&plan.output, what, o.force)?;
+    preflight(&plan.output, what, o.run.force)?;
     if let Some((_, Some(how))) = &plan.shard {
-        if !o.quiet {
+        if !o.run.quiet {
             eprintln!("clothbake: {how}");
         }
     }
@@ -309,13 +309,13 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
         options: plan.options,
         target,
         resume: o.resume,
-        overwrite: o.force,
+        overwrite: o.run.force,
         checkpoint_every: plan.checkpoint_every,
     };
     install_ctrlc();
     let start = Instant::now();
     let pool = thread_pool(plan.threads)?;
-    let bar = progress_bar(0, BAKE_BAR, o.quiet);
+    let bar = progress_bar(0, BAKE_BAR, o.run.quiet);
     let progress = |done: u64, total: u64| {
         if let Some(b) = &bar {
             b.set_length(total);
@@ -323,7 +323,7 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
         }
     };
     let note = |m: &str| {
-        if !o.quiet {
+        if !o.run.quiet {
             eprintln!("clothbake: {m}");
         }
     };
@@ -340,7 +340,7 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     }
     let done = result.map_err(job_error)?;
     let secs = start.elapsed().as_secs_f64();
-    if o.quiet {
+    if o.run.quiet {
         return Ok(String::new());
     }
     let g = plan.options.grid;

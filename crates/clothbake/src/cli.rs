@@ -100,17 +100,9 @@ pub struct BakeOpts {
     #[arg(long, value_enum)]
     pub precision: Option<PrecisionArg>,
 
-    /// Worker threads [default: all cores]; the table does not depend on it.
-    #[arg(long, value_name = "N", value_parser = parse_threads)]
-    pub threads: Option<usize>,
-
-    /// Print nothing but errors (no progress bar, no summary line).
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
-
-    /// Overwrite an existing output file.
-    #[arg(long)]
-    pub force: bool,
+    /// --threads, --quiet, --force.
+    #[command(flatten)]
+    pub run: RunFlags,
 
     /// Facet reflection model: the thesis's Phong-like terms or Lewis's modified Phong.
     #[arg(long, value_enum, default_value_t = FacetArg::Huo)]
@@ -170,6 +162,35 @@ pub struct BakeOpts {
     pub draft: DraftArgs,
 }
 
+/// The flags of every command that works on all cores and writes files (bake, export,
+/// render): `--threads`, `--quiet`, `--force`.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct RunFlags {
+    /// Worker threads [default: all cores]; the output does not depend on it.
+    #[arg(long, value_name = "N", value_parser = parse_threads)]
+    pub threads: Option<usize>,
+
+    /// Print nothing but errors (no progress bar, no summary line).
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// The flags of a command that writes files on one thread (merge): `--quiet`, `--force`.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct WriteFlags {
+    /// Print nothing but errors (no summary line).
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
+}
+
 /// `--shard` values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShardArg {
@@ -198,13 +219,9 @@ pub struct MergeArgs {
     #[arg(long, value_enum)]
     pub precision: Option<PrecisionArg>,
 
-    /// Overwrite an existing table.
-    #[arg(long)]
-    pub force: bool,
-
-    /// Print nothing but errors.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
+    /// --quiet, --force.
+    #[command(flatten)]
+    pub out: WriteFlags,
 }
 
 /// Parses `--shard K/N` or `auto`.
@@ -300,17 +317,9 @@ pub struct ExportArgs {
     #[command(flatten)]
     pub material: MaterialArgs,
 
-    /// Worker threads [default: all cores]; the files do not depend on it.
-    #[arg(long, value_name = "N", value_parser = parse_threads)]
-    pub threads: Option<usize>,
-
-    /// Overwrite existing output files.
-    #[arg(long)]
-    pub force: bool,
-
-    /// Print nothing but errors.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
+    /// --threads, --quiet, --force.
+    #[command(flatten)]
+    pub run: RunFlags,
 }
 
 /// `--rgl-res NT,NP,NS` (see `clothbake_export::rgl::RglGrid`).
@@ -1019,17 +1028,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "PATH")]
     pub exr: Option<PathBuf>,
 
-    /// Worker threads [default: all cores]; the image does not depend on it.
-    #[arg(long, value_name = "N", value_parser = parse_threads)]
-    pub threads: Option<usize>,
-
-    /// Print nothing but errors.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
-
-    /// Overwrite existing output files.
-    #[arg(long)]
-    pub force: bool,
+    /// --threads, --quiet, --force.
+    #[command(flatten)]
+    pub run: RunFlags,
 }
 
 /// `--exposure` values.

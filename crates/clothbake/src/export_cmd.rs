@@ -129,7 +129,7 @@ fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
         .into_iter()
         .flatten()
     {
-        preflight(out, "export", args.force)?;
+        preflight(out, "export", args.run.force)?;
     }
     Ok(())
 }
@@ -141,7 +141,7 @@ fn write_all(
     source: &str,
     half_turn: bool,
 ) -> Result<String, CliError> {
-    let threads = crate::bake_cmd::thread_count(args.threads);
+    let threads = crate::bake_cmd::thread_count(args.run.threads);
     let pool = crate::bake_cmd::thread_pool(threads)?;
     let mut summary = String::new();
     let g = args.rgl_res.0;
@@ -176,7 +176,7 @@ fn write_all(
         let slices = slices.get_or_insert_with(|| pool.install(|| rgl::rgl_slices(brdf, &g)));
         let fields = rgl::fields_of(slices, &description, colour);
         let bytes = rgl::tensor_file(&fields);
-        export::write_file(out, &bytes, args.force)?;
+        export::write_file(out, &bytes, args.run.force)?;
         let _ = writeln!(
             summary,
             "wrote {}: RGL tensor file ({}), view grid {} x {} (+1), slices {} x {}, {:.1} MB, \
@@ -197,7 +197,7 @@ fn write_all(
     if let Some(out) = &args.merl {
         let start = Instant::now();
         let table = pool.install(|| merl::merl_table(brdf, args.phi_samples, half_turn));
-        export::write_file(out, &merl::merl_bytes(&table), args.force)?;
+        export::write_file(out, &merl::merl_bytes(&table), args.run.force)?;
         let a = table.anisotropy;
         let _ = writeln!(
             summary,
@@ -211,7 +211,11 @@ fn write_all(
             100.0 * a.max
         );
     }
-    Ok(if args.quiet { String::new() } else { summary })
+    Ok(if args.run.quiet {
+        String::new()
+    } else {
+        summary
+    })
 }
 
 fn facet_name(f: FacetModel) -> &'static str {

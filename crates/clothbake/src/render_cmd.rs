@@ -128,9 +128,9 @@ const RENDER_BAR: &str = "{elapsed_precise} [{wide_bar}] {percent:>3}% {pos}/{le
 pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
     let mut srcs = sources(&a.brdf, 1)?;
     let (_, shader) = srcs.pop().expect("one source");
-    preflight(&a.output, "PNG image", a.force)?;
+    preflight(&a.output, "PNG image", a.run.force)?;
     if let Some(e) = &a.exr {
-        preflight(e, "EXR image", a.force)?;
+        preflight(e, "EXR image", a.run.force)?;
     }
     let scene = Scene::by_name(match a.scene {
         SceneArg::Drape => "drape",
@@ -167,10 +167,10 @@ pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
         irradiance: a.irradiance.unwrap_or(std::f64::consts::PI),
         ambient: a.ambient,
     };
-    let threads = crate::bake_cmd::thread_count(a.threads);
+    let threads = crate::bake_cmd::thread_count(a.run.threads);
     let pool = crate::bake_cmd::thread_pool(threads)?;
     let start = Instant::now();
-    let bar = progress_bar(u64::from(h), RENDER_BAR, a.quiet);
+    let bar = progress_bar(u64::from(h), RENDER_BAR, a.run.quiet);
     let shown = AtomicU64::new(0);
     let progress = |n: u64| {
         if let Some(b) = &bar {
@@ -193,13 +193,13 @@ pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
         TonemapArg::Reinhard => Curve::Reinhard,
     };
     let rgb = tonemap::to_rgb8(&img, exposure, curve);
-    tonemap::write_png_rgb8(&a.output, w, h, &rgb, a.force)?;
+    tonemap::write_png_rgb8(&a.output, w, h, &rgb, a.run.force)?;
     let mut wrote = a.output.display().to_string();
     if let Some(e) = &a.exr {
-        tonemap::write_exr(e, &img, a.force)?;
+        tonemap::write_exr(e, &img, a.run.force)?;
         wrote = format!("{wrote} and {}", e.display());
     }
-    if a.quiet {
+    if a.run.quiet {
         return Ok(String::new());
     }
     Ok(format!(
