@@ -28,7 +28,7 @@ pub fn checkpoint_path(output: &Path) -> PathBuf {
 
 /// Collects finished rows and saves them periodically.
 pub struct Checkpointer {
-    path: PathBuf,
+    path: Option<PathBuf>,
     interval: Duration,
     shard: Option<ShardId>,
     meta: Metadata,
@@ -48,9 +48,22 @@ impl Checkpointer {
         resumed: BTreeMap<usize, Row>,
     ) -> Checkpointer {
         Checkpointer {
-            path,
+            path: Some(path),
             interval,
             shard,
+            meta,
+            done: Mutex::new(resumed),
+            last: Mutex::new(Instant::now()),
+            writing: Mutex::new(()),
+        }
+    }
+
+    /// A checkpointer that only collects the rows (a bake in memory): it writes nothing.
+    pub fn in_memory(meta: Metadata, resumed: BTreeMap<usize, Row>) -> Checkpointer {
+        Checkpointer {
+            path: None,
+            interval: Duration::MAX,
+            shard: None,
             meta,
             done: Mutex::new(resumed),
             last: Mutex::new(Instant::now()),
@@ -83,13 +96,17 @@ impl Checkpointer {
         }
     }
 
-    /// Writes a checkpoint now, if any row is finished; returns the number of rows saved.
+    /// Writes a checkpoint now, if any row is finished; returns the number of rows saved (0
+    /// when in memory).
     pub fn save(&self) -> Result<usize, TableError> {
         let _guard = self.writing.lock().expect("no panic while held");
         self.write()
     }
 
     fn write(&self) -> Result<usize, TableError> {
+        let Some(path) = &self.path else {
+            return Ok(0);
+        };
         let rows = self.done.lock().expect("no panic while held").clone();
         if rows.is_empty() {
             return Ok(0);
@@ -101,7 +118,7 @@ impl Checkpointer {
             meta: self.meta.clone(),
             rows,
         };
-        write_part(&self.path, &part, true)?;
+        write_part(path, &part, true)?;
         Ok(n)
     }
 

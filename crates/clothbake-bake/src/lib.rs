@@ -3,8 +3,10 @@
 //! [`sweep`] evaluates the (theta_i, phi_i, theta_o, phi_o) grid of a fabric in parallel rows
 //! through the model's BSDF and returns the table (its items are re-exported here: [`bake`],
 //! [`BakeOptions`], [`Baker`]); [`shard`], [`merge`] and [`checkpoint`] split a bake into
-//! shards, assemble them and resume an interrupted one (docs/cluster.md); [`output`] writes
-//! tables with reproducible bytes; [`compare`] holds two tables against each other
+//! shards, assemble them and resume an interrupted one (docs/cluster.md); [`job`] runs a whole
+//! bake (checkpoints, resume, shard or table file, cancellation) for the CLI and Python;
+//! [`settings`] checks and resolves the options as users give them; [`output`] checks outputs
+//! and writes tables with reproducible bytes; [`compare`] holds two tables against each other
 //! (`clothbake diff`, the golden tables of [`golden`]); [`albedo`] integrates a table's
 //! directional albedo (`clothbake info`). The file formats live in `clothbake-loader`.
 //! Nothing here parses command lines or draws progress bars: the `clothbake` binary and the
@@ -14,8 +16,10 @@ pub mod albedo;
 pub mod checkpoint;
 pub mod compare;
 pub mod golden;
+pub mod job;
 pub mod merge;
 pub mod output;
+pub mod settings;
 pub mod shard;
 pub mod sweep;
 

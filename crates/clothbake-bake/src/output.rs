@@ -4,6 +4,70 @@
 use clothbake_loader::{write_binary, write_exr, Precision, Table, TableError};
 use std::path::Path;
 
+/// Refuses an output that would fail only after the work: an existing file unless
+/// `overwrite`, a missing folder, a folder that is not one or that may not be written into
+/// (probed by creating and removing a hidden file next to `out`). `what` names the file in
+/// errors (`table`, `shard`, `PNG image`).
+pub fn preflight(out: &Path, what: &str, overwrite: bool) -> Result<(), TableError> {
+    if !overwrite && std::fs::symlink_metadata(out).is_ok() {
+        return Err(TableError::AlreadyExists {
+            path: out.to_path_buf(),
+        });
+    }
+    let dir = match out.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    match std::fs::metadata(dir) {
+        Ok(m) if m.is_dir() => {}
+        Ok(_) => {
+            return Err(TableError::Unwritable {
+                path: out.to_path_buf(),
+                what: what.to_string().into(),
+                reason: format!(
+                    "{} is not a folder; give an output path inside a folder",
+                    dir.display()
+                ),
+            })
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(TableError::NoSuchFolder {
+                dir: dir.to_path_buf(),
+                path: out.to_path_buf(),
+            })
+        }
+        Err(e) => {
+            return Err(TableError::Io {
+                path: dir.to_path_buf(),
+                action: "open the folder".into(),
+                source: e,
+            })
+        }
+    }
+    // Probe: can we create a file there? (The output itself goes through a temporary file too.)
+    let mut name = std::ffi::OsString::from(".");
+    name.push(out.file_name().unwrap_or_default());
+    name.push(format!(".probe-{}", std::process::id()));
+    let probe = dir.join(name);
+    match std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+    {
+        Ok(f) => {
+            drop(f);
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
+        Err(e) => Err(TableError::Io {
+            path: out.to_path_buf(),
+            action: format!("create the {what}").into(),
+            source: e,
+        }),
+    }
+}
+
 /// The table formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {

@@ -3,32 +3,23 @@
 //! A bake's (theta_i, phi_i) rows are independent (see [`crate::sweep::Baker`]). A **shard** is
 //! shard K of N of a [`split`] of the rows, baked by one process (`clothbake bake --shard K/N`),
 //! and `clothbake merge` assembles the shards into the table. A **checkpoint** holds the rows a
-//! bake (or a shard's bake) has finished so far, for `--resume`. Both are a [`Part`] in the same
-//! file format (docs/cluster.md):
+//! bake (or a shard's bake) has finished so far, for `--resume`. Both are a [`Part`], stored
+//! in the loader's binary container (`clothbake_loader::container`, docs/table-format.md) of
+//! kind `shard` or `checkpoint`.
 //!
-//! ```text
-//! magic "CLTHSHRD" (8) | version u32 LE (4) | header length u64 LE (8) | header (JSON, UTF-8)
-//! | values f32 LE | CRC-32 (IEEE) u32 LE of every byte before it
-//! ```
-//!
-//! The header holds the kind (`"shard"` or `"checkpoint"`), the shard index and count (a
-//! checkpoint of a whole-table bake has none), the rows as half-open ranges, the number of f32
-//! values, and the table's full [`Metadata`]. The values are the canonical cells of each row
+//! The JSON header holds the shard index and count (`"shard"`; `null` for a checkpoint of a
+//! whole-table bake), the rows as half-open ranges (`"rows"`) and the table's full
+//! [`Metadata`] (`"metadata"`). The values are the canonical cells of each row
 //! (rows in increasing order, each [`Row`] in cell order, RGB): exactly the f32 values the
 //! single-process bake computes, so a merge is bit-identical to it.
 
 use crate::sweep::{row_cell, Orbits, Row};
-use clothbake_loader::{write_atomic, Grid, Metadata, TableError};
+use clothbake_loader::container::{read_container, write_container_chunks, ContainerKind};
+use clothbake_loader::{Grid, Metadata, TableError};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-
-/// The 8 magic bytes that open a shard or checkpoint file.
-pub const SHARD_MAGIC: [u8; 8] = *b"CLTHSHRD";
-/// Version of the shard file format; readers reject any other.
-pub const SHARD_VERSION: u32 = 1;
 
 /// What a [`Part`] file is.
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,7 +59,7 @@ pub struct Part {
     pub rows: BTreeMap<usize, Row>,
 }
 
-/// Why a shard or checkpoint file cannot be used: names the file, the cause and the fix.
+/// Why shards cannot be merged: names the file, the cause and the fix.
 #[derive(Debug)]
 pub struct PartError {
     /// The file.
@@ -87,20 +78,11 @@ impl std::fmt::Display for PartError {
 
 impl std::error::Error for PartError {}
 
-fn err(path: &Path, problem: impl Into<String>, fix: impl Into<String>) -> PartError {
-    PartError {
-        path: path.to_path_buf(),
-        problem: problem.into(),
-        fix: fix.into(),
-    }
-}
-
+/// The header of a shard or checkpoint container file (its kind is the container's).
 #[derive(Serialize, Deserialize)]
 struct Header {
-    kind: Kind,
     shard: Option<ShardId>,
     rows: Vec<[usize; 2]>,
-    values: u64,
     metadata: Metadata,
 }
 
@@ -266,155 +248,102 @@ fn ranges(rows: impl Iterator<Item = usize>) -> Vec<[usize; 2]> {
     out
 }
 
-/// Writes `part` to `path` atomically (temp file, fsync, rename), refusing an existing file
-/// unless `overwrite`.
+/// Writes `part` to `path` atomically (temp file, fsync, rename) as a container file of kind
+/// `shard` or `checkpoint`, refusing an existing file unless `overwrite`.
 pub fn write_part(path: &Path, part: &Part, overwrite: bool) -> Result<(), TableError> {
-    let values: usize = part.rows.values().map(|r| 3 * r.len()).sum();
     let header = Header {
-        kind: part.kind,
         shard: part.shard,
         rows: ranges(part.rows.keys().copied()),
-        values: values as u64,
         metadata: part.meta.clone(),
     };
-    let header = serde_json::to_vec(&header).expect("the header serialises");
-    write_atomic(path, overwrite, |out| {
-        let mut hasher = crc32fast::Hasher::new();
-        let mut put = |out: &mut dyn Write, bytes: &[u8]| {
-            hasher.update(bytes);
-            out.write_all(bytes)
-        };
-        put(out, &SHARD_MAGIC)?;
-        put(out, &SHARD_VERSION.to_le_bytes())?;
-        put(out, &(header.len() as u64).to_le_bytes())?;
-        put(out, &header)?;
-        let mut bytes = Vec::new();
-        for row in part.rows.values() {
-            bytes.clear();
-            bytes.extend(row.iter().flatten().flat_map(|v| v.to_le_bytes()));
-            put(out, &bytes)?;
-        }
-        let crc = hasher.finalize();
-        out.write_all(&crc.to_le_bytes())
-    })
+    let header = serde_json::to_value(&header).map_err(|e| TableError::Unwritable {
+        path: path.to_path_buf(),
+        what: container_kind(part.kind).tag().into(),
+        reason: format!("the header cannot be written as JSON ({e})"),
+    })?;
+    let chunks = part.rows.values().map(|r| r.as_flattened());
+    write_container_chunks(path, container_kind(part.kind), &header, chunks, overwrite)
 }
 
-/// Reads a shard or checkpoint file, checking the magic bytes, the version, the sizes and the
-/// checksum, and that every row holds the values its grid and symmetry call for.
+fn container_kind(kind: Kind) -> ContainerKind {
+    match kind {
+        Kind::Shard => ContainerKind::Shard,
+        Kind::Checkpoint => ContainerKind::Checkpoint,
+    }
+}
+
+/// Reads a shard or checkpoint file (the container's checks: magic bytes, version, kind, sizes,
+/// checksum), then checks that the rows are increasing ranges within the grid, that every row
+/// holds the values its grid and symmetry call for, and that every value is finite.
 pub fn read_part(
     path: &Path,
     orbits_of: impl Fn(&Metadata) -> Result<Orbits, String>,
-) -> Result<Part, PartError> {
-    let fix_corrupt = "bake it again (the file is damaged or was cut short)";
-    let bytes = std::fs::read(path)
-        .map_err(|e| err(path, format!("cannot read the file: {e}"), "check the path"))?;
-    if bytes.len() < 8 || bytes[..8] != SHARD_MAGIC {
-        return Err(err(
-            path,
-            "not a clothbake shard or checkpoint (the file does not start with \"CLTHSHRD\")",
-            "give the files written by `clothbake bake --shard K/N`",
-        ));
+) -> Result<Part, TableError> {
+    let c = read_container(path, &[ContainerKind::Shard, ContainerKind::Checkpoint])?;
+    let corrupt = |reason: String| TableError::Corrupted {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let kind = match c.kind {
+        ContainerKind::Shard => Kind::Shard,
+        _ => Kind::Checkpoint,
+    };
+    let h: Header = serde_json::from_value(c.header).map_err(|e| {
+        corrupt(format!(
+            "the header does not describe a {} ({e})",
+            c.kind.tag()
+        ))
+    })?;
+    let orbits = orbits_of(&h.metadata).map_err(|m| {
+        corrupt(format!(
+            "{m} (baked by {}; bake it with this clothbake)",
+            h.metadata.tool
+        ))
+    })?;
+    if let Some(s) = h.shard {
+        if s.count == 0 || s.index >= s.count {
+            return Err(corrupt(format!(
+                "shard {s} is not a shard index below the count"
+            )));
+        }
     }
-    if bytes.len() < 24 {
-        return Err(err(
-            path,
-            format!("truncated: {} bytes", bytes.len()),
-            fix_corrupt,
-        ));
-    }
-    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-    if version != SHARD_VERSION {
-        return Err(err(
-            path,
-            format!(
-                "shard format version {version}, but this clothbake reads version {SHARD_VERSION}"
-            ),
-            "bake the shards and merge them with the same clothbake version",
-        ));
-    }
-    let n = bytes.len();
-    let stored = u32::from_le_bytes(bytes[n - 4..].try_into().expect("4 bytes"));
-    if crc32fast::hash(&bytes[..n - 4]) != stored {
-        return Err(err(
-            path,
-            "the checksum does not match the contents",
-            fix_corrupt,
-        ));
-    }
-    let hlen = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
-    let body = &bytes[20..n - 4];
-    if hlen > body.len() as u64 {
-        return Err(err(path, "the header length exceeds the file", fix_corrupt));
-    }
-    let (head, data) = body.split_at(hlen as usize);
-    let h: Header = serde_json::from_slice(head)
-        .map_err(|e| err(path, format!("the header cannot be read: {e}"), fix_corrupt))?;
-    if data.len() as u64 != 4 * h.values {
-        return Err(err(
-            path,
-            format!(
-                "the header announces {} values but the file holds {}",
-                h.values,
-                data.len() / 4
-            ),
-            fix_corrupt,
-        ));
-    }
-    let orbits =
-        orbits_of(&h.metadata).map_err(|m| err(path, m, "bake it again with this clothbake"))?;
     let mut rows = BTreeMap::new();
-    let mut floats = data
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")));
+    let mut values = c.values.chunks_exact(3);
     let mut last: Option<usize> = None;
     for &[a, b] in &h.rows {
         if a >= b || b > orbits.rows() || last.is_some_and(|l| a < l) {
-            return Err(err(
-                path,
-                format!(
-                    "row range {a}..{b} is not in increasing order within the grid's {} rows",
-                    orbits.rows()
-                ),
-                fix_corrupt,
-            ));
+            return Err(corrupt(format!(
+                "row range {a}..{b} is not in increasing order within the grid's {} rows",
+                orbits.rows()
+            )));
         }
         last = Some(b);
         for r in a..b {
             let k = orbits.row_evaluations(r);
             let mut row = Vec::with_capacity(k);
             for _ in 0..k {
-                let mut v = [0f32; 3];
-                for x in &mut v {
-                    *x = floats
-                        .next()
-                        .ok_or_else(|| err(path, "fewer values than its rows need", fix_corrupt))?;
-                    if !x.is_finite() {
-                        return Err(err(
-                            path,
-                            format!("row {r} holds a non-finite value"),
-                            fix_corrupt,
-                        ));
-                    }
+                let v = values.next().ok_or_else(|| {
+                    corrupt(format!(
+                        "{} values, fewer than its rows need",
+                        c.values.len()
+                    ))
+                })?;
+                if !v.iter().all(|x| x.is_finite()) {
+                    return Err(corrupt(format!("row {r} holds a non-finite value")));
                 }
-                row.push(v);
+                row.push([v[0], v[1], v[2]]);
             }
             rows.insert(r, row);
         }
     }
-    if floats.next().is_some() {
-        return Err(err(path, "more values than its rows need", fix_corrupt));
-    }
-    if let Some(s) = h.shard {
-        if s.count == 0 || s.index >= s.count {
-            return Err(err(
-                path,
-                format!("shard {s} is not a shard index below the count"),
-                fix_corrupt,
-            ));
-        }
+    if values.next().is_some() || !values.remainder().is_empty() {
+        return Err(corrupt(format!(
+            "{} values, more than its rows need",
+            c.values.len()
+        )));
     }
     Ok(Part {
-        kind: h.kind,
+        kind,
         shard: h.shard,
         meta: h.metadata,
         rows,

@@ -113,7 +113,7 @@ fn shard_files_round_trip_and_bad_sets_are_refused() {
     let cut = dir.join("cut.shard");
     std::fs::write(&cut, &bytes[..bytes.len() - 9]).unwrap();
     let e = read_part(&cut, orbits_of).unwrap_err().to_string();
-    assert!(e.contains("cut.shard") && e.contains("checksum"), "{e}");
+    assert!(e.contains("cut.shard") && e.contains("truncated"), "{e}");
     // Not a shard at all.
     std::fs::write(dir.join("x.shard"), b"hello").unwrap();
     let e = read_part(&dir.join("x.shard"), orbits_of)

@@ -136,17 +136,6 @@ pub fn write_atomic_as(
     Ok(())
 }
 
-/// [`write_atomic_as`] with `what` = `"table"`: errors say "cannot write the table". Kept for
-/// callers that write tables or have not been switched yet; name what you write with
-/// [`write_atomic_as`].
-pub fn write_atomic(
-    path: &Path,
-    overwrite: bool,
-    write: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
-) -> Result<(), TableError> {
-    write_atomic_as(path, "table", overwrite, write)
-}
-
 /// Makes the rename durable where the platform allows; failures are harmless and ignored.
 fn sync_dir(dir: &Path) {
     #[cfg(unix)]

@@ -4,7 +4,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use clothbake_loader::{
-    read_binary, read_exr, read_table, write_atomic, write_binary, write_exr, Grid, Metadata,
+    read_binary, read_exr, read_table, write_atomic_as, write_binary, write_exr, Grid, Metadata,
     Precision, Table, TableError, BINARY_MAGIC, EXR_MAGIC, FORMAT_VERSION,
 };
 
@@ -450,7 +450,7 @@ fn failed_writes_leave_nothing_behind() {
 
     // A writer that fails half way: neither target nor temporary file remains.
     let path = d.path().join("t.bin");
-    let e = write_atomic(&path, false, |w| {
+    let e = write_atomic_as(&path, "table", false, |w| {
         use std::io::Write;
         w.write_all(&[0u8; 100_000])?;
         Err(std::io::Error::other("disk on fire"))
@@ -461,7 +461,7 @@ fn failed_writes_leave_nothing_behind() {
 
     // The same over an existing file: the old contents survive.
     fs::write(&path, b"old").unwrap();
-    assert!(write_atomic(&path, true, |_| Err(std::io::Error::other("no"))).is_err());
+    assert!(write_atomic_as(&path, "table", true, |_| Err(std::io::Error::other("no"))).is_err());
     assert_eq!(fs::read(&path).unwrap(), b"old");
     assert_eq!(listing(d.path()), ["t.bin"]);
 }
@@ -470,7 +470,7 @@ fn failed_writes_leave_nothing_behind() {
 fn relative_path_in_current_folder() {
     // A bare file name writes into the current folder; only exercise the error path here
     // (tests must not litter the working directory).
-    let e = write_atomic(Path::new(""), true, |_| Ok(())).unwrap_err();
+    let e = write_atomic_as(Path::new(""), "table", true, |_| Ok(())).unwrap_err();
     assert!(message(e).contains("does not name a file"));
     assert_eq!(BINARY_MAGIC, *b"CLTHBAKE");
 }

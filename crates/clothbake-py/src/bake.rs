@@ -1,30 +1,134 @@
-//! `clothbake.bake`: a table baked in memory by the baker library (`clothbake_bake::bake`).
+//! `clothbake.bake`: a bake through the baker library's job (`clothbake_bake::job`), the one
+//! the `clothbake bake` command runs: in memory, or into a table or shard file with
+//! checkpoints and resume.
 
 use crate::fabric::{check_bounces, facet_model, PyFabric};
 use crate::table::{table_err, PyTable};
-use clothbake_bake::{bake as bake_grid, BakeError, BakeOptions};
-use clothbake_loader::{Grid, StoredTable};
+use clothbake_bake::job::{self, Hooks, Job, JobError, Target};
+use clothbake_bake::output::Format;
+use clothbake_bake::settings::{parse_orders, parse_sampling, Bounces, Naming, Settings};
+use clothbake_bake::shard::parse_shard_id;
+use clothbake_core::{Caps, Kernel, Variant};
+use clothbake_loader::{Grid, Precision, StoredTable};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::Mutex;
+use std::time::Duration;
 
-/// Bakes `fabric` into a Table in memory (f32 values), on all cores with the GIL released;
-/// bit-identical whatever the thread count.
+fn bad(option: &str, msg: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(format!("{option}: {msg}"))
+}
+
+/// One of `words` (`name=` must be one of them), or the error naming the option.
+fn choice<T: Copy>(name: &str, value: Option<&str>, words: &[(&str, T)]) -> PyResult<Option<T>> {
+    let Some(v) = value else { return Ok(None) };
+    match words.iter().find(|(w, _)| *w == v) {
+        Some(&(_, t)) => Ok(Some(t)),
+        None => Err(bad(
+            name,
+            format!(
+                "{v:?} is not one of {}; give one of them",
+                words
+                    .iter()
+                    .map(|(w, _)| format!("{w:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )),
+    }
+}
+
+/// The table format of `output` from `format=` and `precision=` (default: from the
+/// extension, `.bin` binary, anything else EXR; EXR precision f16).
+fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) -> PyResult<Format> {
+    let ext = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let binary = match (
+        choice("format", format, &[("exr", false), ("bin", true)])?,
+        ext.as_deref(),
+    ) {
+        (Some(b), Some(e @ ("exr" | "bin"))) if b != (e == "bin") => {
+            return Err(bad(
+                "format",
+                format!(
+                    "{:?} but the output {} ends in .{e}; name the output *.{} or drop format=",
+                    format.unwrap_or_default(),
+                    output.display(),
+                    format.unwrap_or_default()
+                ),
+            ))
+        }
+        (Some(b), _) => b,
+        (None, e) => e == Some("bin"),
+    };
+    let precision = choice(
+        "precision",
+        precision,
+        &[("f16", Precision::F16), ("f32", Precision::F32)],
+    )?;
+    match (binary, precision) {
+        (true, Some(_)) => Err(bad(
+            "precision",
+            "applies only to EXR tables (binary tables always hold f32); drop precision= or write an EXR table",
+        )),
+        (true, None) => Ok(Format::Binary),
+        (false, p) => Ok(Format::Exr(p.unwrap_or(Precision::F16))),
+    }
+}
+
+/// Bakes `fabric` into a table, on all cores with the GIL released; bit-identical whatever the
+/// thread count, shard split or resume.
 ///
 /// res: (n_theta_i, n_phi_i, n_theta_o, n_phi_o) cells, default (32, 64, 32, 64).
 /// bounces: 1, or 2 to add the secondary reflection (thesis ch. 5; minutes at full res).
-/// facet: "huo" (default) or "lewis". progress: print the percentage done to stderr.
+/// facet: "huo" (default) or "lewis". progress: True prints the percentage done to stderr; a
+/// callable is called as progress(done, total) (cells evaluated) and stops the bake by
+/// returning False (the rows done are kept in the checkpoint; KeyboardInterrupt is raised).
+/// output: write the table (or the shard) to this file, atomically (overwrite: replace an
+/// existing file); the bake then keeps a checkpoint `<output>.checkpoint` every
+/// checkpoint_every seconds (default 60). resume: continue from that checkpoint.
+/// shard: "K/N", bake only shard K (0-based) of N into `output` (for `clothbake merge`).
+/// format: "exr" or "bin" (default from the extension); precision: "f16" (default) or "f32".
+/// method: "analytic" (default; variant "refined" or "thesis") or "raytrace" (samples, seed,
+/// caps "excluded" or "shaded"). With bounces=2: secondary "analytic" (orders: "default",
+/// "fast" or "T,B,A") or "raytrace" (sampling: "N,STEP,L0,exact|area"); kernel
+/// "radiometric" (default) or "thesis".
+/// Returns the Table (None for a shard).
 #[pyfunction]
-#[pyo3(signature = (fabric, res=(32, 64, 32, 64), bounces=1, facet="huo", progress=false))]
+#[pyo3(signature = (fabric, res=(32, 64, 32, 64), bounces=1, facet="huo", progress=None, *,
+    output=None, overwrite=false, resume=false, shard=None, format=None, precision=None,
+    method="analytic", variant=None, samples=None, seed=None, caps=None, secondary=None,
+    kernel=None, orders=None, sampling=None, checkpoint_every=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn bake(
     py: Python<'_>,
     fabric: &PyFabric,
     res: (u32, u32, u32, u32),
     bounces: u32,
     facet: &str,
-    progress: bool,
-) -> PyResult<PyTable> {
+    progress: Option<Bound<'_, PyAny>>,
+    output: Option<PathBuf>,
+    overwrite: bool,
+    resume: bool,
+    shard: Option<&str>,
+    format: Option<&str>,
+    precision: Option<&str>,
+    method: &str,
+    variant: Option<&str>,
+    samples: Option<usize>,
+    seed: Option<u64>,
+    caps: Option<&str>,
+    secondary: Option<&str>,
+    kernel: Option<&str>,
+    orders: Option<&str>,
+    sampling: Option<&str>,
+    checkpoint_every: Option<f64>,
+) -> PyResult<Option<PyTable>> {
     check_bounces(bounces)?;
     let grid = Grid {
         n_theta_i: res.0,
@@ -32,35 +136,202 @@ pub fn bake(
         n_theta_o: res.2,
         n_phi_o: res.3,
     };
-    grid.validate()
-        .map_err(|e| PyValueError::new_err(format!("res: {e}")))?;
-    let opts = BakeOptions {
-        grid,
+    grid.validate().map_err(|e| bad("res", e))?;
+    let raytrace = choice(
+        "method",
+        Some(method),
+        &[("analytic", false), ("raytrace", true)],
+    )?
+    .unwrap_or(false);
+    if samples == Some(0) {
+        return Err(bad("samples", "0 rays; give at least 1"));
+    }
+    let settings = Settings {
+        grid: Some(grid),
         facet: facet_model(facet)?,
-        bounces,
-        ..BakeOptions::default()
+        raytrace,
+        variant: choice(
+            "variant",
+            variant,
+            &[("refined", Variant::Refined), ("thesis", Variant::Thesis)],
+        )?,
+        samples,
+        seed,
+        caps: choice(
+            "caps",
+            caps,
+            &[("excluded", Caps::Excluded), ("shaded", Caps::Shaded)],
+        )?,
+        bounces: Bounces {
+            bounces,
+            sampled: choice(
+                "secondary",
+                secondary,
+                &[("analytic", false), ("raytrace", true)],
+            )?,
+            kernel: choice(
+                "kernel",
+                kernel,
+                &[
+                    ("radiometric", Kernel::Radiometric),
+                    ("thesis", Kernel::Thesis),
+                ],
+            )?,
+            orders: orders
+                .map(parse_orders)
+                .transpose()
+                .map_err(|e| bad("orders", e))?,
+            sampling: sampling
+                .map(parse_sampling)
+                .transpose()
+                .map_err(|e| bad("sampling", e))?,
+        },
     };
-    let total = clothbake_bake::evaluations(&fabric.fabric, &grid).max(1) as u64;
-    let shown = AtomicU64::new(0);
-    let report = |done: u64| {
-        if !progress {
-            return;
+    let options = settings
+        .options(Naming::Python)
+        .map_err(PyValueError::new_err)?;
+    let shard = shard
+        .map(parse_shard_id)
+        .transpose()
+        .map_err(|e| bad("shard", e))?;
+    let checkpoint_every = match checkpoint_every {
+        None => clothbake_bake::checkpoint::DEFAULT_INTERVAL,
+        Some(s) if s.is_finite() && s > 0.0 => Duration::from_secs_f64(s),
+        Some(s) => {
+            return Err(bad(
+                "checkpoint_every",
+                format!("{s} seconds; give a positive number"),
+            ))
         }
-        let pct = done * 100 / total;
-        if shown.fetch_max(pct + 1, Ordering::Relaxed) < pct + 1 {
-            let mut err = std::io::stderr().lock();
-            let _ = write!(err, "\rbaking {}: {pct:3}%", fabric.fabric.name());
-            if done >= total {
-                let _ = writeln!(err);
+    };
+    let target = match (output, shard) {
+        (None, Some(_)) => {
+            return Err(bad(
+                "shard",
+                "a shard is written to a file for `clothbake merge`; give output= as well",
+            ))
+        }
+        (None, None) => {
+            for (name, given) in [
+                ("resume", resume),
+                ("format", format.is_some()),
+                ("precision", precision.is_some()),
+                (
+                    "checkpoint_every",
+                    checkpoint_every != clothbake_bake::checkpoint::DEFAULT_INTERVAL,
+                ),
+            ] {
+                if given {
+                    return Err(bad(
+                        name,
+                        "applies to a bake into a file; give output= as well, or drop it",
+                    ));
+                }
+            }
+            Target::Memory
+        }
+        (Some(path), Some(id)) => {
+            if format.is_some() || precision.is_some() {
+                return Err(bad(
+                    if format.is_some() { "format" } else { "precision" },
+                    "does not apply to a shard (shards have their own file format); give it to `clothbake merge`",
+                ));
+            }
+            Target::Shard { path, id }
+        }
+        (Some(path), None) => {
+            let format = table_format(&path, format, precision)?;
+            Target::Table { path, format }
+        }
+    };
+    let job = Job {
+        fabric: &fabric.fabric,
+        options,
+        target,
+        resume,
+        overwrite,
+        checkpoint_every,
+    };
+
+    let (print, callback) = match &progress {
+        None => (false, None),
+        Some(p) if p.is_callable() => (false, Some(p.clone().unbind())),
+        Some(p) => (p.is_truthy()?, None),
+    };
+    let cancel = AtomicBool::new(false);
+    let callback_error: Mutex<Option<PyErr>> = Mutex::new(None);
+    let shown = AtomicU64::new(0);
+    let name = fabric.fabric.name().to_string();
+    let on_progress = |done: u64, total: u64| {
+        if let Some(cb) = &callback {
+            Python::attach(|py| match cb.call1(py, (done, total)) {
+                Ok(r) => {
+                    if r.bind(py).is(&*pyo3::types::PyBool::new(py, false)) {
+                        cancel.store(true, Ordering::SeqCst);
+                    }
+                }
+                Err(e) => {
+                    cancel.store(true, Ordering::SeqCst);
+                    callback_error
+                        .lock()
+                        .expect("no panic while held")
+                        .get_or_insert(e);
+                }
+            });
+        }
+        if print {
+            let pct = done * 100 / total.max(1);
+            if shown.fetch_max(pct + 1, Ordering::Relaxed) < pct + 1 {
+                let mut err = std::io::stderr().lock();
+                let _ = write!(err, "\rbaking {name}: {pct:3}%");
+                if done >= total {
+                    let _ = writeln!(err);
+                }
             }
         }
     };
-    let cancel = AtomicBool::new(false);
-    let baked = py
-        .detach(|| bake_grid(&fabric.fabric, &opts, &report, &cancel))
-        .map_err(|e| match e {
-            BakeError::Cancelled => PyKeyboardInterrupt::new_err("the bake was cancelled"),
-            BakeError::Invalid(m) => PyValueError::new_err(m),
-        })?;
-    PyTable::from_stored(StoredTable::from(baked.table), false).map_err(table_err)
+    let note = |m: &str| {
+        if print {
+            eprintln!("clothbake: {m}");
+        }
+    };
+    let warn = |m: &str| eprintln!("clothbake: warning: {m}");
+    let hooks = Hooks {
+        progress: &on_progress,
+        note: &note,
+        warn: &warn,
+        cancel: &cancel,
+    };
+    let result = py.detach(|| job::run(&job, &hooks));
+    if let Some(e) = callback_error.lock().expect("no panic while held").take() {
+        return Err(e);
+    }
+    let done = result.map_err(|e| match e {
+        JobError::Invalid(m) => PyValueError::new_err(m),
+        JobError::File(e) => table_err(e),
+        JobError::Checkpoint { path, error } => PyValueError::new_err(format!(
+            "{error}; or delete {} to start the bake again",
+            path.display()
+        )),
+        JobError::Interrupted(i) => {
+            let msg = match (&i.save_error, &i.checkpoint) {
+                (None, Some(ck)) if i.saved > 0 => format!(
+                    "interrupted; no {} was written, {} of {} rows are saved in {}; call bake \
+                     again with resume=True to continue",
+                    i.what,
+                    i.saved,
+                    i.rows,
+                    ck.display()
+                ),
+                _ => i.to_string(),
+            };
+            PyKeyboardInterrupt::new_err(msg)
+        }
+    })?;
+    match done.table {
+        None => Ok(None),
+        Some(t) => PyTable::from_stored(StoredTable::from(t), false)
+            .map(Some)
+            .map_err(table_err),
+    }
 }

@@ -173,3 +173,98 @@ def test_bad_tables_raise(tmp_path, twill_path):
         clothbake.Table.open(tmp_path / "bad.bin")
     with pytest.raises(ValueError, match="not in"):
         t.sample(dirs([10], [0]), np.array([[0.5, 1.5]]))
+
+
+def test_sharded_bake_merged_equals_the_whole_bake(tmp_path, twill_path):
+    """Three shards baked from Python, merged by the `clothbake` binary (an independent
+    assembly path from the in-memory bake), give the whole bake bit for bit."""
+    import os
+    import subprocess
+
+    exe = os.environ.get("CLOTHBAKE_BIN")
+    if not exe:
+        pytest.skip("CLOTHBAKE_BIN (the clothbake binary) is not set: tests/tests/python.rs sets it")
+    fab = clothbake.Fabric(twill_path)
+    res = (4, 8, 4, 8)
+    whole = clothbake.bake(fab, res=res, output=tmp_path / "whole.bin")
+    shards = []
+    for k in range(3):
+        s = tmp_path / f"twill-{k}-of-3.shard"
+        assert clothbake.bake(fab, res=res, output=s, shard=f"{k}/3") is None
+        shards.append(str(s))
+    merged = tmp_path / "merged.bin"
+    subprocess.run([exe, "merge", "-q", "-o", str(merged), *shards], check=True)
+    assert merged.read_bytes() == (tmp_path / "whole.bin").read_bytes()
+    memory = clothbake.bake(fab, res=res)
+    np.testing.assert_array_equal(clothbake.Table.open(merged).to_numpy(), memory.to_numpy())
+    np.testing.assert_array_equal(whole.to_numpy(), memory.to_numpy())
+    # The output exists: refused without overwrite, replaced with it.
+    with pytest.raises(FileExistsError, match="whole.bin"):
+        clothbake.bake(fab, res=res, output=tmp_path / "whole.bin")
+    clothbake.bake(fab, res=res, output=tmp_path / "whole.bin", overwrite=True)
+
+
+def test_resumed_bake_equals_an_uninterrupted_one(tmp_path, twill_path):
+    """A bake stopped half way (its progress callback returns False) leaves a checkpoint;
+    resuming from it gives the uninterrupted bake's table bit for bit, and removes it."""
+    fab = clothbake.Fabric(twill_path)
+    res, out = (8, 16, 8, 16), tmp_path / "twill.bin"
+    checkpoint = tmp_path / "twill.bin.checkpoint"
+
+    def stop_half_way(done, total):
+        return done < total // 2
+
+    with pytest.raises(KeyboardInterrupt, match="resume=True"):
+        clothbake.bake(fab, res=res, output=out, progress=stop_half_way, bounces=2, orders="fast")
+    assert checkpoint.exists() and not out.exists()
+    with pytest.raises(ValueError, match="checkpoint of an interrupted bake"):
+        clothbake.bake(fab, res=res, output=out, bounces=2, orders="fast")
+    # Another bake's checkpoint is refused.
+    with pytest.raises(ValueError, match="other options"):
+        clothbake.bake(fab, res=res, output=out, resume=True, bounces=2)
+    seen = []
+    resumed = clothbake.bake(fab, res=res, output=out, resume=True, bounces=2, orders="fast",
+                             progress=lambda d, t: seen.append((d, t)))
+    assert not checkpoint.exists()
+    assert seen[0][0] > 0, "the resumed bake starts from the checkpoint's rows"
+    whole = clothbake.bake(fab, res=res, bounces=2, orders="fast")
+    np.testing.assert_array_equal(resumed.to_numpy(), whole.to_numpy())
+    np.testing.assert_array_equal(clothbake.Table.open(out).to_numpy(), whole.to_numpy())
+
+
+def test_bake_options_reach_the_table(twill_path):
+    fab = clothbake.Fabric(twill_path)
+    t = clothbake.bake(fab, res=(2, 4, 2, 4), method="raytrace", samples=50, seed=7, caps="shaded")
+    opts = json.loads(t.metadata["options_json"])
+    assert (opts["method"], opts["samples"], opts["seed"], opts["caps"]) == ("raytrace", 50, 7, "shaded")
+    t = clothbake.bake(fab, res=(2, 4, 2, 4), variant="thesis", bounces=2, secondary="raytrace",
+                       sampling="8,0.3,1.5,area", kernel="thesis")
+    opts = json.loads(t.metadata["options_json"])
+    assert opts["variant"] == "thesis"
+    assert opts["secondary"]["method"] == "sampling" and opts["secondary"]["kernel"] == "thesis"
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        (dict(method="raytrac"), "method: \"raytrac\""),
+        (dict(samples=10), "samples=, seed= and caps= apply only to the ray tracer"),
+        (dict(variant="best"), "variant: \"best\""),
+        (dict(method="raytrace", variant="thesis"), "variant= applies only"),
+        (dict(method="raytrace", bounces=2), "bounces=2 needs the analytic model"),
+        (dict(orders="fast"), "orders= and sampling= apply only to the secondary"),
+        (dict(bounces=2, orders="1,2"), "orders: expected"),
+        (dict(bounces=2, secondary="raytrace", orders="fast"), "orders= sets the analytic"),
+        (dict(bounces=2, sampling="8,0.3,1.5,area"), "sampling= sets the two-level"),
+        (dict(kernel="pi"), "kernel: \"pi\""),
+        (dict(shard="0/2"), "shard: a shard is written to a file"),
+        (dict(shard="2/2", output="x.shard"), "shard: shard index 2"),
+        (dict(resume=True), "resume: applies to a bake into a file"),
+        (dict(precision="f32", output="t.bin"), "precision: applies only to EXR"),
+        (dict(format="bin", output="t.exr"), "format: \"bin\" but the output t.exr"),
+        (dict(checkpoint_every=0.0, output="t.exr"), "checkpoint_every: 0"),
+    ],
+)
+def test_bad_bake_options_name_the_option(twill_path, kwargs, words):
+    with pytest.raises(ValueError, match=__import__("re").escape(words)):
+        clothbake.bake(clothbake.Fabric(twill_path), res=(2, 4, 2, 4), **kwargs)

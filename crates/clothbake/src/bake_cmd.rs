@@ -7,23 +7,20 @@
 //! stops and nothing is written (exit 130; a second Ctrl-C exits at once).
 
 use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg, ShardArg};
-use crate::cli::{DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::{table_error, CliError};
 use crate::eval_cmd::load_fabric;
-use clothbake_bake::checkpoint::{checkpoint_path, Checkpointer, DEFAULT_INTERVAL};
-use clothbake_bake::merge;
-use clothbake_bake::output::{write_table, Format};
-use clothbake_bake::shard::{
-    describe_rows, read_part, shard_from_env, shard_rows, write_part, Kind, Part, ShardId,
-};
-use clothbake_bake::{self as bake, BakeError, BakeOptions, Baker, Method, DEFAULT_GRID};
+use clothbake_bake::checkpoint::DEFAULT_INTERVAL;
+use clothbake_bake::job::{self, Hooks, Job, JobError, Target};
+use clothbake_bake::output::Format;
+use clothbake_bake::settings::{Naming, Settings};
+use clothbake_bake::shard::{describe_rows, shard_from_env, ShardId};
+use clothbake_bake::BakeOptions;
 use clothbake_core::{Caps, Variant};
-use clothbake_loader::{Precision, TableError};
+use clothbake_loader::Precision;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Raised by Ctrl-C.
@@ -111,27 +108,17 @@ pub fn plan_with_env(
     o: &BakeOpts,
     env: &dyn Fn(&str) -> Option<String>,
 ) -> Result<Plan, CliError> {
-    let raytrace = o.method == MethodArg::Raytrace;
-    if !raytrace && (o.samples.is_some() || o.seed.is_some() || o.caps.is_some()) {
-        return Err(CliError::new(
-            "--samples, --seed and --caps apply only to the ray tracer",
-            "add --method raytrace or drop them",
-        ));
-    }
-    if raytrace && o.variant.is_some() {
-        return Err(CliError::new(
-            "--variant applies only to the analytic model",
-            "drop --variant or use --method analytic",
-        ));
-    }
-    let secondary = o.bounces.options()?;
-    if o.bounces.bounces == 2 && raytrace {
-        return Err(CliError::new(
-            "--bounces 2 needs the analytic model: the ray tracer bakes the direct reflection only",
-            "use --method analytic with --bounces 2 (--secondary raytrace selects the thesis's \
-             two-level sampling of the secondary reflection)",
-        ));
-    }
+    let settings = Settings {
+        grid: o.res,
+        facet: o.facet.into(),
+        raytrace: o.method == MethodArg::Raytrace,
+        variant: o.variant.map(Variant::from),
+        samples: o.samples,
+        seed: o.seed,
+        caps: o.caps.map(Caps::from),
+        bounces: o.bounces.settings(),
+    };
+    let options = settings.options(Naming::Cli).map_err(CliError::line)?;
     let shard = match (o.shard, o.shards) {
         (None, None) => None,
         (None, Some(_)) | (Some(ShardArg::Fixed(_)), Some(_)) => {
@@ -179,26 +166,7 @@ pub fn plan_with_env(
             "give a file name with -o PATH, e.g. -o twill.exr",
         ));
     }
-    let threads = thread_count(o.threads);
-    let method = if raytrace {
-        Method::Raytrace {
-            samples: o.samples.unwrap_or(DEFAULT_SAMPLES),
-            seed: o.seed.unwrap_or(DEFAULT_SEED),
-            caps: o.caps.map_or(Caps::Excluded, Caps::from),
-        }
-    } else {
-        Method::Analytic {
-            variant: o.variant.map_or(Variant::Refined, Variant::from),
-        }
-    };
-    let options = BakeOptions {
-        grid: o.res.unwrap_or(DEFAULT_GRID),
-        facet: o.facet.into(),
-        method,
-        bounces: o.bounces.bounces,
-        secondary,
-    };
-    bake::check_options(&options).map_err(|e| CliError::line(e.to_string()))?;
+    let threads = thread_count(o.run.threads);
     Ok(Plan {
         weave: weave.to_path_buf(),
         output,
@@ -213,66 +181,11 @@ pub fn plan_with_env(
     })
 }
 
-/// Refuses an output that would fail only after the bake: an existing file without --force, a
-/// missing folder, a folder we may not write into.
-pub fn preflight(out: &Path, force: bool) -> Result<(), CliError> {
-    if !force && std::fs::symlink_metadata(out).is_ok() {
-        return Err(TableError::AlreadyExists {
-            path: out.to_path_buf(),
-        }
-        .into());
-    }
-    let dir = match out.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    match std::fs::metadata(dir) {
-        Ok(m) if m.is_dir() => {}
-        Ok(_) => {
-            return Err(CliError::new(
-                format!("{}: {} is not a folder", out.display(), dir.display()),
-                "give an output path inside a folder with -o PATH",
-            ))
-        }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(TableError::NoSuchFolder {
-                dir: dir.to_path_buf(),
-                path: out.to_path_buf(),
-            }
-            .into())
-        }
-        Err(e) => {
-            return Err(TableError::Io {
-                path: dir.to_path_buf(),
-                action: "open the folder".into(),
-                source: e,
-            }
-            .into())
-        }
-    }
-    // Probe: can we create a file there? (The table itself goes through a temporary file too.)
-    let mut name = std::ffi::OsString::from(".");
-    name.push(out.file_name().unwrap_or_default());
-    name.push(format!(".probe-{}", std::process::id()));
-    let probe = dir.join(name);
-    match std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&probe)
-    {
-        Ok(f) => {
-            drop(f);
-            let _ = std::fs::remove_file(&probe);
-            Ok(())
-        }
-        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
-        Err(e) => Err(TableError::Io {
-            path: out.to_path_buf(),
-            action: "create the table".into(),
-            source: e,
-        }
-        .into()),
-    }
+/// Refuses an output that would fail only after the work (bake, merge, render, plot, export):
+/// an existing file without --force, a missing folder, a folder we may not write into (the
+/// library's check, as one line); `what` names the file (`table`, `PNG image`).
+pub fn preflight(out: &Path, what: &str, force: bool) -> Result<(), CliError> {
+    clothbake_bake::output::preflight(out, what, force).map_err(|e| table_error(&e))
 }
 
 fn install_ctrlc() {
@@ -286,23 +199,27 @@ fn install_ctrlc() {
     });
 }
 
-fn progress_bar(total: u64, quiet: bool) -> Option<ProgressBar> {
+/// The bake's progress line: cells evaluated, with their rate.
+const BAKE_BAR: &str = "{elapsed_precise} [{wide_bar}] {percent:>3}% {human_pos}/{human_len} \
+                        cells evaluated, {rate}, ETA {eta}";
+
+/// A progress bar of `total` steps drawn with `template` on stderr, or none with --quiet or
+/// when stderr is not a terminal (shared by bake and render). `{rate}` in the template shows
+/// the steps per second with thousands grouped.
+pub fn progress_bar(total: u64, template: &str, quiet: bool) -> Option<ProgressBar> {
     if quiet || !std::io::stderr().is_terminal() {
         return None;
     }
     let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-    let style = ProgressStyle::with_template(
-        "{elapsed_precise} [{wide_bar}] {percent:>3}% {human_pos}/{human_len} cells evaluated, \
-         {rate}, ETA {eta}",
-    )
-    .expect("valid template")
-    .with_key(
-        "rate",
-        |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
-            let _ = write!(w, "{} cells/s", thousands(s.per_sec().round() as u64));
-        },
-    )
-    .progress_chars("=> ");
+    let style = ProgressStyle::with_template(template)
+        .expect("valid template")
+        .with_key(
+            "rate",
+            |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = write!(w, "{} cells/s", thousands(s.per_sec().round() as u64));
+            },
+        )
+        .progress_chars("=> ");
     bar.set_style(style);
     Some(bar)
 }
@@ -316,67 +233,6 @@ pub fn thousands(n: u64) -> String {
         .map(|g| std::str::from_utf8(g).expect("ASCII digits"))
         .collect();
     groups.join(",")
-}
-
-/// The rows of an earlier run of this bake, from its checkpoint; `what` names the output.
-fn load_checkpoint(
-    path: &Path,
-    baker: &Baker,
-    shard: Option<ShardId>,
-    rows: &std::ops::Range<usize>,
-) -> Result<BTreeMap<usize, bake::Row>, CliError> {
-    let part = read_part(path, merge::orbits_of).map_err(|e| {
-        CliError::new(
-            e.to_string(),
-            format!("or delete {} to start the bake again", path.display()),
-        )
-    })?;
-    let restart = format!("delete {} to start again", path.display());
-    if part.kind != Kind::Checkpoint {
-        return Err(CliError::new(
-            format!("{}: not a checkpoint", path.display()),
-            restart,
-        ));
-    }
-    let (m, want) = (&part.meta, baker.metadata());
-    let differs = if m.tool != want.tool {
-        Some(format!("was written by {}, this is {}", m.tool, want.tool))
-    } else if m.fabric_json != want.fabric_json {
-        Some("is of another fabric (or other material overrides)".to_string())
-    } else if m.options_json != want.options_json {
-        Some(format!(
-            "is of a bake with other options ({} instead of {})",
-            m.options_json, want.options_json
-        ))
-    } else if m != want {
-        Some("has other metadata".to_string())
-    } else if part.shard != shard {
-        let name =
-            |s: Option<ShardId>| s.map_or("the whole table".into(), |s| format!("shard {s}"));
-        Some(format!(
-            "is of {}, this bake is of {}",
-            name(part.shard),
-            name(shard)
-        ))
-    } else {
-        None
-    };
-    if let Some(d) = differs {
-        return Err(CliError::new(
-            format!("{}: the checkpoint {d}", path.display()),
-            format!("resume with the command that wrote it, or {restart}"),
-        ));
-    }
-    if let Some(r) = part.rows.keys().find(|r| !rows.contains(r)) {
-        return Err(CliError::new(
-            format!(
-                "{}: the checkpoint holds row {r}, outside this bake's rows",
-                path.display()
-            ),
-            restart,
-        ));
-    }
-    Ok(part.rows)
 }
 
 /// The worker thread count: `--threads N` if given, else every core.
@@ -398,172 +254,113 @@ pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, CliError> {
         })
 }
 
+/// A job's error as the CLI's one line (exit 130 for an interrupted bake).
+fn job_error(e: JobError) -> CliError {
+    match e {
+        JobError::Invalid(m) => CliError::line(m),
+        JobError::File(e) => table_error(&e),
+        JobError::Checkpoint { path, error } => CliError::new(
+            table_error(&error).to_string(),
+            format!("or delete {} to start the bake again", path.display()),
+        ),
+        JobError::Interrupted(i) => {
+            let msg = match &i.save_error {
+                Some(e) => format!(
+                    "interrupted; nothing was written (the checkpoint could not be saved: {})",
+                    table_error(e)
+                ),
+                None => i.to_string(),
+            };
+            CliError::line(msg).with_code(INTERRUPTED)
+        }
+    }
+}
+
 /// Runs a bake and returns the summary line for stdout (empty with --quiet).
 pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     let plan = plan(weave, o)?;
     let fabric = load_fabric(&plan.weave, &o.draft, &o.material)?;
-    preflight(&plan.output, o.force)?;
-    let shard = plan.shard.as_ref().map(|(id, _)| *id);
+    let what = if plan.shard.is_some() {
+        "shard"
+    } else {
+        "table"
+    };
+    preflight(&plan.output, what, o.run.force)?;
     if let Some((_, Some(how))) = &plan.shard {
-        if !o.quiet {
+        if !o.run.quiet {
             eprintln!("clothbake: {how}");
         }
     }
-    let baker = Baker::new(&fabric, &plan.options).map_err(|e| CliError::line(e.to_string()))?;
-    let rows = match shard {
-        Some(id) => shard_rows(baker.orbits(), id),
-        None => 0..baker.orbits().rows(),
+    let target = match plan.shard {
+        Some((id, _)) => Target::Shard {
+            path: plan.output.clone(),
+            id,
+        },
+        None => Target::Table {
+            path: plan.output.clone(),
+            format: match plan.format {
+                FormatArg::Exr => Format::Exr(plan.precision),
+                FormatArg::Bin => Format::Binary,
+            },
+        },
     };
-    let ck_path = checkpoint_path(&plan.output);
-    let exists = std::fs::symlink_metadata(&ck_path).is_ok();
-    let resumed = match (exists, o.resume) {
-        (true, true) => load_checkpoint(&ck_path, &baker, shard, &rows)?,
-        (true, false) => {
-            return Err(CliError::new(
-                format!(
-                    "{} exists: the checkpoint of an interrupted bake of {}",
-                    ck_path.display(),
-                    plan.output.display()
-                ),
-                format!(
-                    "continue it with the same command and --resume, or delete {} to start again",
-                    ck_path.display()
-                ),
-            ))
-        }
-        (false, _) => BTreeMap::new(),
+    let job = Job {
+        fabric: &fabric,
+        options: plan.options,
+        target,
+        resume: o.resume,
+        overwrite: o.run.force,
+        checkpoint_every: plan.checkpoint_every,
     };
-    if o.resume && !o.quiet {
-        if exists {
-            eprintln!(
-                "clothbake: resuming from {}: {} of {} rows done",
-                ck_path.display(),
-                resumed.len(),
-                rows.len()
-            );
-        } else {
-            eprintln!(
-                "clothbake: no checkpoint {} to resume from: starting at the beginning",
-                ck_path.display()
-            );
-        }
-    }
     install_ctrlc();
-
     let start = Instant::now();
     let pool = thread_pool(plan.threads)?;
-    let g = plan.options.grid;
-    let orbits = baker.orbits();
-    let todo: Vec<usize> = rows.clone().filter(|r| !resumed.contains_key(r)).collect();
-    let to_evaluate: usize = todo.iter().map(|&r| orbits.row_evaluations(r)).sum();
-    let done_before: usize = resumed.keys().map(|&r| orbits.row_evaluations(r)).sum();
-    let bar = progress_bar((to_evaluate + done_before) as u64, o.quiet);
-    let shown = AtomicU64::new(0);
-    let progress = |n: u64| {
+    let bar = progress_bar(0, BAKE_BAR, o.run.quiet);
+    let progress = |done: u64, total: u64| {
         if let Some(b) = &bar {
-            // Rows finish out of order: show the largest count seen.
-            let m = shown.fetch_max(n, Ordering::Relaxed).max(n);
-            b.set_position(done_before as u64 + m);
+            b.set_length(total);
+            b.set_position(done);
         }
     };
-    let ck = Checkpointer::new(
-        ck_path.clone(),
-        plan.checkpoint_every,
-        shard,
-        baker.metadata().clone(),
-        resumed,
-    );
-    let warned = AtomicBool::new(false);
-    let sink = |row: usize, vals: bake::Row| {
-        if let Err(e) = ck.record(row, vals) {
-            if !warned.swap(true, Ordering::Relaxed) {
-                eprintln!(
-                    "clothbake: warning: the checkpoint could not be written ({}); the bake goes on",
-                    table_error(&e)
-                );
-            }
+    let note = |m: &str| {
+        if !o.run.quiet {
+            eprintln!("clothbake: {m}");
         }
     };
-    let result = pool.install(|| baker.sweep(&todo, &progress, &CANCEL, &sink));
+    let warn = |m: &str| eprintln!("clothbake: warning: {m}");
+    let hooks = Hooks {
+        progress: &progress,
+        note: &note,
+        warn: &warn,
+        cancel: &CANCEL,
+    };
+    let result = pool.install(|| job::run(&job, &hooks));
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    match result {
-        Ok(()) if !CANCEL.load(Ordering::SeqCst) => {}
-        Ok(()) | Err(BakeError::Cancelled) => {
-            let what = if shard.is_some() { "shard" } else { "table" };
-            let msg = match ck.save() {
-                Ok(0) => "interrupted; nothing was written".to_string(),
-                Ok(n) => format!(
-                    "interrupted; no {what} was written, {n} of {} rows are saved in {}; run the \
-                     same command with --resume to continue",
-                    rows.len(),
-                    ck_path.display()
-                ),
-                Err(e) => format!(
-                    "interrupted; nothing was written (the checkpoint could not be saved: {})",
-                    table_error(&e)
-                ),
-            };
-            return Err(CliError::line(msg).with_code(INTERRUPTED));
-        }
-        Err(BakeError::Invalid(m)) => return Err(CliError::line(m)),
-    }
-    let done = ck.into_rows();
-    let evaluated: usize = done.keys().map(|&r| orbits.row_evaluations(r)).sum();
-    let what = match shard {
-        Some(id) => {
-            let part = Part {
-                kind: Kind::Shard,
-                shard: Some(id),
-                meta: baker.metadata().clone(),
-                rows: done,
-            };
-            write_part(&plan.output, &part, o.force)?;
-            format!("shard {id}, {}", describe_rows(&g, &rows))
-        }
-        None => {
-            let all: Vec<bake::Row> = done.into_values().collect();
-            let table = baker
-                .table(&all)
-                .map_err(|e| CliError::line(e.to_string()))?;
-            let format = match plan.format {
-                FormatArg::Exr => Format::Exr(plan.precision),
-                FormatArg::Bin => Format::Binary,
-            };
-            write_table(&plan.output, &table, format, o.force)?;
-            format!(
-                "grid {}x{}x{}x{} (theta_i x phi_i x theta_o x phi_o)",
-                g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o
-            )
-        }
-    };
-    // The output is in place: the checkpoint has served.
-    match std::fs::remove_file(&ck_path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => eprintln!(
-            "clothbake: warning: cannot remove the checkpoint {}: {e}",
-            ck_path.display()
-        ),
-        _ => {}
-    }
+    let done = result.map_err(job_error)?;
     let secs = start.elapsed().as_secs_f64();
-    if o.quiet {
+    if o.run.quiet {
         return Ok(String::new());
     }
-    let symmetry = if baker.symmetries().is_empty() {
-        "no symmetry".to_string()
-    } else {
-        format!("symmetry {}", baker.metadata().symmetry)
+    let g = plan.options.grid;
+    let what = match plan.shard {
+        Some((id, _)) => format!("shard {id}, {}", describe_rows(&g, &done.rows)),
+        None => format!(
+            "grid {}x{}x{}x{} (theta_i x phi_i x theta_o x phi_o)",
+            g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o
+        ),
     };
-    let total = match shard {
-        Some(_) => rows.len() * (g.n_theta_o * g.n_phi_o) as usize,
-        None => g.len(),
-    } as u64;
+    let symmetry = match &done.symmetry {
+        None => "no symmetry".to_string(),
+        Some(s) => format!("symmetry {s}"),
+    };
+    let total = done.cells as u64;
     Ok(format!(
         "wrote {}: {what}, {} of {} cells evaluated ({symmetry}), {secs:.2} s, {} cells/s, {} \
          thread{}\n",
         plan.output.display(),
-        thousands(evaluated as u64),
+        thousands(done.evaluated as u64),
         thousands(total),
         thousands((total as f64 / secs.max(1e-9)).round() as u64),
         plan.threads,

@@ -7,18 +7,15 @@
 
 use crate::error::CliError;
 use clap::{Args, Parser, Subcommand, ValueEnum};
+pub use clothbake_bake::settings::{parse_orders, parse_sampling};
+use clothbake_bake::settings::{Bounces, Naming};
 use clothbake_bake::shard::{parse_shard_id, ShardId};
-use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
-use clothbake_core::{
-    Caps, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
-};
+use clothbake_core::interreflection::{Orders, Sampling};
+use clothbake_core::{Caps, FacetModel, Kernel, SecondaryOptions, UnitVec3, Variant};
 use clothbake_loader::Grid;
 use std::path::PathBuf;
 
-/// Default number of samples (rays) of `--method raytrace`.
-pub const DEFAULT_SAMPLES: usize = 100_000;
-/// Default random seed of `--method raytrace`.
-pub const DEFAULT_SEED: u64 = 1;
+pub use clothbake_bake::settings::{DEFAULT_SAMPLES, DEFAULT_SEED};
 
 /// Bake the BRDF of woven cloth, derived from its yarn geometry (Huo 1993), into tables.
 #[derive(Parser, Debug)]
@@ -103,17 +100,9 @@ pub struct BakeOpts {
     #[arg(long, value_enum)]
     pub precision: Option<PrecisionArg>,
 
-    /// Worker threads [default: all cores]; the table does not depend on it.
-    #[arg(long, value_name = "N", value_parser = parse_threads)]
-    pub threads: Option<usize>,
-
-    /// Print nothing but errors (no progress bar, no summary line).
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
-
-    /// Overwrite an existing output file.
-    #[arg(long)]
-    pub force: bool,
+    /// --threads, --quiet, --force.
+    #[command(flatten)]
+    pub run: RunFlags,
 
     /// Facet reflection model: the thesis's Phong-like terms or Lewis's modified Phong.
     #[arg(long, value_enum, default_value_t = FacetArg::Huo)]
@@ -173,6 +162,35 @@ pub struct BakeOpts {
     pub draft: DraftArgs,
 }
 
+/// The flags of every command that works on all cores and writes files (bake, export,
+/// render): `--threads`, `--quiet`, `--force`.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct RunFlags {
+    /// Worker threads [default: all cores]; the output does not depend on it.
+    #[arg(long, value_name = "N", value_parser = parse_threads)]
+    pub threads: Option<usize>,
+
+    /// Print nothing but errors (no progress bar, no summary line).
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// The flags of a command that writes files on one thread (merge): `--quiet`, `--force`.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct WriteFlags {
+    /// Print nothing but errors (no summary line).
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
+}
+
 /// `--shard` values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShardArg {
@@ -201,13 +219,9 @@ pub struct MergeArgs {
     #[arg(long, value_enum)]
     pub precision: Option<PrecisionArg>,
 
-    /// Overwrite an existing table.
-    #[arg(long)]
-    pub force: bool,
-
-    /// Print nothing but errors.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
+    /// --quiet, --force.
+    #[command(flatten)]
+    pub out: WriteFlags,
 }
 
 /// Parses `--shard K/N` or `auto`.
@@ -303,17 +317,9 @@ pub struct ExportArgs {
     #[command(flatten)]
     pub material: MaterialArgs,
 
-    /// Worker threads [default: all cores]; the files do not depend on it.
-    #[arg(long, value_name = "N", value_parser = parse_threads)]
-    pub threads: Option<usize>,
-
-    /// Overwrite existing output files.
-    #[arg(long)]
-    pub force: bool,
-
-    /// Print nothing but errors.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
+    /// --threads, --quiet, --force.
+    #[command(flatten)]
+    pub run: RunFlags,
 }
 
 /// `--rgl-res NT,NP,NS` (see `clothbake_export::rgl::RglGrid`).
@@ -631,132 +637,33 @@ pub struct BounceArgs {
 }
 
 impl BounceArgs {
+    /// The settings as the library takes them.
+    pub fn settings(&self) -> Bounces {
+        Bounces {
+            bounces: self.bounces,
+            sampled: self.secondary.map(|s| s == SecondaryArg::Raytrace),
+            kernel: self.kernel.map(Kernel::from),
+            orders: self.orders,
+            sampling: self.sampling,
+        }
+    }
+
     /// The first of --secondary, --kernel, --orders and --sampling given, if any: the flags
     /// that set the secondary reflection (what --bounces 2 needs, and a table refuses).
     pub fn secondary_flag(&self) -> Option<&'static str> {
-        [
-            ("--secondary", self.secondary.is_some()),
-            ("--kernel", self.kernel.is_some()),
-            ("--orders", self.orders.is_some()),
-            ("--sampling", self.sampling.is_some()),
-        ]
-        .into_iter()
-        .find_map(|(flag, given)| given.then_some(flag))
-    }
-
-    /// The secondary-reflection options (also for --bounces 1, where they are unused); an
-    /// error when --secondary, --kernel, --orders or --sampling is given without --bounces 2,
-    /// --orders with the sampling or --sampling with the analytic solution.
-    pub fn options(&self) -> Result<SecondaryOptions, CliError> {
-        if self.bounces == 1 && self.secondary_flag().is_some() {
-            return Err(CliError::new(
-                "--secondary, --kernel, --orders and --sampling apply only to the secondary \
-                 reflection",
-                "add --bounces 2 or drop them",
-            ));
-        }
-        let method = match (self.secondary, self.orders, self.sampling) {
-            (None | Some(SecondaryArg::Analytic), orders, None) => SecondaryMethod::Analytic {
-                ranges: Ranges::Full,
-                orders: orders.unwrap_or_default(),
-            },
-            (Some(SecondaryArg::Raytrace), None, sampling) => {
-                SecondaryMethod::Sampling(sampling.unwrap_or_default())
-            }
-            (Some(SecondaryArg::Raytrace), Some(_), _) => {
-                return Err(CliError::new(
-                    "--orders sets the analytic solution's quadrature, not the sampling's",
-                    "drop --orders, or --secondary raytrace (and give --sampling instead)",
-                ))
-            }
-            (_, _, Some(_)) => {
-                return Err(CliError::new(
-                    "--sampling sets the two-level sampling (--secondary raytrace), not the \
-                     analytic solution",
-                    "add --secondary raytrace, or drop --sampling (and give --orders instead)",
-                ))
-            }
-        };
-        Ok(SecondaryOptions {
-            method,
-            kernel: self.kernel.map_or(Kernel::Radiometric, Kernel::from),
+        self.settings().secondary_given().map(|name| match name {
+            "secondary" => "--secondary",
+            "kernel" => "--kernel",
+            "orders" => "--orders",
+            _ => "--sampling",
         })
     }
-}
 
-/// Parses `--orders`: `default`, `fast` or THETA,BETA,AXIAL (whole numbers; theta and beta
-/// 1 to 64 nodes in all, axial 1 to 16 a panel, the largest tabulated Gauss-Legendre rule).
-pub fn parse_orders(s: &str) -> Result<Orders, String> {
-    const FIX: &str = "give `default`, `fast` or three whole numbers THETA,BETA,AXIAL, e.g. \
-                       11,5,3 (theta and beta 1 to 64, axial 1 to 16)";
-    match s.trim() {
-        "default" => return Ok(Orders::default()),
-        "fast" => return Ok(ORDERS_FAST),
-        _ => {}
+    /// The secondary-reflection options (also for --bounces 1, where they are unused); the
+    /// library's rules ([`Bounces::options`]).
+    pub fn options(&self) -> Result<SecondaryOptions, CliError> {
+        self.settings().options(Naming::Cli).map_err(CliError::line)
     }
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    let [t, b, a] = parts.as_slice() else {
-        return Err(format!(
-            "expected `default`, `fast` or 3 comma-separated numbers, found {} values; {FIX}",
-            parts.len()
-        ));
-    };
-    Ok(Orders {
-        theta: whole_in(t, "THETA", 64, FIX)?,
-        tol: 0.0,
-        beta: whole_in(b, "BETA", 64, FIX)?,
-        axial: whole_in(a, "AXIAL", 16, FIX)?,
-    })
-}
-
-/// A whole number from 1 to `max` named `name`, or the error with `fix`.
-fn whole_in(p: &str, name: &str, max: usize, fix: &str) -> Result<usize, String> {
-    match p.parse::<usize>() {
-        Ok(x) if (1..=max).contains(&x) => Ok(x),
-        Ok(x) => Err(format!("{name} {x} is outside 1 to {max}; {fix}")),
-        Err(_) => Err(format!("{name} `{p}` is not a whole number; {fix}")),
-    }
-}
-
-/// Parses `--sampling N,STEP,L0,exact|area`: N first-level samples (1 to 10000), a step in
-/// (0, 1] and a half-length l0 in (0, 1000] (fabric units), and the solid angle.
-pub fn parse_sampling(s: &str) -> Result<Sampling, String> {
-    const FIX: &str = "give N,STEP,L0,exact|area, e.g. 32,0.2,1.5,exact (the thesis's) or \
-                       28,0.15,3,area";
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    let [n, step, l0, solid] = parts.as_slice() else {
-        return Err(format!(
-            "expected 4 comma-separated values, found {}; {FIX}",
-            parts.len()
-        ));
-    };
-    let first_level = whole_in(n, "N", 10_000, FIX)?;
-    let within = |p: &str, name: &str, max: f64| {
-        let x = number(p, name).map_err(|e| format!("{e}; {FIX}"))?;
-        if x > 0.0 && x <= max {
-            Ok(x)
-        } else {
-            Err(format!("{name} {x} is outside (0, {max}]; {FIX}"))
-        }
-    };
-    let step = within(step, "STEP", 1.0)?;
-    let l0 = within(l0, "L0", 1000.0)?;
-    let exact_solid_angle = match *solid {
-        "exact" => true,
-        "area" => false,
-        other => {
-            return Err(format!(
-                "solid angle `{other}` is neither `exact` nor `area`; {FIX}"
-            ))
-        }
-    };
-    Ok(Sampling {
-        first_level,
-        d_alpha: step,
-        d_l: step,
-        l0,
-        exact_solid_angle,
-    })
 }
 
 /// `--secondary` values.
@@ -1121,17 +1028,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "PATH")]
     pub exr: Option<PathBuf>,
 
-    /// Worker threads [default: all cores]; the image does not depend on it.
-    #[arg(long, value_name = "N", value_parser = parse_threads)]
-    pub threads: Option<usize>,
-
-    /// Print nothing but errors.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
-
-    /// Overwrite existing output files.
-    #[arg(long)]
-    pub force: bool,
+    /// --threads, --quiet, --force.
+    #[command(flatten)]
+    pub run: RunFlags,
 }
 
 /// `--exposure` values.
@@ -1303,6 +1202,7 @@ pub fn parse_theta_list(s: &str) -> Result<f64, String> {
 mod tests {
     use super::*;
     use clap::CommandFactory;
+    use clothbake_core::interreflection::ORDERS_FAST;
 
     #[test]
     fn clap_definition_is_consistent() {

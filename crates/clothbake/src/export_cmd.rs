@@ -3,13 +3,13 @@
 //! pbrt-v4 and Mitsuba's spectral variants) and/or a MERL binary, each written atomically.
 //! Formats and conventions: `docs/export.md`.
 
+use crate::bake_cmd::preflight;
 use crate::cli::ExportArgs;
 use crate::error::CliError;
 use crate::eval_cmd::apply_material;
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel};
 use clothbake_export::{self as export, merl, rgl, spectrum, Bsdf};
-use clothbake_loader::TableError;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -123,15 +123,13 @@ fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
     }
 }
 
-/// Refuses to replace an existing output unless --force (before any work is done).
+/// Checks every output before any work is done ([`preflight`]).
 fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
     for out in [&args.rgl, &args.rgl_spectral, &args.merl]
         .into_iter()
         .flatten()
     {
-        if !args.force && std::fs::symlink_metadata(out).is_ok() {
-            return Err(TableError::AlreadyExists { path: out.clone() }.into());
-        }
+        preflight(out, "export", args.run.force)?;
     }
     Ok(())
 }
@@ -143,7 +141,7 @@ fn write_all(
     source: &str,
     half_turn: bool,
 ) -> Result<String, CliError> {
-    let threads = crate::bake_cmd::thread_count(args.threads);
+    let threads = crate::bake_cmd::thread_count(args.run.threads);
     let pool = crate::bake_cmd::thread_pool(threads)?;
     let mut summary = String::new();
     let g = args.rgl_res.0;
@@ -178,7 +176,7 @@ fn write_all(
         let slices = slices.get_or_insert_with(|| pool.install(|| rgl::rgl_slices(brdf, &g)));
         let fields = rgl::fields_of(slices, &description, colour);
         let bytes = rgl::tensor_file(&fields);
-        export::write_file(out, &bytes, args.force)?;
+        export::write_file(out, &bytes, args.run.force)?;
         let _ = writeln!(
             summary,
             "wrote {}: RGL tensor file ({}), view grid {} x {} (+1), slices {} x {}, {:.1} MB, \
@@ -199,7 +197,7 @@ fn write_all(
     if let Some(out) = &args.merl {
         let start = Instant::now();
         let table = pool.install(|| merl::merl_table(brdf, args.phi_samples, half_turn));
-        export::write_file(out, &merl::merl_bytes(&table), args.force)?;
+        export::write_file(out, &merl::merl_bytes(&table), args.run.force)?;
         let a = table.anisotropy;
         let _ = writeln!(
             summary,
@@ -213,7 +211,11 @@ fn write_all(
             100.0 * a.max
         );
     }
-    Ok(if args.quiet { String::new() } else { summary })
+    Ok(if args.run.quiet {
+        String::new()
+    } else {
+        summary
+    })
 }
 
 fn facet_name(f: FacetModel) -> &'static str {

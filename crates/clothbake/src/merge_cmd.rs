@@ -21,10 +21,10 @@ pub fn run(a: &MergeArgs) -> Result<String, CliError> {
             "give a file name with -o TABLE, e.g. -o twill.exr",
         ));
     }
-    preflight(&a.output, a.force)?;
+    preflight(&a.output, "table", a.out.force)?;
     let mut parts = Vec::with_capacity(a.shards.len());
     for p in &a.shards {
-        let part = read_part(p, orbits_of).map_err(|e| CliError::line(e.to_string()))?;
+        let part = read_part(p, orbits_of)?;
         parts.push((p.clone(), part));
     }
     let table = merge(&parts).map_err(|e| CliError::line(e.to_string()))?;
@@ -32,8 +32,8 @@ pub fn run(a: &MergeArgs) -> Result<String, CliError> {
         FormatArg::Exr => Format::Exr(precision),
         FormatArg::Bin => Format::Binary,
     };
-    write_table(&a.output, &table, format, a.force)?;
-    if a.quiet {
+    write_table(&a.output, &table, format, a.out.force)?;
+    if a.out.quiet {
         return Ok(String::new());
     }
     let g = table.meta.grid;

@@ -1,6 +1,7 @@
 //! `clothbake render` and `clothbake plot`: the command-line side of `clothbake_render` and
 //! `clothbake_render::plot` (building the shader, checking outputs, progress, summary line).
 
+use crate::bake_cmd::{preflight, progress_bar};
 use crate::cli::{
     BrdfArgs, ComponentArg, Exposure, PlotArgs, PlotKind, RenderArgs, SceneArg, TonemapArg,
 };
@@ -13,8 +14,6 @@ use clothbake_render::scene::Scene;
 use clothbake_render::shade::{Component, Lighting, Shader};
 use clothbake_render::tonemap::{self, Curve};
 use clothbake_render::{self as renderer};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
@@ -118,42 +117,20 @@ fn file_name(p: &Path) -> String {
     )
 }
 
-/// Refuses an existing output without --force before any work is done.
-fn preflight(path: &Path, force: bool) -> Result<(), CliError> {
-    if !force && std::fs::symlink_metadata(path).is_ok() {
-        return Err(CliError::new(
-            format!("{} exists", path.display()),
-            "add --force to overwrite it, or choose another path with -o",
-        ));
-    }
-    Ok(())
-}
-
 fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
 }
 
-fn progress_bar(total: u64, quiet: bool) -> Option<ProgressBar> {
-    if quiet || !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-    let style = ProgressStyle::with_template(
-        "{elapsed_precise} [{wide_bar}] {percent:>3}% {pos}/{len} rows, ETA {eta}",
-    )
-    .expect("valid template")
-    .progress_chars("=> ");
-    bar.set_style(style);
-    Some(bar)
-}
+/// The render's progress line: rows of pixels.
+const RENDER_BAR: &str = "{elapsed_precise} [{wide_bar}] {percent:>3}% {pos}/{len} rows, ETA {eta}";
 
 /// Runs `clothbake render`; returns the summary line.
 pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
     let mut srcs = sources(&a.brdf, 1)?;
     let (_, shader) = srcs.pop().expect("one source");
-    preflight(&a.output, a.force)?;
+    preflight(&a.output, "PNG image", a.run.force)?;
     if let Some(e) = &a.exr {
-        preflight(e, a.force)?;
+        preflight(e, "EXR image", a.run.force)?;
     }
     let scene = Scene::by_name(match a.scene {
         SceneArg::Drape => "drape",
@@ -190,10 +167,10 @@ pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
         irradiance: a.irradiance.unwrap_or(std::f64::consts::PI),
         ambient: a.ambient,
     };
-    let threads = crate::bake_cmd::thread_count(a.threads);
+    let threads = crate::bake_cmd::thread_count(a.run.threads);
     let pool = crate::bake_cmd::thread_pool(threads)?;
     let start = Instant::now();
-    let bar = progress_bar(u64::from(h), a.quiet);
+    let bar = progress_bar(u64::from(h), RENDER_BAR, a.run.quiet);
     let shown = AtomicU64::new(0);
     let progress = |n: u64| {
         if let Some(b) = &bar {
@@ -216,13 +193,13 @@ pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
         TonemapArg::Reinhard => Curve::Reinhard,
     };
     let rgb = tonemap::to_rgb8(&img, exposure, curve);
-    tonemap::write_png_rgb8(&a.output, w, h, &rgb, a.force)?;
+    tonemap::write_png_rgb8(&a.output, w, h, &rgb, a.run.force)?;
     let mut wrote = a.output.display().to_string();
     if let Some(e) = &a.exr {
-        tonemap::write_exr(e, &img, a.force)?;
+        tonemap::write_exr(e, &img, a.run.force)?;
         wrote = format!("{wrote} and {}", e.display());
     }
-    if a.quiet {
+    if a.run.quiet {
         return Ok(String::new());
     }
     Ok(format!(
@@ -253,7 +230,7 @@ pub fn run_plot(a: &PlotArgs) -> Result<String, CliError> {
                 "name the output .png or .svg (repeat -o for both)",
             ));
         }
-        preflight(o, a.force)?;
+        preflight(o, "plot", a.force)?;
     }
     let srcs = sources(&a.brdf, 2)?;
     let sources: Vec<Source<'_>> = srcs

@@ -2,7 +2,7 @@
 wo toward the eye; f_r in 1/sr, RGB."""
 
 import os
-from typing import Any, Dict, Tuple, Union, overload
+from typing import Any, Callable, Dict, Optional, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -68,5 +68,15 @@ class Table:
     def _rust_batch_seconds(self, n: int, repeats: int = 5) -> float: ...
 
 def bake(fabric: Fabric, res: Tuple[int, int, int, int] = (32, 64, 32, 64), bounces: int = 1,
-         facet: str = "huo", progress: bool = False) -> Table:
-    """Bakes fabric into an in-memory Table (f32), GIL released, deterministic."""
+         facet: str = "huo",
+         progress: Union[None, bool, Callable[[int, int], Optional[bool]]] = None, *,
+         output: Union[None, str, "os.PathLike[str]"] = None, overwrite: bool = False,
+         resume: bool = False, shard: Optional[str] = None, format: Optional[str] = None,
+         precision: Optional[str] = None, method: str = "analytic", variant: Optional[str] = None,
+         samples: Optional[int] = None, seed: Optional[int] = None, caps: Optional[str] = None,
+         secondary: Optional[str] = None, kernel: Optional[str] = None,
+         orders: Optional[str] = None, sampling: Optional[str] = None,
+         checkpoint_every: Optional[float] = None) -> Optional[Table]:
+    """Bakes fabric (the `clothbake bake` job): returns the Table (f32), also written to
+    `output` if given (atomically, with checkpoints and resume); a shard (`shard="K/N"`) is
+    written only and None returned. GIL released, deterministic."""

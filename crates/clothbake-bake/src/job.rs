@@ -1,0 +1,413 @@
+//! The bake job: what `clothbake bake` and Python's `bake()` both run.
+//!
+//! A [`Job`] bakes a fabric with [`BakeOptions`] into a table in memory, a table file or a
+//! shard file ([`Target`]). With a file it checks the output before any time is spent
+//! ([`crate::output::preflight`]), keeps a checkpoint of the finished rows next to it
+//! ([`checkpoint_path`]), resumes from one (only when asked: an unasked-for checkpoint is an
+//! error, so that no bake silently mixes runs), writes the output atomically and removes the
+//! checkpoint. Raising the cancel flag stops the sweep; the rows done are saved and
+//! [`JobError::Interrupted`] says how many. Progress, notes and warnings go to [`Hooks`]; the
+//! library prints nothing. Runs on the current rayon pool: the result does not depend on its
+//! size, on the shard split or on resuming.
+
+use crate::checkpoint::{checkpoint_path, Checkpointer, DEFAULT_INTERVAL};
+use crate::merge::orbits_of;
+use crate::output::{preflight, write_table, Format};
+use crate::shard::{read_part, shard_rows, write_part, Kind, Part, ShardId};
+use crate::sweep::{BakeError, BakeOptions, Baker, Row};
+use clothbake_core::Fabric;
+use clothbake_loader::{Metadata, Table, TableError};
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Duration;
+
+/// Where a job's result goes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Target {
+    /// Returned in memory only (no file, no checkpoint, no shard, no resume).
+    Memory,
+    /// A table file in `format`.
+    Table {
+        /// The file.
+        path: PathBuf,
+        /// Its format.
+        format: Format,
+    },
+    /// A shard file (the rows of one shard, for `clothbake merge`).
+    Shard {
+        /// The file.
+        path: PathBuf,
+        /// Which shard.
+        id: ShardId,
+    },
+}
+
+/// A bake request.
+#[derive(Clone, Debug)]
+pub struct Job<'a> {
+    /// The fabric.
+    pub fabric: &'a Fabric,
+    /// The options (everything that determines the table besides the fabric).
+    pub options: BakeOptions,
+    /// Where the result goes.
+    pub target: Target,
+    /// Continue from the checkpoint next to the output, if there is one.
+    pub resume: bool,
+    /// Replace an existing output file.
+    pub overwrite: bool,
+    /// Time between checkpoints.
+    pub checkpoint_every: Duration,
+}
+
+impl<'a> Job<'a> {
+    /// A job baking `fabric` with `options` into memory; set the other fields to write a file.
+    pub fn new(fabric: &'a Fabric, options: BakeOptions) -> Job<'a> {
+        Job {
+            fabric,
+            options,
+            target: Target::Memory,
+            resume: false,
+            overwrite: false,
+            checkpoint_every: DEFAULT_INTERVAL,
+        }
+    }
+}
+
+/// The caller's side of a running job: progress, notes, warnings, and the cancel flag.
+pub struct Hooks<'a> {
+    /// `(done, total)` cells evaluated, rows of a resumed checkpoint included; called from
+    /// worker threads, with `done` never decreasing.
+    pub progress: &'a (dyn Fn(u64, u64) + Sync),
+    /// A sentence about what the job does (resuming, or nothing to resume from).
+    pub note: &'a (dyn Fn(&str) + Sync),
+    /// A problem the job goes on despite (a checkpoint that cannot be written or removed).
+    pub warn: &'a (dyn Fn(&str) + Sync),
+    /// Raised to stop the job (Ctrl-C).
+    pub cancel: &'a AtomicBool,
+}
+
+/// A finished job.
+#[derive(Debug)]
+pub struct Done {
+    /// The table (`None` for a shard).
+    pub table: Option<Table>,
+    /// Its metadata (of the whole table, for a shard too).
+    pub metadata: Metadata,
+    /// The rows baked (all of them, or the shard's).
+    pub rows: Range<usize>,
+    /// Cells evaluated in those rows, resumed ones included (the rest are symmetry copies).
+    pub evaluated: usize,
+    /// Cells of the output: the grid's, or the shard rows'.
+    pub cells: usize,
+    /// The symmetry used, `None` without one.
+    pub symmetry: Option<String>,
+}
+
+/// A job stopped by its cancel flag.
+#[derive(Debug)]
+pub struct Interrupted {
+    /// `"table"` or `"shard"`: what was not written.
+    pub what: &'static str,
+    /// Rows saved in the checkpoint (0: none, or nothing was saved).
+    pub saved: usize,
+    /// Rows of the job.
+    pub rows: usize,
+    /// The checkpoint file (`None` for a bake in memory).
+    pub checkpoint: Option<PathBuf>,
+    /// Why the checkpoint could not be saved, if it could not.
+    pub save_error: Option<TableError>,
+}
+
+/// Why a job produced nothing. Every message names the problem and the fix.
+#[derive(Debug)]
+pub enum JobError {
+    /// The options or the request cannot be baked: one line, problem and fix.
+    Invalid(String),
+    /// A file could not be read or written (the output, a checkpoint).
+    File(TableError),
+    /// The checkpoint to resume from cannot be read; the fix: delete it to start again.
+    Checkpoint {
+        /// The checkpoint file.
+        path: PathBuf,
+        /// Why it cannot be read.
+        error: TableError,
+    },
+    /// Cancelled; the rows done so far are saved where a checkpoint is kept.
+    Interrupted(Box<Interrupted>),
+}
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match (&self.save_error, &self.checkpoint) {
+            (Some(e), _) => write!(
+                f,
+                "interrupted; nothing was written (the checkpoint could not be saved: {e})"
+            ),
+            (None, Some(ck)) if self.saved > 0 => write!(
+                f,
+                "interrupted; no {} was written, {} of {} rows are saved in {}; run the same \
+                 command with --resume to continue",
+                self.what,
+                self.saved,
+                self.rows,
+                ck.display()
+            ),
+            _ => f.write_str("interrupted; nothing was written"),
+        }
+    }
+}
+
+impl std::fmt::Display for JobError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            JobError::Invalid(m) => f.write_str(m),
+            JobError::File(e) => write!(f, "{e}"),
+            JobError::Checkpoint { path, error } => write!(
+                f,
+                "{error}; or delete {} to start the bake again",
+                path.display()
+            ),
+            JobError::Interrupted(i) => write!(f, "{i}"),
+        }
+    }
+}
+
+impl std::error::Error for JobError {}
+
+impl From<TableError> for JobError {
+    fn from(e: TableError) -> Self {
+        JobError::File(e)
+    }
+}
+
+fn invalid(problem: impl std::fmt::Display, fix: impl std::fmt::Display) -> JobError {
+    JobError::Invalid(format!("{problem}; {fix}"))
+}
+
+/// The rows of an earlier run of this bake from its checkpoint at `path`, after checking that
+/// it belongs to this bake (tool, fabric, options, metadata, shard) and holds only its rows.
+pub fn load_checkpoint(
+    path: &Path,
+    baker: &Baker,
+    shard: Option<ShardId>,
+    rows: &Range<usize>,
+) -> Result<BTreeMap<usize, Row>, JobError> {
+    let part = read_part(path, orbits_of).map_err(|error| JobError::Checkpoint {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let restart = format!("delete {} to start again", path.display());
+    if part.kind != Kind::Checkpoint {
+        return Err(invalid(
+            format!("{}: not a checkpoint", path.display()),
+            restart,
+        ));
+    }
+    let (m, want) = (&part.meta, baker.metadata());
+    let differs = if m.tool != want.tool {
+        Some(format!("was written by {}, this is {}", m.tool, want.tool))
+    } else if m.fabric_json != want.fabric_json {
+        Some("is of another fabric (or other material overrides)".to_string())
+    } else if m.options_json != want.options_json {
+        Some(format!(
+            "is of a bake with other options ({} instead of {})",
+            m.options_json, want.options_json
+        ))
+    } else if m != want {
+        Some("has other metadata".to_string())
+    } else if part.shard != shard {
+        let name =
+            |s: Option<ShardId>| s.map_or("the whole table".into(), |s| format!("shard {s}"));
+        Some(format!(
+            "is of {}, this bake is of {}",
+            name(part.shard),
+            name(shard)
+        ))
+    } else {
+        None
+    };
+    if let Some(d) = differs {
+        return Err(invalid(
+            format!("{}: the checkpoint {d}", path.display()),
+            format!("resume with the command that wrote it, or {restart}"),
+        ));
+    }
+    if let Some(r) = part.rows.keys().find(|r| !rows.contains(r)) {
+        return Err(invalid(
+            format!(
+                "{}: the checkpoint holds row {r}, outside this bake's rows",
+                path.display()
+            ),
+            restart,
+        ));
+    }
+    Ok(part.rows)
+}
+
+/// Runs `job` on the current rayon pool.
+pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
+    let (output, shard) = match &job.target {
+        Target::Memory => {
+            if job.resume {
+                return Err(invalid(
+                    "resuming needs an output file (its checkpoint lies next to it)",
+                    "give the output file, or do not resume",
+                ));
+            }
+            (None, None)
+        }
+        Target::Table { path, .. } => (Some(path.as_path()), None),
+        Target::Shard { path, id } => (Some(path.as_path()), Some(*id)),
+    };
+    if let Some(out) = output {
+        let what = if shard.is_some() { "shard" } else { "table" };
+        preflight(out, what, job.overwrite)?;
+    }
+    let baker = Baker::new(job.fabric, &job.options).map_err(bake_error)?;
+    let orbits = baker.orbits();
+    let rows = match shard {
+        Some(id) => shard_rows(orbits, id),
+        None => 0..orbits.rows(),
+    };
+    let ck_path = output.map(checkpoint_path);
+    let exists = ck_path
+        .as_deref()
+        .is_some_and(|p| std::fs::symlink_metadata(p).is_ok());
+    let resumed = match (&ck_path, exists, job.resume) {
+        (Some(ck), true, true) => {
+            let r = load_checkpoint(ck, &baker, shard, &rows)?;
+            (hooks.note)(&format!(
+                "resuming from {}: {} of {} rows done",
+                ck.display(),
+                r.len(),
+                rows.len()
+            ));
+            r
+        }
+        (Some(ck), true, false) => {
+            return Err(invalid(
+                format!(
+                    "{} exists: the checkpoint of an interrupted bake of {}",
+                    ck.display(),
+                    output.expect("a checkpoint has an output").display()
+                ),
+                format!(
+                    "continue it with the same command and --resume, or delete {} to start again",
+                    ck.display()
+                ),
+            ))
+        }
+        (Some(ck), false, true) => {
+            (hooks.note)(&format!(
+                "no checkpoint {} to resume from: starting at the beginning",
+                ck.display()
+            ));
+            BTreeMap::new()
+        }
+        _ => BTreeMap::new(),
+    };
+
+    let todo: Vec<usize> = rows.clone().filter(|r| !resumed.contains_key(r)).collect();
+    let to_evaluate: usize = todo.iter().map(|&r| orbits.row_evaluations(r)).sum();
+    let done_before: usize = resumed.keys().map(|&r| orbits.row_evaluations(r)).sum();
+    let total = (to_evaluate + done_before) as u64;
+    let shown = AtomicU64::new(0);
+    (hooks.progress)(done_before as u64, total);
+    let progress = |n: u64| {
+        // Rows finish out of order: report the largest count seen.
+        let m = shown.fetch_max(n, Ordering::Relaxed).max(n);
+        (hooks.progress)(done_before as u64 + m, total);
+    };
+    let ck = match &ck_path {
+        Some(p) => Checkpointer::new(
+            p.clone(),
+            job.checkpoint_every,
+            shard,
+            baker.metadata().clone(),
+            resumed,
+        ),
+        None => Checkpointer::in_memory(baker.metadata().clone(), resumed),
+    };
+    let warned = AtomicBool::new(false);
+    let sink = |row: usize, vals: Row| {
+        if let Err(e) = ck.record(row, vals) {
+            if !warned.swap(true, Ordering::Relaxed) {
+                (hooks.warn)(&format!(
+                    "the checkpoint could not be written ({e}); the bake goes on"
+                ));
+            }
+        }
+    };
+    let result = baker.sweep(&todo, &progress, hooks.cancel, &sink);
+    match result {
+        Ok(()) if !hooks.cancel.load(Ordering::SeqCst) => {}
+        Ok(()) | Err(BakeError::Cancelled) => {
+            let (saved, save_error) = match ck.save() {
+                Ok(n) => (n, None),
+                Err(e) => (0, Some(e)),
+            };
+            return Err(JobError::Interrupted(Box::new(Interrupted {
+                what: if shard.is_some() { "shard" } else { "table" },
+                saved,
+                rows: rows.len(),
+                checkpoint: ck_path,
+                save_error,
+            })));
+        }
+        Err(e) => return Err(bake_error(e)),
+    }
+    let done = ck.into_rows();
+    let evaluated: usize = done.keys().map(|&r| orbits.row_evaluations(r)).sum();
+    let g = job.options.grid;
+    let table = match &job.target {
+        Target::Shard { path, id } => {
+            let part = Part {
+                kind: Kind::Shard,
+                shard: Some(*id),
+                meta: baker.metadata().clone(),
+                rows: done,
+            };
+            write_part(path, &part, job.overwrite)?;
+            None
+        }
+        target => {
+            let all: Vec<Row> = done.into_values().collect();
+            let table = baker.table(&all).map_err(bake_error)?;
+            if let Target::Table { path, format } = target {
+                write_table(path, &table, *format, job.overwrite)?;
+            }
+            Some(table)
+        }
+    };
+    // The output is in place: the checkpoint has served.
+    if let Some(ck) = &ck_path {
+        match std::fs::remove_file(ck) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => (hooks.warn)(&format!(
+                "cannot remove the checkpoint {}: {e}",
+                ck.display()
+            )),
+            _ => {}
+        }
+    }
+    let cells = match shard {
+        Some(_) => rows.len() * (g.n_theta_o * g.n_phi_o) as usize,
+        None => g.len(),
+    };
+    Ok(Done {
+        table,
+        metadata: baker.metadata().clone(),
+        rows,
+        evaluated,
+        cells,
+        symmetry: (!baker.symmetries().is_empty()).then(|| baker.metadata().symmetry.clone()),
+    })
+}
+
+fn bake_error(e: BakeError) -> JobError {
+    match e {
+        BakeError::Invalid(m) => JobError::Invalid(m),
+        BakeError::Cancelled => JobError::Invalid("the bake was cancelled".into()),
+    }
+}

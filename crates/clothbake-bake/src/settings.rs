@@ -1,0 +1,301 @@
+//! The bake options as a user gives them (command-line flags, Python keywords), checked and
+//! resolved into [`BakeOptions`] by one set of rules, with messages in the caller's spelling
+//! ([`Naming`]).
+
+use crate::sweep::{check_options, BakeOptions, Method, DEFAULT_GRID};
+use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
+use clothbake_core::{Caps, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, Variant};
+use clothbake_loader::Grid;
+
+/// Rays per cell of the ray tracer unless given.
+pub const DEFAULT_SAMPLES: usize = 100_000;
+/// The ray tracer's base seed unless given.
+pub const DEFAULT_SEED: u64 = 1;
+
+/// How messages spell an option: `--samples` and `--method raytrace` on the command line,
+/// `samples=` and `method="raytrace"` in Python.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Naming {
+    /// Command-line flags.
+    Cli,
+    /// Python keyword arguments.
+    Python,
+}
+
+impl Naming {
+    /// The option `name` (`samples`): `--samples` or `samples=`.
+    pub fn flag(self, name: &str) -> String {
+        match self {
+            Naming::Cli => format!("--{name}"),
+            Naming::Python => format!("{name}="),
+        }
+    }
+
+    /// The option `name` set to the word `value`: `--method raytrace` or `method="raytrace"`.
+    pub fn word(self, name: &str, value: &str) -> String {
+        match self {
+            Naming::Cli => format!("--{name} {value}"),
+            Naming::Python => format!("{name}=\"{value}\""),
+        }
+    }
+
+    /// The option `name` set to the number `value`: `--bounces 2` or `bounces=2`.
+    pub fn number(self, name: &str, value: &str) -> String {
+        match self {
+            Naming::Cli => format!("--{name} {value}"),
+            Naming::Python => format!("{name}={value}"),
+        }
+    }
+}
+
+/// Every bake option as given; `None`: not given (the default applies).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Settings {
+    /// The grid [default: [`DEFAULT_GRID`]].
+    pub grid: Option<Grid>,
+    /// Facet model.
+    pub facet: FacetModel,
+    /// The ray tracer instead of the analytic model.
+    pub raytrace: bool,
+    /// Analytic variant [default: refined].
+    pub variant: Option<Variant>,
+    /// Ray tracer: rays per cell.
+    pub samples: Option<usize>,
+    /// Ray tracer: base seed.
+    pub seed: Option<u64>,
+    /// Ray tracer: end caps.
+    pub caps: Option<Caps>,
+    /// The secondary-reflection settings.
+    pub bounces: Bounces,
+}
+
+/// The bounces and the secondary reflection's settings as given.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounces {
+    /// 1 or 2.
+    pub bounces: u32,
+    /// `Some(true)`: the two-level sampling; `Some(false)`: the analytic solution [default].
+    pub sampled: Option<bool>,
+    /// Weight of the second bounce [default: radiometric].
+    pub kernel: Option<Kernel>,
+    /// Quadrature orders of the analytic solution.
+    pub orders: Option<Orders>,
+    /// Parameters of the two-level sampling.
+    pub sampling: Option<Sampling>,
+}
+
+impl Default for Bounces {
+    fn default() -> Self {
+        Bounces {
+            bounces: 1,
+            sampled: None,
+            kernel: None,
+            orders: None,
+            sampling: None,
+        }
+    }
+}
+
+impl Bounces {
+    /// The first secondary-reflection option given, if any (`secondary`, `kernel`, `orders`,
+    /// `sampling`).
+    pub fn secondary_given(&self) -> Option<&'static str> {
+        [
+            ("secondary", self.sampled.is_some()),
+            ("kernel", self.kernel.is_some()),
+            ("orders", self.orders.is_some()),
+            ("sampling", self.sampling.is_some()),
+        ]
+        .into_iter()
+        .find_map(|(name, given)| given.then_some(name))
+    }
+
+    /// The secondary-reflection options (also for one bounce, where they are unused); an
+    /// error when one is given without two bounces, orders with the sampling or sampling
+    /// parameters with the analytic solution.
+    pub fn options(&self, n: Naming) -> Result<SecondaryOptions, String> {
+        let f = |name| n.flag(name);
+        if self.bounces == 1 && self.secondary_given().is_some() {
+            return Err(format!(
+                "{}, {}, {} and {} apply only to the secondary reflection; add {} or drop them",
+                f("secondary"),
+                f("kernel"),
+                f("orders"),
+                f("sampling"),
+                n.number("bounces", "2")
+            ));
+        }
+        let method = match (self.sampled, self.orders, self.sampling) {
+            (None | Some(false), orders, None) => SecondaryMethod::Analytic {
+                ranges: Ranges::Full,
+                orders: orders.unwrap_or_default(),
+            },
+            (Some(true), None, sampling) => SecondaryMethod::Sampling(sampling.unwrap_or_default()),
+            (Some(true), Some(_), _) => {
+                return Err(format!(
+                    "{} sets the analytic solution's quadrature, not the sampling's; drop {}, or \
+                     {} (and give {} instead)",
+                    f("orders"),
+                    f("orders"),
+                    n.word("secondary", "raytrace"),
+                    f("sampling")
+                ))
+            }
+            (_, _, Some(_)) => {
+                return Err(format!(
+                    "{} sets the two-level sampling ({}), not the analytic solution; add {}, or \
+                     drop {} (and give {} instead)",
+                    f("sampling"),
+                    n.word("secondary", "raytrace"),
+                    n.word("secondary", "raytrace"),
+                    f("sampling"),
+                    f("orders")
+                ))
+            }
+        };
+        Ok(SecondaryOptions {
+            method,
+            kernel: self.kernel.unwrap_or(Kernel::Radiometric),
+        })
+    }
+}
+
+impl Settings {
+    /// The bake options: the option combinations checked (ray-tracer options need the ray
+    /// tracer, the variant the analytic model, two bounces the analytic model), the defaults
+    /// filled in, and [`check_options`] passed. Messages name the options as `n` spells them.
+    pub fn options(&self, n: Naming) -> Result<BakeOptions, String> {
+        let f = |name| n.flag(name);
+        if !self.raytrace && (self.samples.is_some() || self.seed.is_some() || self.caps.is_some())
+        {
+            return Err(format!(
+                "{}, {} and {} apply only to the ray tracer; add {} or drop them",
+                f("samples"),
+                f("seed"),
+                f("caps"),
+                n.word("method", "raytrace")
+            ));
+        }
+        if self.raytrace && self.variant.is_some() {
+            return Err(format!(
+                "{} applies only to the analytic model; drop {} or use {}",
+                f("variant"),
+                f("variant"),
+                n.word("method", "analytic")
+            ));
+        }
+        let secondary = self.bounces.options(n)?;
+        if self.bounces.bounces == 2 && self.raytrace {
+            return Err(format!(
+                "{} needs the analytic model: the ray tracer bakes the direct reflection only; \
+                 use {} with {} ({} selects the thesis's two-level sampling of the secondary \
+                 reflection)",
+                n.number("bounces", "2"),
+                n.word("method", "analytic"),
+                n.number("bounces", "2"),
+                n.word("secondary", "raytrace")
+            ));
+        }
+        let method = if self.raytrace {
+            Method::Raytrace {
+                samples: self.samples.unwrap_or(DEFAULT_SAMPLES),
+                seed: self.seed.unwrap_or(DEFAULT_SEED),
+                caps: self.caps.unwrap_or(Caps::Excluded),
+            }
+        } else {
+            Method::Analytic {
+                variant: self.variant.unwrap_or(Variant::Refined),
+            }
+        };
+        let options = BakeOptions {
+            grid: self.grid.unwrap_or(DEFAULT_GRID),
+            facet: self.facet,
+            method,
+            bounces: self.bounces.bounces,
+            secondary,
+        };
+        check_options(&options).map_err(|e| e.to_string())?;
+        Ok(options)
+    }
+}
+
+/// Parses quadrature orders: `default`, `fast` or THETA,BETA,AXIAL (whole numbers; theta and
+/// beta 1 to 64 nodes in all, axial 1 to 16 a panel, the largest tabulated Gauss-Legendre
+/// rule).
+pub fn parse_orders(s: &str) -> Result<Orders, String> {
+    const FIX: &str = "give `default`, `fast` or three whole numbers THETA,BETA,AXIAL, e.g. \
+                       11,5,3 (theta and beta 1 to 64, axial 1 to 16)";
+    match s.trim() {
+        "default" => return Ok(Orders::default()),
+        "fast" => return Ok(ORDERS_FAST),
+        _ => {}
+    }
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [t, b, a] = parts.as_slice() else {
+        return Err(format!(
+            "expected `default`, `fast` or 3 comma-separated numbers, found {} values; {FIX}",
+            parts.len()
+        ));
+    };
+    Ok(Orders {
+        theta: whole_in(t, "THETA", 64, FIX)?,
+        tol: 0.0,
+        beta: whole_in(b, "BETA", 64, FIX)?,
+        axial: whole_in(a, "AXIAL", 16, FIX)?,
+    })
+}
+
+/// A whole number from 1 to `max` named `name`, or the error with `fix`.
+fn whole_in(p: &str, name: &str, max: usize, fix: &str) -> Result<usize, String> {
+    match p.parse::<usize>() {
+        Ok(x) if (1..=max).contains(&x) => Ok(x),
+        Ok(x) => Err(format!("{name} {x} is outside 1 to {max}; {fix}")),
+        Err(_) => Err(format!("{name} `{p}` is not a whole number; {fix}")),
+    }
+}
+
+/// Parses the two-level sampling's `N,STEP,L0,exact|area`: N first-level samples (1 to
+/// 10000), a step in (0, 1] and a half-length l0 in (0, 1000] (fabric units), and the solid
+/// angle.
+pub fn parse_sampling(s: &str) -> Result<Sampling, String> {
+    const FIX: &str = "give N,STEP,L0,exact|area, e.g. 32,0.2,1.5,exact (the thesis's) or \
+                       28,0.15,3,area";
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [n, step, l0, solid] = parts.as_slice() else {
+        return Err(format!(
+            "expected 4 comma-separated values, found {}; {FIX}",
+            parts.len()
+        ));
+    };
+    let first_level = whole_in(n, "N", 10_000, FIX)?;
+    let within = |p: &str, name: &str, max: f64| {
+        let x = match p.parse::<f64>() {
+            Ok(x) if x.is_finite() => x,
+            Ok(_) => return Err(format!("{name} `{p}` is not a finite number; {FIX}")),
+            Err(_) => return Err(format!("{name} `{p}` is not a number; {FIX}")),
+        };
+        if x > 0.0 && x <= max {
+            Ok(x)
+        } else {
+            Err(format!("{name} {x} is outside (0, {max}]; {FIX}"))
+        }
+    };
+    let step = within(step, "STEP", 1.0)?;
+    let l0 = within(l0, "L0", 1000.0)?;
+    let exact_solid_angle = match *solid {
+        "exact" => true,
+        "area" => false,
+        other => {
+            return Err(format!(
+                "solid angle `{other}` is neither `exact` nor `area`; {FIX}"
+            ))
+        }
+    };
+    Ok(Sampling {
+        first_level,
+        d_alpha: step,
+        d_l: step,
+        l0,
+        exact_solid_angle,
+    })
+}
