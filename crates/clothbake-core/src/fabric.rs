@@ -47,6 +47,11 @@ impl fmt::Display for FabricError {
 }
 impl std::error::Error for FabricError {}
 
+/// Smallest length (radius, spacing, segment length) a fabric may give, in its own unit.
+pub const MIN_LENGTH: f64 = 1e-9;
+/// Largest length a fabric may give, in its own unit.
+pub const MAX_LENGTH: f64 = 1e9;
+
 /// A validated fabric: weave period, both yarn groups. Every invariant the model relies on holds:
 /// the fields are private and [`Fabric::new`] is the one constructor (fabric files, WIF drafts,
 /// Python dicts and material overrides all go through it).
@@ -459,10 +464,28 @@ impl Fabric {
                 ))
             }
         };
+        // Only ratios of lengths matter, but squares and products of lengths must stay normal
+        // f64 numbers: lengths outside [MIN_LENGTH, MAX_LENGTH] are refused, not computed wrong.
+        let in_range = |x: f64, f: Field, i: usize| {
+            if x > 0.0 && !(MIN_LENGTH..=MAX_LENGTH).contains(&x) {
+                Err(err(
+                    naming.field(g, f, i),
+                    format!("is {x}, outside the lengths clothbake computes with ({MIN_LENGTH:e} to {MAX_LENGTH:e})"),
+                    "give every length in one unit between 1e-9 and 1e9 (only their ratios matter: e.g. millimetres)",
+                ))
+            } else {
+                Ok(())
+            }
+        };
         for (i, y) in threads.iter().enumerate() {
             finite(y.radius, Field::Radius, i)?;
             finite(y.height, Field::Height, i)?;
             finite(y.spacing, Field::Spacing, i)?;
+            in_range(y.radius, Field::Radius, i)?;
+            in_range(y.spacing, Field::Spacing, i)?;
+            if let Some(s) = y.segment_length {
+                in_range(s, Field::SegmentLength, i)?;
+            }
             if y.radius <= 0.0 {
                 return Err(err(
                     naming.field(g, Field::Radius, i),
@@ -761,6 +784,24 @@ mod tests {
         ));
         assert_eq!(e.field, "warp.segment_length");
         assert!(err("{").problem.contains("EOF"));
+    }
+
+    #[test]
+    fn lengths_beyond_what_f64_squares_hold_are_refused_with_the_range() {
+        // Radius 1e300 would overflow r^2 (NaN values), 1e-300 underflow it (all zeros).
+        for (from, to) in [("1.5, 1.2", "1e300, 1.2"), ("1.5, 1.2", "1e-300, 1.2")] {
+            let e = err(&OK.replace(from, to));
+            assert_eq!(e.field, "weft.radius[0]", "{e}");
+            assert!(e.problem.contains("1e-9 to 1e9"), "{e}");
+        }
+        let e = err(&OK.replace("\"spacing\": 3.1}", "\"spacing\": 3.1e300}"));
+        assert_eq!(e.field, "warp.spacing", "{e}");
+        // The same fabric scaled by 1e6 is accepted: the bound is not a unit.
+        let big = OK
+            .replace("1.5", "1.5e6")
+            .replace("1.2", "1.2e6")
+            .replace("3.1", "3.1e6");
+        assert!(Fabric::from_json_str(&big, "t.json").is_ok());
     }
 
     #[test]
