@@ -133,13 +133,14 @@ pub fn plan_with_env(
             Some((id, Some(how)))
         }
     };
-    if shard.is_some() && (o.format.is_some() || o.precision.is_some()) {
+    if shard.is_some() && (o.table.format.is_some() || o.table.precision.is_some()) {
         return Err(CliError::new(
             "--format and --precision do not apply to a shard: shards have their own file format",
             "give them to `clothbake merge`, which writes the table",
         ));
     }
-    let (format, precision) = output_format(o.format, o.output.as_deref(), o.precision)?;
+    let (format, precision) =
+        output_format(o.table.format, o.output.as_deref(), o.table.precision)?;
     let output = match &o.output {
         Some(p) => p.clone(),
         None => {

@@ -92,13 +92,9 @@ pub struct BakeOpts {
     #[arg(long, value_name = "NTI,NPI,NTO,NPO", value_parser = parse_res, default_value = "32,64,32,64")]
     pub res: Option<Grid>,
 
-    /// Table format [default: from the output's extension, .exr or .bin; otherwise exr].
-    #[arg(long, value_enum)]
-    pub format: Option<FormatArg>,
-
-    /// Sample precision of an EXR table (f16: about 3 digits, at most 65504) [default: f16].
-    #[arg(long, value_enum)]
-    pub precision: Option<PrecisionArg>,
+    /// --format, --precision.
+    #[command(flatten)]
+    pub table: TableFormatArgs,
 
     /// --threads, --quiet, --force.
     #[command(flatten)]
@@ -200,6 +196,18 @@ pub enum ShardArg {
     Auto,
 }
 
+/// The format of a table a command writes (bake, merge).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct TableFormatArgs {
+    /// Table format [default: from the output's extension, .exr or .bin; otherwise exr].
+    #[arg(long, value_enum)]
+    pub format: Option<FormatArg>,
+
+    /// Sample precision of an EXR table (f16: about 3 digits, at most 65504) [default: f16].
+    #[arg(long, value_enum)]
+    pub precision: Option<PrecisionArg>,
+}
+
 /// `clothbake merge`.
 #[derive(Args, Debug)]
 pub struct MergeArgs {
@@ -211,13 +219,9 @@ pub struct MergeArgs {
     #[arg(value_name = "SHARD", required = true)]
     pub shards: Vec<PathBuf>,
 
-    /// Table format [default: from the output's extension, .exr or .bin; otherwise exr].
-    #[arg(long, value_enum)]
-    pub format: Option<FormatArg>,
-
-    /// Sample precision of an EXR table [default: f16].
-    #[arg(long, value_enum)]
-    pub precision: Option<PrecisionArg>,
+    /// --format, --precision.
+    #[command(flatten)]
+    pub table: TableFormatArgs,
 
     /// --quiet, --force.
     #[command(flatten)]

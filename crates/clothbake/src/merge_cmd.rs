@@ -14,7 +14,7 @@ use clothbake_bake::shard::read_part;
 
 /// Runs the merge and returns the summary line for stdout (empty with --quiet).
 pub fn run(a: &MergeArgs) -> Result<String, CliError> {
-    let (format, precision) = output_format(a.format, Some(&a.output), a.precision)?;
+    let (format, precision) = output_format(a.table.format, Some(&a.output), a.table.precision)?;
     if a.output.file_name().is_none() {
         return Err(CliError::new(
             format!("the output {} does not name a file", a.output.display()),

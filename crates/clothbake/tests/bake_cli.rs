@@ -5,7 +5,7 @@ use std::process::{Command, Output};
 
 mod common;
 
-use common::fabric;
+use common::{fabric, fails_with, listing, succeeds, text};
 
 fn fresh_dir(name: &str) -> PathBuf {
     common::fresh_dir("bake-cli", name)
@@ -17,47 +17,6 @@ fn run_in(dir: &Path, args: &[&str]) -> Output {
         .current_dir(dir)
         .output()
         .expect("run the clothbake binary")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn succeeds(out: &Output) -> String {
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "stdout: {}\nstderr: {}",
-        text(&out.stdout),
-        text(&out.stderr)
-    );
-    text(&out.stdout)
-}
-
-/// Exit status `code`, nothing on stdout, one line `clothbake: ...` with every needle.
-fn fails_with(out: &Output, code: i32, needles: &[&str]) -> String {
-    let err = text(&out.stderr);
-    assert_eq!(out.status.code(), Some(code), "stderr: {err}");
-    assert!(out.stdout.is_empty(), "stdout: {}", text(&out.stdout));
-    assert!(
-        err.ends_with('\n') && err.lines().count() == 1,
-        "not one line: {err:?}"
-    );
-    assert!(err.starts_with("clothbake: "), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "{err:?} does not contain {n:?}");
-    }
-    err
-}
-
-/// The names in a folder, sorted (temporary files included).
-fn listing(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 const SMALL: &str = "4,8,4,8";

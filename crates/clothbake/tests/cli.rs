@@ -6,6 +6,8 @@ use std::process::{Command, Output};
 
 const TABLES: [&str; 6] = ["plain", "basket", "twill", "twill31", "satin5", "parallel"];
 
+mod common;
+
 fn table(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../tables")
@@ -36,22 +38,7 @@ fn temp_fabric(name: &str, text: &str) -> PathBuf {
 /// Asserts a failure: exit status 2, nothing on stdout, one line `clothbake: ...` on stderr
 /// containing every needle. Returns that line.
 fn fails(out: &Output, needles: &[&str]) -> String {
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert!(
-        out.stdout.is_empty(),
-        "stdout: {}",
-        String::from_utf8_lossy(&out.stdout)
-    );
-    assert!(
-        err.ends_with('\n') && err.lines().count() == 1,
-        "not one line: {err:?}"
-    );
-    assert!(err.starts_with("clothbake: "), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "{err:?} does not contain {n:?}");
-    }
-    err
+    common::fails_with(out, 2, needles)
 }
 
 fn rgb(v: &Value, key: &str) -> [f64; 3] {

@@ -6,7 +6,12 @@ use std::time::{Duration, Instant};
 
 mod common;
 
-use common::fabric;
+use common::{fabric, listing, succeeds, text};
+
+/// Exit status 2, one line `clothbake: ...` on stderr containing every needle.
+fn fails_with(out: &Output, needles: &[&str]) -> String {
+    common::fails_with(out, 2, needles)
+}
 
 fn fresh_dir(name: &str) -> PathBuf {
     common::fresh_dir("shards", name)
@@ -25,41 +30,6 @@ fn cmd(dir: &Path, args: &[&str]) -> Command {
 
 fn run_in(dir: &Path, args: &[&str]) -> Output {
     cmd(dir, args).output().expect("run the clothbake binary")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn succeeds(out: &Output) -> String {
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "stdout: {}\nstderr: {}",
-        text(&out.stdout),
-        text(&out.stderr)
-    );
-    text(&out.stdout)
-}
-
-/// Exit status 2, one line on stderr containing every needle.
-fn fails_with(out: &Output, needles: &[&str]) -> String {
-    let err = text(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert_eq!(err.lines().count(), 1, "not one line: {err:?}");
-    for n in needles {
-        assert!(err.contains(n), "{err:?} does not contain {n:?}");
-    }
-    err
-}
-
-fn listing(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 /// `clothbake diff A B --tol 0 --abs 0`: exit 0 and no value differs.

@@ -1,6 +1,8 @@
-//! Helpers shared by the tests that drive the `clothbake` binary.
+//! Helpers shared by the tests that drive the `clothbake` binary (each test file uses some).
+#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
+use std::process::Output;
 
 /// The absolute path of the shipped fabric `tables/<name>.json`.
 pub fn fabric(name: &str) -> String {
@@ -19,4 +21,48 @@ pub fn fresh_dir(prefix: &str, name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// Bytes as text (lossy).
+pub fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// Asserts exit status 0; returns stdout.
+pub fn succeeds(out: &Output) -> String {
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "stdout: {}\nstderr: {}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    text(&out.stdout)
+}
+
+/// Exit status `code`, nothing on stdout, one line `clothbake: ...` with every needle; returns
+/// that line.
+pub fn fails_with(out: &Output, code: i32, needles: &[&str]) -> String {
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "stderr: {err}");
+    assert!(out.stdout.is_empty(), "stdout: {}", text(&out.stdout));
+    assert!(
+        err.ends_with('\n') && err.lines().count() == 1,
+        "not one line: {err:?}"
+    );
+    assert!(err.starts_with("clothbake: "), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} does not contain {n:?}");
+    }
+    err
+}
+
+/// The names of the files in `dir`, sorted.
+pub fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
 }
