@@ -415,14 +415,9 @@ pub struct EvalArgs {
     #[arg(long, value_name = "S")]
     pub seed: Option<u64>,
 
-    /// Facet reflection model: the thesis's Phong-like terms or Lewis's modified Phong.
-    #[arg(long, value_enum, default_value_t = FacetArg::Huo)]
-    pub facet: FacetArg,
-
-    /// Analytic variant: eq. 3.6 on the rectangle top as printed (thesis) or averaged over the
-    /// arc's true heights (refined, the default; see docs/model.md).
-    #[arg(long, value_enum, default_value_t = VariantArg::Refined)]
-    pub variant: VariantArg,
+    /// --facet, --variant.
+    #[command(flatten)]
+    pub model: ModelArgs,
 
     /// Ray tracer: whether rays ending on a segment's flat end cap are averaged (shaded) or, like
     /// floor hits, left out (excluded, the default: the analytic model has no caps).
@@ -894,6 +889,19 @@ pub fn parse_tolerance(s: &str) -> Result<f64, String> {
     non_negative(s, "tolerance", "give a non-negative number, e.g. 1e-6")
 }
 
+/// The analytic model's facet terms and variant (eval, render, plot).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct ModelArgs {
+    /// Facet reflection model: the thesis's Phong-like terms or Lewis's modified Phong.
+    #[arg(long, value_enum, default_value_t = FacetArg::Huo)]
+    pub facet: FacetArg,
+
+    /// Analytic variant: eq. 3.6 on the rectangle top as printed (thesis) or averaged over the
+    /// arc's true heights (refined, the default; see docs/model.md).
+    #[arg(long, value_enum, default_value_t = VariantArg::Refined)]
+    pub variant: VariantArg,
+}
+
 /// Where the BRDF of `render` and `plot` comes from, and the model's options.
 #[derive(Args, Debug, Clone)]
 pub struct BrdfArgs {
@@ -905,13 +913,9 @@ pub struct BrdfArgs {
     #[arg(long, value_name = "TABLE")]
     pub table: Vec<PathBuf>,
 
-    /// With --weave: the facet reflection model.
-    #[arg(long, value_enum, default_value_t = FacetArg::Huo)]
-    pub facet: FacetArg,
-
-    /// With --weave: the analytic variant (see docs/model.md).
-    #[arg(long, value_enum, default_value_t = VariantArg::Refined)]
-    pub variant: VariantArg,
+    /// With --weave: --facet, --variant.
+    #[command(flatten)]
+    pub model: ModelArgs,
 
     /// With --weave: bounces and the secondary reflection's options (--bounces 2 is slow: about
     /// 0.5 ms a shading point).

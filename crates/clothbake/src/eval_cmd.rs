@@ -39,57 +39,55 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     let kernel = opts.kernel;
     let secondary = (args.bounces.bounces == 2).then_some(opts);
     let fabric = load_fabric(&args.weave, &args.draft, &args.material)?;
-    let facet = FacetModel::from(args.facet);
+    let facet = FacetModel::from(args.model.facet);
     let (wi, wo) = (args.wi.unit(), args.wo.unit());
     let horizon = !(args.wi.above_horizon() && args.wo.above_horizon());
 
-    let (reflection, raytrace) =
-        match args.method {
-            Method::Analytic => {
-                let r =
-                    if horizon {
-                        Reflection {
-                            secondary: secondary.map(|_| Secondary::default()),
-                            ..Reflection::default()
-                        }
-                    } else {
-                        AnalyticModel::with_variant(&fabric, facet, args.variant.into())
-                            .intensity_with(wi, wo, secondary.as_ref())
-                    };
-                (r, None)
-            }
-            Method::Raytrace => {
-                let samples = args.samples.unwrap_or(DEFAULT_SAMPLES);
-                let seed = args.seed.unwrap_or(DEFAULT_SEED);
-                let tracer = RayTracer::new(&fabric, facet).with_caps(args.caps.into());
-                let (r, std_err) = if horizon {
-                    (
-                        Reflection {
-                            secondary: secondary.map(|_| Secondary::default()),
-                            ..Reflection::default()
-                        },
-                        [0.0; 3],
-                    )
-                } else if args.bounces.bounces == 2 {
-                    // The path tracer: orders 1 and 2, I_2 split into its four components.
-                    let opts = PathOptions {
-                        max_bounces: 2,
-                        kernel,
-                        roulette_from: 9,
-                    };
-                    let p = tracer.render_paths(wi, wo, samples, seed, opts);
-                    let direct = tracer.render(wi, wo, samples, seed);
-                    let mut r = direct.reflection;
-                    r.secondary = Some(p.secondary);
-                    let err = std::array::from_fn(|c| direct.std_err[c].hypot(p.std_err[1][c]));
-                    (r, err)
-                } else {
-                    let est = tracer.render(wi, wo, samples, seed);
-                    (est.reflection, est.std_err)
+    let (reflection, raytrace) = match args.method {
+        Method::Analytic => {
+            let r = if horizon {
+                Reflection {
+                    secondary: secondary.map(|_| Secondary::default()),
+                    ..Reflection::default()
+                }
+            } else {
+                AnalyticModel::with_variant(&fabric, facet, args.model.variant.into())
+                    .intensity_with(wi, wo, secondary.as_ref())
+            };
+            (r, None)
+        }
+        Method::Raytrace => {
+            let samples = args.samples.unwrap_or(DEFAULT_SAMPLES);
+            let seed = args.seed.unwrap_or(DEFAULT_SEED);
+            let tracer = RayTracer::new(&fabric, facet).with_caps(args.caps.into());
+            let (r, std_err) = if horizon {
+                (
+                    Reflection {
+                        secondary: secondary.map(|_| Secondary::default()),
+                        ..Reflection::default()
+                    },
+                    [0.0; 3],
+                )
+            } else if args.bounces.bounces == 2 {
+                // The path tracer: orders 1 and 2, I_2 split into its four components.
+                let opts = PathOptions {
+                    max_bounces: 2,
+                    kernel,
+                    roulette_from: 9,
                 };
-                (r, Some(report::Raytrace { std_err, samples }))
-            }
-        };
+                let p = tracer.render_paths(wi, wo, samples, seed, opts);
+                let direct = tracer.render(wi, wo, samples, seed);
+                let mut r = direct.reflection;
+                r.secondary = Some(p.secondary);
+                let err = std::array::from_fn(|c| direct.std_err[c].hypot(p.std_err[1][c]));
+                (r, err)
+            } else {
+                let est = tracer.render(wi, wo, samples, seed);
+                (est.reflection, est.std_err)
+            };
+            (r, Some(report::Raytrace { std_err, samples }))
+        }
+    };
     let brdf = if horizon {
         [0.0; 3]
     } else {

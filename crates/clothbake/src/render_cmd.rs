@@ -31,8 +31,8 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
     let fabric = apply_material(Fabric::from_path(weave)?, &b.material)?;
     Shader::model(
         &fabric,
-        FacetModel::from(b.facet),
-        b.variant.into(),
+        FacetModel::from(b.model.facet),
+        b.model.variant.into(),
         secondary,
         component,
     )
