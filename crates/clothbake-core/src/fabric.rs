@@ -470,7 +470,7 @@ impl Fabric {
             if x > 0.0 && !(MIN_LENGTH..=MAX_LENGTH).contains(&x) {
                 Err(err(
                     naming.field(g, f, i),
-                    format!("is {x}, outside the lengths clothbake computes with ({MIN_LENGTH:e} to {MAX_LENGTH:e})"),
+                    format!("is {x:e}, outside the lengths clothbake computes with ({MIN_LENGTH:e} to {MAX_LENGTH:e})"),
                     "give every length in one unit between 1e-9 and 1e9 (only their ratios matter: e.g. millimetres)",
                 ))
             } else {
