@@ -274,6 +274,7 @@ impl<'a> OverC2<'a> {
     }
 
     /// The integral of the diffuse-diffuse part's cos^2 u (radiometric) or cos^3 u (thesis).
+    #[inline]
     fn cos_power(&self, a: AxialEnd, b: AxialEnd) -> f64 {
         match self.pair.kernel {
             Kernel::Radiometric => int_cos2(a, b),
@@ -283,6 +284,7 @@ impl<'a> OverC2<'a> {
 
     /// J(theta) times (N_i . E) r1: the inner double integral over C2 for the point of C1 at
     /// angle `t`.
+    #[inline]
     fn at(&self, t: f64) -> Parts {
         let (pair, s) = (self.pair, self.s);
         let mut acc = Parts::default();
@@ -329,6 +331,7 @@ impl<'a> OverC2<'a> {
     /// The generator line of C2 at angle `b` seen from P_i (normal `ni`, N_i . E = `ne`,
     /// position `pi_`): its integral ([`line_integral`]), none where the two do not face each
     /// other or C2 is not lit there. `own` holds the rule of a line of finite extent.
+    #[inline]
     fn line(
         &self,
         (ni, ne, pi_): (Vec3, f64, Vec3),

@@ -209,6 +209,7 @@ pub(super) struct Line {
 /// cos^2 u (radiometric kernel), a^2 c N_j.L / D times that of cos^3 u (thesis kernel); the
 /// three with a specular reflection by the nodes given. `cos_int` is that integral of cos^2 u
 /// or cos^3 u over the line's range. Returns the colourless parts per unit r2 dbeta.
+#[inline]
 pub(super) fn line_integral(
     pair: &Pair,
     s: &Setting,

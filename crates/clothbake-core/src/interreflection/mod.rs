@@ -146,6 +146,7 @@ pub struct Setting {
 }
 
 /// Normal at angle `t` in the cross-section (no axial component).
+#[inline]
 pub(super) fn normal(t: f64) -> Vec3 {
     let (s, c) = sin_cos(t);
     Vec3::new(c, 0.0, s)
