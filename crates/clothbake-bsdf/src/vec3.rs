@@ -15,18 +15,22 @@ pub struct Vec3 {
 
 impl Vec3 {
     /// Builds a vector from its components.
+    #[inline]
     pub const fn new(x: f64, y: f64, z: f64) -> Self {
         Self { x, y, z }
     }
     /// Dot product.
+    #[inline]
     pub fn dot(self, o: Vec3) -> f64 {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
     /// Euclidean length.
+    #[inline]
     pub fn length(self) -> f64 {
         self.dot(self).sqrt()
     }
     /// Cross product.
+    #[inline]
     pub fn cross(self, o: Vec3) -> Vec3 {
         Vec3::new(
             self.y * o.z - self.z * o.y,
@@ -35,6 +39,7 @@ impl Vec3 {
         )
     }
     /// True when every component is finite.
+    #[inline]
     pub fn is_finite(self) -> bool {
         self.x.is_finite() && self.y.is_finite() && self.z.is_finite()
     }
@@ -42,24 +47,28 @@ impl Vec3 {
 
 impl Add for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn add(self, o: Vec3) -> Vec3 {
         Vec3::new(self.x + o.x, self.y + o.y, self.z + o.z)
     }
 }
 impl Sub for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn sub(self, o: Vec3) -> Vec3 {
         Vec3::new(self.x - o.x, self.y - o.y, self.z - o.z)
     }
 }
 impl Mul<f64> for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn mul(self, s: f64) -> Vec3 {
         Vec3::new(self.x * s, self.y * s, self.z * s)
     }
 }
 impl Neg for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn neg(self) -> Vec3 {
         Vec3::new(-self.x, -self.y, -self.z)
     }
@@ -78,6 +87,7 @@ impl UnitVec3 {
     pub const Z: UnitVec3 = UnitVec3(Vec3::new(0.0, 0.0, 1.0));
 
     /// Normalises `v`; `None` for a zero-length or non-finite vector.
+    #[inline]
     pub fn new(v: Vec3) -> Option<Self> {
         let l = v.length();
         if !(l.is_finite() && l > 1e-300) {
@@ -87,6 +97,7 @@ impl UnitVec3 {
     }
 
     /// The direction at polar angle `theta` (from +Z) and azimuth `phi` (from +X toward +Y), radians.
+    #[inline]
     pub fn from_spherical(theta: f64, phi: f64) -> Self {
         let (st, ct) = theta.sin_cos();
         let (sp, cp) = phi.sin_cos();
@@ -94,37 +105,45 @@ impl UnitVec3 {
     }
 
     /// As [`UnitVec3::from_spherical`] with angles in degrees.
+    #[inline]
     pub fn from_degrees(theta_deg: f64, phi_deg: f64) -> Self {
         Self::from_spherical(theta_deg.to_radians(), phi_deg.to_radians())
     }
 
     /// The polar angle from +Z and the azimuth from +X (radians, azimuth in (-pi, pi]).
+    #[inline]
     pub fn to_spherical(self) -> (f64, f64) {
         (self.0.z.clamp(-1.0, 1.0).acos(), self.0.y.atan2(self.0.x))
     }
 
     /// The underlying vector.
+    #[inline]
     pub fn get(self) -> Vec3 {
         self.0
     }
     /// Cosine of the angle to the macro normal +Z.
+    #[inline]
     pub fn cos_theta(self) -> f64 {
         self.0.z
     }
     /// True when the direction is above the horizon: cos(theta) > [`HORIZON_COS`]. Directions at
     /// the horizon (theta = 90 degrees, whose cosine rounds to about 6e-17) count as below it.
+    #[inline]
     pub fn above_horizon(self) -> bool {
         self.0.z > HORIZON_COS
     }
     /// Mirror image under x -> -x.
+    #[inline]
     pub fn mirror_x(self) -> Self {
         UnitVec3(Vec3::new(-self.0.x, self.0.y, self.0.z))
     }
     /// Mirror image under y -> -y.
+    #[inline]
     pub fn mirror_y(self) -> Self {
         UnitVec3(Vec3::new(self.0.x, -self.0.y, self.0.z))
     }
     /// Rotation by +90 degrees about +Z: (x, y) -> (-y, x).
+    #[inline]
     pub fn rotate_z90(self) -> Self {
         UnitVec3(Vec3::new(-self.0.y, self.0.x, self.0.z))
     }
@@ -132,12 +151,14 @@ impl UnitVec3 {
 
 impl std::ops::Deref for UnitVec3 {
     type Target = Vec3;
+    #[inline]
     fn deref(&self) -> &Vec3 {
         &self.0
     }
 }
 
 /// The half vector of two unit directions, `None` when they are opposite.
+#[inline]
 pub fn half_vector(a: UnitVec3, b: UnitVec3) -> Option<UnitVec3> {
     UnitVec3::new(a.get() + b.get())
 }
