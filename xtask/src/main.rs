@@ -5,6 +5,8 @@
 //! * `ch5`: the comparisons of thesis sec. 5.4 (sphere, disk, convergence) into
 //!   `docs/interreflection-results.md`.
 //! * `figures`: the thesis's rendered scenes (Figs 4.5, 5.10, 5.11, 5.17) into `docs/figures/`.
+//! * `validate-spatial`: the model per crossing cell against the truth sorted into the same
+//!   cells, written to `docs/validation-spatial.md`.
 //! * `validate`: holds the analytic model against the ray-traced ground truth for every shipped
 //!   fabric and writes the error tables to `docs/validation.md`.
 //! * `golden`: bakes every shipped fabric (`tables/*.json`) at the golden grid into
@@ -23,6 +25,7 @@ use clothbake_bake::{bake, BakeOptions};
 mod ch5;
 mod figures;
 mod ir_accuracy;
+mod spatial;
 mod test;
 
 use clothbake_core::validate::{compare_with, direction_set, Report};
@@ -45,6 +48,7 @@ fn main() {
     match task.as_str() {
         "test" => test::run_all(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
         "validate" => validate(),
+        "validate-spatial" => spatial::run(&root()),
         "ch5" => ch5::run(&root()),
         "figures" => figures::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
         "golden" => golden(),
@@ -56,7 +60,7 @@ fn main() {
         "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask test [CARGO TEST ARGS] | validate | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
+                "usage: cargo xtask test [CARGO TEST ARGS] | validate | validate-spatial | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
             );
             std::process::exit(2);
         }
@@ -92,7 +96,8 @@ fn validate() {
          relative difference; noise is the ground truth's own mean relative standard error.\n\n\
          Facets: rho_d 0.4, rho_s 0.3, n 10 (sec. 4.3). `refined` and `thesis` are the analytic variants \
          (docs/model.md); `caps excluded` is the ground-truth convention the model is held to, `caps shaded` \
-         shows what flat yarn ends would add if they were averaged as yarn surface.\n"
+         shows what flat yarn ends would add if they were averaged as yarn surface. The same model resolved \
+         per crossing cell of the period: docs/validation-spatial.md (`cargo xtask validate-spatial`).\n"
     )
     .unwrap();
     for (bound, title) in [

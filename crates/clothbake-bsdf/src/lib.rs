@@ -40,11 +40,40 @@ impl BsdfSample {
     }
 }
 
+/// Where on the cloth a reflectance is looked up: a point of the weave period and the part of
+/// the period one pixel covers (docs/spatial.md).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footprint {
+    /// Fraction of the period along the weft (+X); any finite value, wrapped.
+    pub u: f64,
+    /// Fraction of the period along the warp (+Y); any finite value, wrapped.
+    pub v: f64,
+    /// Side of the square the pixel covers, in periods: 0 for a point, 1 or more for the whole
+    /// period (the averaged reflectance).
+    pub width: f64,
+}
+
 /// A bidirectional reflectance distribution: f_r, a sampler of incident directions and its
 /// density, on local-frame unit directions.
 pub trait Bsdf: Sync {
-    /// f_r(wi, wo) in 1/sr, RGB; zero when either direction is at or below the horizon.
+    /// f_r(wi, wo) in 1/sr, RGB; zero when either direction is at or below the horizon. For
+    /// cloth, the average over the weave period (eq. 4.11).
     fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb;
+
+    /// f_r seen through a footprint of the weave period: the coverage-weighted mean of the
+    /// local f_r over the footprint, which is [`Bsdf::f`] once the footprint spans the period.
+    /// The default is spatially uniform.
+    fn f_at(&self, at: Footprint, wi: UnitVec3, wo: UnitVec3) -> Rgb {
+        let _ = at;
+        self.f(wi, wo)
+    }
+
+    /// The share of the footprint's projected area seen from `wo` in which the eye meets yarn
+    /// (the rest shows what lies behind the cloth). The default is opaque: 1.
+    fn coverage_at(&self, at: Footprint, wo: UnitVec3) -> f64 {
+        let _ = (at, wo);
+        1.0
+    }
 
     /// Draws an incident direction for the outgoing `wo` from `u` in [0, 1)^2; `None` when
     /// there is none (`wo` below the horizon). The default draws cos(theta_i)-weighted

@@ -17,6 +17,7 @@
 //! 4. the area-weighted average I = sum D_i I_i / sum D_i S_v,i (eq. 4.11 and its pseudocode).
 
 use crate::arc::{diffuse_integral, huo_specular_integral, projected_width, Arc, Projected};
+use crate::cells::{Cell, CellGrid, PeriodPoint};
 use crate::fabric::{Fabric, Material};
 use crate::facet::{Facet, FacetModel};
 use crate::geometry::{equal_area_height, Geometry, Segment};
@@ -160,6 +161,48 @@ pub struct AnalyticModel {
     facet: FacetModel,
     variant: Variant,
     units: Vec<Unit>,
+    /// The period's crossing cells.
+    grid: CellGrid,
+    /// The unit each cell shows, by [`CellGrid::index`].
+    cell_units: Vec<u32>,
+}
+
+/// What the model answers at one point of the weave period (docs/spatial.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LocalReflection {
+    /// The intensity averaged over the visible yarn of the cell (eq. 4.11 restricted to the
+    /// cell's unit): f_r(x) = I / (pi cos theta_i). Zero where `coverage` is zero.
+    pub reflection: Reflection,
+    /// c(x; wo): the visible yarn's projected area over the cell per unit projected area of the
+    /// cell, seen from `wo` (0 where the eye sees no yarn).
+    pub coverage: f64,
+}
+
+/// What of a unit the eye sees.
+struct Visible {
+    /// The visible arc of the cross-section (above the floor, not self- or neighbour-hidden).
+    arc: Arc,
+    /// The interval along the axis the ends' occluders leave visible.
+    along: (f64, f64),
+    /// Visible length l_v within the piece.
+    l_v: f64,
+    /// Projected width of the visible arc, with |E_p|.
+    width: f64,
+    /// The eye direction projected on the cross-section plane.
+    ep: Projected,
+}
+
+/// A unit's share of eq. 4.11 for one pair of directions, before the multiplicity D_i.
+struct UnitTerms {
+    /// Visible length l_v along the axis (within the piece).
+    l_v: f64,
+    /// Projected width of the visible arc (with |E_p|): S_v = l_v * width (eq. 4.3).
+    width: f64,
+    /// Secondary reflection per unit visible length, when asked for.
+    secondary: Option<Secondary>,
+    /// Lit and visible length l_vi and the arc integrals of the facet's diffuse factor and
+    /// specular intensity (eqs 4.4-4.10); `None` where no point is both lit and visible.
+    lit: Option<(f64, f64, f64)>,
 }
 
 fn frame(g: Group) -> (Vec3, Vec3) {
@@ -303,6 +346,9 @@ impl AnalyticModel {
     /// and independent units with their multiplicities.
     pub fn with_variant(fabric: &Fabric, facet: FacetModel, variant: Variant) -> Self {
         let geo = Geometry::new(fabric);
+        let grid = CellGrid::new(&geo.warp_pos, geo.period.0, &geo.weft_pos, geo.period.1);
+        let (nx, ny) = grid.dims();
+        let mut cell_units = vec![u32::MAX; nx * ny];
         let mut units: Vec<(Vec<f64>, Unit)> = Vec::new();
         for seg in &geo.segments {
             let g = seg.group;
@@ -399,16 +445,25 @@ impl AnalyticModel {
                 let same = |k2: &Vec<f64>| {
                     k2.len() == key.len() && k2.iter().zip(&key).all(|(x, y)| (x - y).abs() < 1e-9)
                 };
-                match units.iter_mut().find(|(k2, _)| same(k2)) {
-                    Some((_, u)) => u.count += 1,
-                    None => units.push((key, unit)),
-                }
+                let index = match units.iter_mut().position(|(k2, _)| same(k2)) {
+                    Some(i) => {
+                        units[i].1.count += 1;
+                        i
+                    }
+                    None => {
+                        units.push((key, unit));
+                        units.len() - 1
+                    }
+                };
+                cell_units[grid.index(grid.crossing(g, seg.thread, k))] = index as u32;
             }
         }
         AnalyticModel {
             facet,
             variant,
             units: units.into_iter().map(|(_, u)| u).collect(),
+            grid,
+            cell_units,
         }
     }
 
@@ -462,44 +517,24 @@ impl AnalyticModel {
                 ..Reflection::default()
             };
         }
-        let (l, e) = (wi.get(), wo.get());
         let mut s_total = 0.0;
         let mut i_d = [0.0; 3];
         let mut i_s = 0.0;
         let mut i_2 = Secondary::default();
         for u in &self.units {
-            let seg = &u.seg;
-            let (c, a) = frame(seg.group);
-            let lp = Projected {
-                c: l.dot(c),
-                z: l.z,
-            };
-            let ep = Projected {
-                c: e.dot(c),
-                z: e.z,
-            };
-            let floor = Arc::above_floor(seg.radius, seg.height);
-            let vis = self.side_arc(u, ep).meet(floor);
-            let lit = self.side_arc(u, lp).meet(floor);
-            let vi = vis.meet(lit);
-            let vis_len = self.end_interval(u, e.dot(a), e.z, vis, ep);
-            let lit_len = self.end_interval(u, l.dot(a), l.z, vi, ep);
-            let l_v = overlap(u.range, vis_len);
-            if vis.is_empty() || l_v <= 0.0 {
+            let Some(t) = self.unit_terms(u, wi, wo, secondary) else {
                 continue;
-            }
+            };
             let d = u.count as f64;
-            s_total += d * l_v * projected_width(seg.radius, vis, ep);
-            if let Some(opts) = secondary {
-                i_2.add_scaled(&self.secondary(u, opts, l, e, vis, lit), d * l_v);
+            s_total += d * t.l_v * t.width;
+            if let Some(s) = &t.secondary {
+                i_2.add_scaled(s, d * t.l_v);
             }
-            let l_vi = overlap(u.range, meet(vis_len, lit_len));
-            if vi.is_empty() || l_vi <= 0.0 {
+            let Some((l_vi, kd, ks)) = t.lit else {
                 continue;
-            }
-            let w = d * l_vi * seg.radius;
-            let (kd, ks) = self.arc_integral(&seg.material, seg.group, vi, wi, wo, lp, ep);
-            for (acc, a) in i_d.iter_mut().zip(seg.material.albedo) {
+            };
+            let w = d * l_vi * u.seg.radius;
+            for (acc, a) in i_d.iter_mut().zip(u.seg.material.albedo) {
                 *acc += w * kd * a;
             }
             i_s += w * ks;
@@ -515,6 +550,144 @@ impl AnalyticModel {
             i_s: [i_s / s_total; 3],
             secondary: secondary.map(|_| i_2.scaled(1.0 / s_total)),
         }
+    }
+
+    /// What of unit `u` is visible from `e`: `None` where nothing is.
+    fn visible(&self, u: &Unit, e: Vec3) -> Option<Visible> {
+        let seg = &u.seg;
+        let (c, a) = frame(seg.group);
+        let ep = Projected {
+            c: e.dot(c),
+            z: e.z,
+        };
+        let floor = Arc::above_floor(seg.radius, seg.height);
+        let arc = self.side_arc(u, ep).meet(floor);
+        let along = self.end_interval(u, e.dot(a), e.z, arc, ep);
+        let l_v = overlap(u.range, along);
+        if arc.is_empty() || l_v <= 0.0 {
+            return None;
+        }
+        Some(Visible {
+            arc,
+            along,
+            l_v,
+            width: projected_width(seg.radius, arc, ep),
+            ep,
+        })
+    }
+
+    /// Unit `u`'s terms of eq. 4.11 (and of I_2 with `secondary`) for light from `wi` seen
+    /// from `wo`, both above the horizon: `None` where nothing of it is visible.
+    fn unit_terms(
+        &self,
+        u: &Unit,
+        wi: UnitVec3,
+        wo: UnitVec3,
+        secondary: Option<&SecondaryOptions>,
+    ) -> Option<UnitTerms> {
+        let (l, e) = (wi.get(), wo.get());
+        let seg = &u.seg;
+        let v = self.visible(u, e)?;
+        let (c, a) = frame(seg.group);
+        let lp = Projected {
+            c: l.dot(c),
+            z: l.z,
+        };
+        let lit = self
+            .side_arc(u, lp)
+            .meet(Arc::above_floor(seg.radius, seg.height));
+        let vi = v.arc.meet(lit);
+        let lit_len = self.end_interval(u, l.dot(a), l.z, vi, v.ep);
+        let secondary = secondary.map(|opts| self.secondary(u, opts, l, e, v.arc, lit));
+        let l_vi = overlap(u.range, meet(v.along, lit_len));
+        let lit = (!vi.is_empty() && l_vi > 0.0).then(|| {
+            let (kd, ks) = self.arc_integral(&seg.material, seg.group, vi, wi, wo, lp, v.ep);
+            (l_vi, kd, ks)
+        });
+        Some(UnitTerms {
+            l_v: v.l_v,
+            width: v.width,
+            secondary,
+            lit,
+        })
+    }
+
+    /// The period's crossing cells.
+    pub fn cells(&self) -> &CellGrid {
+        &self.grid
+    }
+
+    /// The reflection at point `at` of the period (docs/spatial.md): eq. 4.11 restricted to the
+    /// unit over the cell containing `at`, with the cell's coverage. The coverage-weighted mean
+    /// over the period of the local reflection is [`AnalyticModel::intensity_with`].
+    pub fn intensity_at(
+        &self,
+        wi: UnitVec3,
+        wo: UnitVec3,
+        at: PeriodPoint,
+        secondary: Option<&SecondaryOptions>,
+    ) -> LocalReflection {
+        self.intensity_in(wi, wo, self.grid.cell_at(at), secondary)
+    }
+
+    /// As [`AnalyticModel::intensity_at`], for a cell.
+    pub fn intensity_in(
+        &self,
+        wi: UnitVec3,
+        wo: UnitVec3,
+        cell: Cell,
+        secondary: Option<&SecondaryOptions>,
+    ) -> LocalReflection {
+        let empty = LocalReflection {
+            reflection: Reflection {
+                secondary: secondary.map(|_| Secondary::default()),
+                ..Reflection::default()
+            },
+            coverage: 0.0,
+        };
+        if !(wi.above_horizon() && wo.above_horizon()) {
+            return empty;
+        }
+        let u = &self.units[self.cell_units[self.grid.index(cell)] as usize];
+        let Some(t) = self.unit_terms(u, wi, wo, secondary) else {
+            return empty;
+        };
+        let s_v = t.l_v * t.width;
+        let (px, py) = self.grid.period();
+        let coverage = s_v / (self.grid.area_fraction(cell) * px * py * wo.cos_theta());
+        let (i_d, i_s) = match t.lit {
+            Some((l_vi, kd, ks)) => {
+                let w = l_vi * u.seg.radius / s_v;
+                (u.seg.material.albedo.map(|a| w * kd * a), [w * ks; 3])
+            }
+            None => ([0.0; 3], [0.0; 3]),
+        };
+        LocalReflection {
+            reflection: Reflection {
+                i_d,
+                i_s,
+                secondary: t.secondary.map(|s| s.scaled(1.0 / t.width)),
+            },
+            coverage,
+        }
+    }
+
+    /// The directional coverage C(wo): the period mean of the coverage, the visible yarn's
+    /// projected area per unit projected area of the period (0 below the horizon).
+    pub fn coverage(&self, wo: UnitVec3) -> f64 {
+        if !wo.above_horizon() {
+            return 0.0;
+        }
+        let s: f64 = self
+            .units
+            .iter()
+            .filter_map(|u| {
+                let v = self.visible(u, wo.get())?;
+                Some(u.count as f64 * v.l_v * v.width)
+            })
+            .sum();
+        let (px, py) = self.grid.period();
+        s / (px * py * wo.cos_theta())
     }
 
     /// Secondary reflection reaching the eye from the visible arc of unit `u`, per unit length,

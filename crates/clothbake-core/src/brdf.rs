@@ -4,8 +4,9 @@
 //! export, pictures and Python all evaluate the model through it.
 
 use crate::analytic::{AnalyticModel, SecondaryOptions};
+use crate::cells::{Cell, PeriodPoint};
 use crate::reflect::{intensity_to_brdf, Reflection};
-use clothbake_bsdf::{Bsdf, Rgb, UnitVec3};
+use clothbake_bsdf::{Bsdf, Footprint, Rgb, UnitVec3};
 
 /// Which part of the model's reflection an [`AnalyticBsdf`] returns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -82,12 +83,73 @@ impl AnalyticBsdf {
     }
 }
 
+impl AnalyticBsdf {
+    /// The cells a footprint covers with their shares of the period's area; `None` once it
+    /// spans the whole period (or is not finite).
+    fn cells_under(&self, at: Footprint) -> Option<Vec<(Cell, f64)>> {
+        let p = PeriodPoint::new(at.u, at.v)?;
+        let grid = self.model.cells();
+        if at.width >= 1.0 || at.width.is_nan() {
+            return None;
+        }
+        if at.width <= 0.0 {
+            return Some(vec![(grid.cell_at(p), 1.0)]);
+        }
+        Some(grid.overlaps(p, at.width))
+    }
+}
+
 impl Bsdf for AnalyticBsdf {
     fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb {
         if !(wi.above_horizon() && wo.above_horizon()) {
             return [0.0; 3];
         }
         intensity_to_brdf(self.component.of(&self.intensity(wi, wo)), wi)
+    }
+
+    /// The box filter over the footprint of the cells' f_r (thesis units, docs/spatial.md),
+    /// weighted by area times coverage; [`Bsdf::f`] at a footprint of a period or more.
+    fn f_at(&self, at: Footprint, wi: UnitVec3, wo: UnitVec3) -> Rgb {
+        if !(wi.above_horizon() && wo.above_horizon()) {
+            return [0.0; 3];
+        }
+        let Some(cells) = self.cells_under(at) else {
+            return self.f(wi, wo);
+        };
+        let (mut num, mut den) = ([0.0; 3], 0.0);
+        for (cell, share) in cells {
+            let l = self
+                .model
+                .intensity_in(wi, wo, cell, self.secondary.as_ref());
+            let i = self.component.of(&l.reflection);
+            let w = share * l.coverage;
+            for k in 0..3 {
+                num[k] += w * i[k];
+            }
+            den += w;
+        }
+        if den <= 0.0 {
+            return [0.0; 3];
+        }
+        intensity_to_brdf(num.map(|x| x / den), wi)
+    }
+
+    fn coverage_at(&self, at: Footprint, wo: UnitVec3) -> f64 {
+        let Some(cells) = self.cells_under(at) else {
+            return self.model.coverage(wo);
+        };
+        let total: f64 = cells.iter().map(|c| c.1).sum();
+        cells
+            .iter()
+            .map(|&(cell, share)| {
+                share
+                    * self
+                        .model
+                        .intensity_in(UnitVec3::Z, wo, cell, None)
+                        .coverage
+            })
+            .sum::<f64>()
+            / total
     }
 }
 
@@ -121,6 +183,48 @@ mod tests {
             let want = i[k] / (std::f64::consts::PI * wi.cos_theta());
             assert!(f[k] > 0.0 && (f[k] - want).abs() <= 1e-15 * want, "{f:?}");
         }
+    }
+
+    #[test]
+    fn footprints_filter_between_a_cell_and_the_period() {
+        let b = AnalyticBsdf::new(shipped("twill"), None);
+        let (wi, wo) = (
+            UnitVec3::from_degrees(60.0, 0.0),
+            UnitVec3::from_degrees(20.0, 180.0),
+        );
+        let at = |u, v, width| Footprint { u, v, width };
+        // A footprint of a period or more is the average, wherever it lies.
+        assert_eq!(b.f_at(at(0.3, 0.7, 1.0), wi, wo), b.f(wi, wo));
+        assert_eq!(b.coverage_at(at(0.3, 0.7, 2.0), wo), b.model().coverage(wo));
+        // A point, or a footprint inside one cell, is that cell's unit.
+        let cell = b
+            .model()
+            .intensity_in(wi, wo, Cell { warp: 0, weft: 0 }, None);
+        let f = intensity_to_brdf(cell.reflection.total(), wi);
+        assert_eq!(b.f_at(at(0.0, 0.0, 0.0), wi, wo), f);
+        let small = b.f_at(at(0.01, 0.02, 0.05), wi, wo);
+        assert!((0..3).all(|k| (small[k] - f[k]).abs() <= 1e-15 * f[k]));
+        // A footprint just under the period approaches the average.
+        let near = b.f_at(at(0.37, 0.61, 0.999), wi, wo);
+        let avg = b.f(wi, wo);
+        assert!((near[0] - avg[0]).abs() < 0.01 * avg[0], "{near:?} {avg:?}");
+        // Between them, the value lies between the cells' extremes.
+        let cells: Vec<f64> = (0..9)
+            .map(|k| {
+                let c = Cell {
+                    warp: k % 3,
+                    weft: k / 3,
+                };
+                intensity_to_brdf(
+                    b.model().intensity_in(wi, wo, c, None).reflection.total(),
+                    wi,
+                )[0]
+            })
+            .collect();
+        let mid = b.f_at(at(0.2, 0.4, 0.5), wi, wo)[0];
+        let lo = cells.iter().cloned().fold(f64::INFINITY, f64::min);
+        let hi = cells.iter().cloned().fold(0.0, f64::max);
+        assert!(lo <= mid && mid <= hi && lo < hi);
     }
 
     #[test]

@@ -10,6 +10,7 @@
 pub mod analytic;
 pub mod arc;
 pub mod brdf;
+pub mod cells;
 pub mod fabric;
 pub mod facet;
 pub mod geometry;
@@ -28,9 +29,10 @@ pub mod weave;
 pub mod wif;
 pub mod yarn;
 
-pub use analytic::{AnalyticModel, SecondaryMethod, SecondaryOptions, Variant};
+pub use analytic::{AnalyticModel, LocalReflection, SecondaryMethod, SecondaryOptions, Variant};
 pub use brdf::{AnalyticBsdf, Component};
-pub use clothbake_bsdf::{vec3, Bsdf, BsdfSample, FromFn, Rgb};
+pub use cells::{Cell, CellGrid, PeriodPoint};
+pub use clothbake_bsdf::{vec3, Bsdf, BsdfSample, Footprint, FromFn, Rgb};
 pub use fabric::{Fabric, FabricError, Field, Naming, PlainNaming};
 pub use facet::{Facet, FacetIntensity, FacetModel};
 pub use geometry::Geometry;

@@ -1,10 +1,10 @@
 //! `clothbake.Fabric`: a validated fabric description and its BRDF from the analytic model
 //! (thesis ch. 3-4, ch. 5 with two bounces) or the ray-traced ground truth.
 
-use crate::vectors::{check_unit, same_len, to_array, unit_rows};
+use crate::vectors::{check_unit, rows, same_len, to_array, to_array1, unit_rows};
 use clothbake_core::{
-    intensity_to_brdf, AnalyticModel, Fabric, FacetModel, RayTracer, Reflection, SecondaryOptions,
-    UnitVec3, Vec3,
+    intensity_to_brdf, AnalyticModel, Fabric, FacetModel, LocalReflection, PeriodPoint, RayTracer,
+    Reflection, SecondaryOptions, UnitVec3, Vec3,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -121,8 +121,12 @@ impl PyFabric {
     /// bounces: 1, or 2 to add the secondary reflection (thesis ch. 5; analytic only).
     /// facet: "huo" (default, eqs 4.6 and 4.8) or "lewis" (energy conserving).
     /// split: also return the diffuse, specular and secondary parts, each as f_r in 1/sr.
+    /// uv: points of the weave period, (N, 2) or (2,), in period fractions (u along the weft
+    /// +X, v along the warp +Y, any finite numbers, wrapped; analytic only): f_r of the yarn
+    /// over that crossing instead of the period's average (docs/spatial.md); with `split=True`
+    /// the dict also holds "coverage", c(x; wo) per row.
     /// Returns an (N, 3) float64 array, or a dict of them with `split=True`.
-    #[pyo3(signature = (wi, wo, method="analytic", bounces=1, facet="huo", split=false, samples=100_000, seed=1))]
+    #[pyo3(signature = (wi, wo, method="analytic", bounces=1, facet="huo", split=false, samples=100_000, seed=1, uv=None))]
     #[allow(clippy::too_many_arguments)]
     fn eval<'py>(
         &self,
@@ -135,12 +139,38 @@ impl PyFabric {
         split: bool,
         samples: usize,
         seed: u64,
+        uv: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let facet = facet_model(facet)?;
         check_bounces(bounces)?;
         let wi = unit_rows("wi", wi)?;
         let wo = unit_rows("wo", wo)?;
         same_len(("wi", wi.rows.len()), ("wo", wo.rows.len()))?;
+        let at = match uv {
+            None => None,
+            Some(obj) => {
+                if method != "analytic" {
+                    return Err(PyValueError::new_err(
+                        "uv: points of the period are evaluated by the analytic model only; drop uv or use method=\"analytic\"",
+                    ));
+                }
+                let r = rows::<2>("uv", obj)?;
+                same_len(("wi", wi.rows.len()), ("uv", r.rows.len()))?;
+                let pts = r
+                    .rows
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &[u, v])| {
+                        PeriodPoint::new(u, v).ok_or_else(|| {
+                            PyValueError::new_err(format!(
+                                "uv: row {i} is ({u}, {v}); give finite period fractions"
+                            ))
+                        })
+                    })
+                    .collect::<PyResult<Vec<_>>>()?;
+                Some(pts)
+            }
+        };
         let secondary = (bounces == 2).then(SecondaryOptions::default);
         let pairs: Vec<(UnitVec3, UnitVec3)> = wi
             .rows
@@ -148,8 +178,25 @@ impl PyFabric {
             .zip(&wo.rows)
             .map(|(&a, &b)| (unit(a), unit(b)))
             .collect();
-        let out: Vec<[[f64; 3]; 4]> = match method {
-            "analytic" => {
+        let mut coverage = Vec::new();
+        let out: Vec<[[f64; 3]; 4]> = match (method, &at) {
+            ("analytic", Some(at)) => {
+                let m = self.model(facet);
+                let local: Vec<LocalReflection> = py.detach(|| {
+                    pairs
+                        .par_iter()
+                        .zip(at)
+                        .map(|(&(a, b), &p)| m.intensity_at(a, b, p, secondary.as_ref()))
+                        .collect()
+                });
+                coverage = local.iter().map(|l| l.coverage).collect();
+                local
+                    .iter()
+                    .zip(&pairs)
+                    .map(|(l, &(a, _))| parts(&l.reflection, a))
+                    .collect()
+            }
+            ("analytic", None) => {
                 let m = self.model(facet);
                 py.detach(|| {
                     pairs
@@ -158,7 +205,7 @@ impl PyFabric {
                         .collect()
                 })
             }
-            "raytrace" => {
+            ("raytrace", _) => {
                 if bounces != 1 {
                     return Err(PyValueError::new_err(
                         "bounces: the ray tracer here gives the direct reflection only; use bounces=1 with method=\"raytrace\"",
@@ -176,7 +223,7 @@ impl PyFabric {
                         .collect()
                 })
             }
-            other => {
+            (other, _) => {
                 return Err(PyValueError::new_err(format!(
                     "method: {other:?}; use \"analytic\" or \"raytrace\""
                 )))
@@ -193,6 +240,12 @@ impl PyFabric {
             .enumerate()
         {
             d.set_item(PyString::new(py, name), to_array(py, &part(k), single)?)?;
+        }
+        if at.is_some() {
+            d.set_item(
+                PyString::new(py, "coverage"),
+                to_array1(py, coverage, single)?,
+            )?;
         }
         Ok(d.into_any())
     }

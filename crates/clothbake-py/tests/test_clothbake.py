@@ -48,6 +48,31 @@ def test_split_terms_add_up_and_horizon_is_zero(twill_path):
     np.testing.assert_array_equal(fab.eval(below, wo[:1]), 0.0)
 
 
+def test_points_of_the_period_average_to_the_period(twill_path):
+    """docs/spatial.md: the coverage-weighted mean of f_r over the period is the average."""
+    fab = clothbake.Fabric(twill_path)
+    n = 30  # 10 x 10 points in each of the twill's 3 x 3 equal cells
+    u, v = np.meshgrid((np.arange(n) + 0.5) / n, (np.arange(n) + 0.5) / n)
+    uv = np.stack([u.ravel(), v.ravel()], axis=-1)
+    wi = np.repeat(dirs([60], [0]), len(uv), axis=0)
+    wo = np.repeat(dirs([20], [180]), len(uv), axis=0)
+    s = fab.eval(wi, wo, uv=uv, split=True)
+    c = s["coverage"]
+    # Light is attributed where the yarn lies, so a yarn seen over a neighbour's cell can
+    # exceed 1 slightly (docs/spatial.md); the period mean cannot exceed 1 here.
+    assert c.shape == (len(uv),) and (c > 0).all() and (c < 1.05).all() and c.mean() <= 1.0
+    mean = (c[:, None] * s["brdf"]).sum(axis=0) / c.sum()
+    np.testing.assert_allclose(mean, fab.eval(wi[:1], wo[:1])[0], rtol=1e-9)
+    # Warp floats and weft floats differ; a whole period away is the same point.
+    f = fab.eval(wi[:2], wo[:2], uv=np.array([[0.0, 0.0], [0.7, 0.05]]))
+    assert abs(f[0, 0] - f[1, 0]) > 0.1 * f[0, 0]
+    np.testing.assert_array_equal(fab.eval(wi[0], wo[0], uv=np.array([-3.0, 2.0])), f[0])
+    with pytest.raises(ValueError, match="uv"):
+        fab.eval(wi[:1], wo[:1], uv=np.array([[np.nan, 0.0]]))
+    with pytest.raises(ValueError, match="uv"):
+        fab.eval(wi[:1], wo[:1], uv=np.array([[0.0, 0.0]]), method="raytrace")
+
+
 def test_brdf_is_linear_in_the_albedo(twill_path):
     """With Lewis facets and no specular part f_r is linear in each channel's albedo:
     f(rho) = rho f(1), channel by channel."""

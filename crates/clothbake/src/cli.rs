@@ -437,10 +437,18 @@ pub struct EvalArgs {
     #[command(flatten)]
     pub draft: DraftArgs,
 
+    /// A point of the weave period, U,V in period fractions (U along the weft +X, V along the
+    /// warp +Y; any finite numbers, wrapped): the reflection of the yarn over that crossing
+    /// instead of the period's average, with its coverage (docs/spatial.md). Analytic only.
+    #[arg(long, value_name = "U,V", value_parser = parse_period_point, allow_hyphen_values = true)]
+    pub at: Option<clothbake_core::PeriodPoint>,
+
     /// Print one JSON object instead of a table: keys I_d, I_s, I (reflected intensity for unit
     /// incident intensity) and brdf (1/sr), each [r, g, b]; with --bounces 2 also I_ss, I_sd,
     /// I_ds, I_dd and I_2 (I is then I_1 + I_2); raytrace adds std_err ([r, g, b], null when
-    /// too few samples to estimate it) and samples.
+    /// too few samples to estimate it) and samples; the analytic model adds
+    /// directional_coverage, and with --at also at ([u, v]), cell ([warp, weft]), on_top ("warp"
+    /// or "weft") and coverage.
     #[arg(long)]
     pub json: bool,
 }
@@ -746,6 +754,21 @@ pub fn parse_direction(s: &str) -> Result<Direction, String> {
         ));
     }
     Ok(Direction { theta, phi })
+}
+
+/// Parses a point of the weave period, `U,V` in period fractions.
+pub fn parse_period_point(s: &str) -> Result<clothbake_core::PeriodPoint, String> {
+    const FIX: &str = "write U,V in fractions of the weave period, e.g. 0.25,0.5 (U along the weft +X, V along the warp +Y)";
+    let parts: Vec<&str> = s.split(',').collect();
+    let [u, v] = parts.as_slice() else {
+        return Err(format!(
+            "expected two numbers separated by a comma, found {}; {FIX}",
+            parts.len()
+        ));
+    };
+    let u = number(u, "U").map_err(|e| format!("{e}; {FIX}"))?;
+    let v = number(v, "V").map_err(|e| format!("{e}; {FIX}"))?;
+    clothbake_core::PeriodPoint::new(u, v).ok_or_else(|| format!("U and V must be finite; {FIX}"))
 }
 
 /// Parses a positive sample count.

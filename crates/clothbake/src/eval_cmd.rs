@@ -36,6 +36,13 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
             format!("drop {flag} or use --method analytic"),
         ));
     }
+    if args.at.is_some() && args.method == Method::Raytrace {
+        return Err(CliError::new(
+            "--at evaluates the analytic model at a point of the period; the ray tracer \
+             answers only the period's average here",
+            "drop --at or --method raytrace",
+        ));
+    }
     let kernel = opts.kernel;
     let secondary = (args.bounces.bounces == 2).then_some(opts);
     let fabric = load_fabric(&args.weave, &args.draft, &args.material)?;
@@ -43,17 +50,39 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     let (wi, wo) = (args.wi.unit(), args.wo.unit());
     let horizon = !(args.wi.above_horizon() && args.wo.above_horizon());
 
+    let mut local = None;
     let (reflection, raytrace) = match args.method {
         Method::Analytic => {
+            let model = AnalyticModel::with_variant(&fabric, facet, args.model.variant.into());
+            let coverage = if horizon { 0.0 } else { model.coverage(wo) };
             let r = if horizon {
                 Reflection {
                     secondary: secondary.map(|_| Secondary::default()),
                     ..Reflection::default()
                 }
+            } else if let Some(at) = args.at {
+                model
+                    .intensity_at(wi, wo, at, secondary.as_ref())
+                    .reflection
             } else {
-                AnalyticModel::with_variant(&fabric, facet, args.model.variant.into())
-                    .intensity_with(wi, wo, secondary.as_ref())
+                model.intensity_with(wi, wo, secondary.as_ref())
             };
+            local = Some(report::Local {
+                directional_coverage: coverage,
+                warp_on_top: args.at.is_some_and(|at| {
+                    let cell = model.cells().cell_at(at);
+                    fabric.weave().warp_over(cell.warp, cell.weft)
+                }),
+                at: args.at.map(|at| {
+                    let cell = model.cells().cell_at(at);
+                    let c = if horizon {
+                        0.0
+                    } else {
+                        model.intensity_at(wi, wo, at, None).coverage
+                    };
+                    (at, cell, c)
+                }),
+            });
             (r, None)
         }
         Method::Raytrace => {
@@ -104,6 +133,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
         reflection,
         brdf,
         raytrace,
+        local,
     };
     Ok(if args.json { rep.json() } else { rep.table() })
 }

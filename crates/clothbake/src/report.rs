@@ -1,7 +1,7 @@
 //! Output of `clothbake eval`: one JSON object (`--json`) or a short table.
 
 use crate::cli::{Direction, Method};
-use clothbake_core::{FacetModel, Reflection};
+use clothbake_core::{Cell, FacetModel, PeriodPoint, Reflection};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -14,6 +14,17 @@ pub struct Raytrace {
     pub std_err: [f64; 3],
     /// Number of samples asked for.
     pub samples: usize,
+}
+
+/// Coverage of the analytic model (docs/spatial.md).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Local {
+    /// C(wo): the visible yarn's projected area per unit projected area of the period.
+    pub directional_coverage: f64,
+    /// With `--at`: the point, its crossing cell and the coverage c(x; wo) there.
+    pub at: Option<(PeriodPoint, Cell, f64)>,
+    /// With `--at`: whether the warp thread lies on top at that crossing.
+    pub warp_on_top: bool,
 }
 
 /// Everything one evaluation prints.
@@ -39,6 +50,8 @@ pub struct Report<'a> {
     pub brdf: [f64; 3],
     /// Present for `--method raytrace`.
     pub raytrace: Option<Raytrace>,
+    /// Present for the analytic model.
+    pub local: Option<Local>,
 }
 
 impl Report<'_> {
@@ -60,6 +73,15 @@ impl Report<'_> {
         if let Some(rt) = &self.raytrace {
             v["std_err"] = json!(rt.std_err);
             v["samples"] = json!(rt.samples);
+        }
+        if let Some(l) = &self.local {
+            v["directional_coverage"] = json!(l.directional_coverage);
+            if let Some((p, cell, c)) = l.at {
+                v["at"] = json!([p.u(), p.v()]);
+                v["cell"] = json!([cell.warp, cell.weft]);
+                v["on_top"] = json!(if l.warp_on_top { "warp" } else { "weft" });
+                v["coverage"] = json!(c);
+            }
         }
         let mut s = v.to_string();
         s.push('\n');
@@ -87,6 +109,21 @@ impl Report<'_> {
             "wo      theta {:6.2}  phi {:7.2}  (toward the eye, degrees)",
             self.wo.theta, self.wo.phi
         );
+        if let Some(l) = self.local {
+            if let Some((p, cell, _)) = l.at {
+                let (top, under) = if l.warp_on_top {
+                    (format!("warp {}", cell.warp), format!("weft {}", cell.weft))
+                } else {
+                    (format!("weft {}", cell.weft), format!("warp {}", cell.warp))
+                };
+                let _ = writeln!(
+                    s,
+                    "at      u {:.6}  v {:.6}  (period fractions): {top} over {under}",
+                    p.u(),
+                    p.v(),
+                );
+            }
+        }
         if self.horizon {
             let _ = writeln!(
                 s,
@@ -112,6 +149,16 @@ impl Report<'_> {
         }
         row(&mut s, "I", self.reflection.total(), "");
         row(&mut s, "brdf", self.brdf, "  1/sr");
+        if let Some(l) = &self.local {
+            if let Some((_, _, c)) = l.at {
+                let _ = writeln!(s, "coverage {c:.6}  (visible yarn over the cell)");
+            }
+            let _ = writeln!(
+                s,
+                "coverage {:.6}  (directional: visible yarn over the period)",
+                l.directional_coverage
+            );
+        }
         if let Some(rt) = &self.raytrace {
             row(
                 &mut s,

@@ -86,7 +86,13 @@ fn json_output_has_the_documented_keys_and_is_consistent() {
                 &table(name),
                 &["--wi", "40,90", "--wo", "30,250", "--facet", facet],
             );
-            assert_eq!(keys(&v), ["I", "I_d", "I_s", "brdf"], "{v}");
+            assert_eq!(
+                keys(&v),
+                ["I", "I_d", "I_s", "brdf", "directional_coverage"],
+                "{v}"
+            );
+            let c = v["directional_coverage"].as_f64().unwrap();
+            assert!(c > 0.0 && c <= 1.05, "{name}: {v}");
             let (d, s, i, f) = (
                 rgb(&v, "I_d"),
                 rgb(&v, "I_s"),
@@ -716,4 +722,60 @@ fn draft_size_flags_only_with_a_draft() {
         ),
         &["--radius"],
     );
+}
+
+#[test]
+fn eval_at_a_point_of_the_period() {
+    let twill = table("twill");
+    let dirs = ["--wi", "60,0", "--wo", "20,180"];
+    let at = |p: &str| {
+        let mut a = dirs.to_vec();
+        a.extend(["--at", p]);
+        eval_json(&twill, &a)
+    };
+    // Row 0 of the twill's pattern is 1,1,0: warp 0 lies over weft 0, weft 0 over warp 2.
+    let warp = at("0,0");
+    assert_eq!(warp["cell"], serde_json::json!([0, 0]));
+    assert_eq!(warp["on_top"], "warp");
+    let weft = at("0.7,0.05");
+    assert_eq!(weft["cell"], serde_json::json!([2, 0]));
+    assert_eq!(weft["on_top"], "weft");
+    let (a, b) = (rgb(&warp, "brdf")[0], rgb(&weft, "brdf")[0]);
+    assert!((a - b).abs() > 0.1 * a, "{a} vs {b}");
+    // Points wrap: a whole period away is the same point.
+    assert_eq!(at("-3,2")["brdf"], warp["brdf"]);
+    // Coverage in (0, 1] here; the directional coverage is the same at every point and is
+    // reported without --at too.
+    let c = warp["coverage"].as_f64().unwrap();
+    assert!(c > 0.5 && c <= 1.0, "{c}");
+    let avg = eval_json(&twill, &dirs);
+    assert_eq!(avg["directional_coverage"], warp["directional_coverage"]);
+    assert!(avg.get("coverage").is_none());
+    let text = succeeds_text(&eval(
+        &twill,
+        &["--wi", "60,0", "--wo", "20,180", "--at", "0.7,0.05"],
+    ));
+    assert!(text.contains("weft 0 over warp 2"), "{text}");
+    // Bad points and the ray tracer are refused in one line.
+    fails(
+        &eval(&twill, &["--wi", "0,0", "--wo", "0,0", "--at", "nan,0"]),
+        &["--at", "finite"],
+    );
+    fails(
+        &eval(&twill, &["--wi", "0,0", "--wo", "0,0", "--at", "0.5"]),
+        &["--at", "U,V"],
+    );
+    fails(
+        &eval(
+            &twill,
+            &[
+                "--wi", "0,0", "--wo", "0,0", "--at", "0,0", "--method", "raytrace",
+            ],
+        ),
+        &["--at", "drop"],
+    );
+}
+
+fn succeeds_text(out: &Output) -> String {
+    common::succeeds(out)
 }

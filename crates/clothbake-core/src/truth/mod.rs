@@ -13,6 +13,7 @@
 //! * [`cells`]: the acceleration cells over one period and the walk over the tiling;
 //! * [`estimate`]: the batch ratio estimator and its standard error;
 //! * [`raytracer`]: [`RayTracer`], the direct reflection (eq. 4.11's average);
+//! * [`patches`]: the same estimate resolved per crossing cell of the period;
 //! * [`pathtracer`]: [`PathOptions`], [`PathEstimate`], every bounce order.
 //!
 //! Imports from the rest of the crate are limited to `crate::vec3`, `crate::rng`,
@@ -26,6 +27,7 @@ pub mod description;
 pub mod estimate;
 pub mod facets;
 pub mod intersect;
+pub mod patches;
 pub mod pathtracer;
 pub mod raytracer;
 pub mod yarns;
@@ -33,6 +35,7 @@ pub mod yarns;
 pub use description::{Description, Finish, Thread};
 pub use estimate::{Estimate, BATCHES};
 pub use facets::{Shading, Terms};
+pub use patches::CellEstimate;
 pub use pathtracer::{PathEstimate, PathOptions};
 pub use raytracer::{Caps, RayTracer};
 pub use yarns::{Cylinder, Yarns};

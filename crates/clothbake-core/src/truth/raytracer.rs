@@ -208,16 +208,16 @@ impl RayTracer {
     }
 
     /// Shading of one primary ray from `o` along `-wo`: `None` for an uncounted hit, otherwise
-    /// the facet intensity at the first yarn hit (zero when shadowed) and its segment.
-    fn shade(&self, o: Vec3, wi: UnitVec3, wo: UnitVec3) -> Option<(Shading, u32)> {
+    /// the facet intensity at the first yarn hit (zero when shadowed) and the hit.
+    pub(crate) fn shade(&self, o: Vec3, wi: UnitVec3, wo: UnitVec3) -> Option<(Shading, Contact)> {
         let c = self.first_contact(o, -wo.get())?;
         let s = self
             .terms
             .shade(&self.cylinder(&c).finish, c.normal, wi.get(), wo.get());
         if s == Shading::default() || !self.lit(&c, wi) {
-            return Some((Shading::default(), c.seg));
+            return Some((Shading::default(), c));
         }
-        Some((s, c.seg))
+        Some((s, c))
     }
 
     /// The origins of `m` stratified primary rays over one period (jittered with `rng`).
@@ -245,9 +245,9 @@ impl RayTracer {
     fn batch(&self, wi: UnitVec3, wo: UnitVec3, m: usize, rng: &mut Rng, sums: &mut BatchSums) {
         for o in self.origins(m, rng) {
             sums.rays += 1;
-            if let Some((s, seg)) = self.shade(o, wi, wo) {
+            if let Some((s, c)) = self.shade(o, wi, wo) {
                 sums.hits += 1;
-                let albedo = self.yarns.cylinders[seg as usize].finish.albedo;
+                let albedo = self.cylinder(&c).finish.albedo;
                 for (d, a) in sums.diffuse.iter_mut().zip(albedo) {
                     *d += s.diffuse * a;
                 }
@@ -469,6 +469,7 @@ mod tests {
         let (r, len) = (1.0, 4.0);
         let yarns = Yarns {
             period: (20.0, 20.0),
+            threads: (vec![10.0], vec![0.0]),
             cylinders: vec![Cylinder {
                 group: Group::Warp,
                 thread: 0,

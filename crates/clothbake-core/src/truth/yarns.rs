@@ -42,6 +42,9 @@ pub struct Yarns {
     /// Every segment of one period: warp threads in order, then weft threads, each thread's
     /// floats in the order of their first crossing.
     pub cylinders: Vec<Cylinder>,
+    /// Axis positions of the warp threads (x) and of the weft threads (y) in one period,
+    /// increasing from 0.
+    pub threads: (Vec<f64>, Vec<f64>),
 }
 
 /// Positions of threads along the direction they are spaced in, and the period length.
@@ -129,6 +132,7 @@ impl Yarns {
         }
         Yarns {
             period: (warp.period, weft.period),
+            threads: (warp.start.clone(), weft.start.clone()),
             cylinders,
         }
     }
