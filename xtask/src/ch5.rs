@@ -5,8 +5,10 @@
 //! * sphere: radius 1 at the origin, 48 x 48 pixels of a pinhole camera at the eye looking at the
 //!   origin; the cylinders follow the sphere's longitudes (local warp axis = the tangent toward
 //!   the north pole +z); surface points where L or E is below the local horizon are skipped;
-//! * disk: radius 5 on z = 0, sampled on a 41 x 41 grid, cylinders along +y, light 75 degrees
-//!   above the plane with the sphere test's azimuth: L = (0, -cos 75, sin 75);
+//! * disk: radius 5 on z = 0, sampled on a 41 x 41 grid, light 75 degrees above the plane with
+//!   the sphere test's azimuth: L = (0, -cos 75, sin 75); the cylinders along +y (reading A,
+//!   parallel to the light's azimuth) and, in tables of their own, along +x (reading B: light
+//!   and eye in the cylinders' cross-section plane);
 //! * eye at (0, -10, 10) for both, so E varies over the surface (perspective);
 //! * "ray-traced solution" = the two-level sampling with the thesis's steps (first level 32,
 //!   d_alpha = d_l = 0.2, l0 = 1.5); "analytical" = the thesis's ranges (C_max 0.3, l0 1.5)
@@ -165,7 +167,26 @@ fn sphere(out: &mut String) {
     }
 }
 
+/// The two readings of the disk's cylinders (the thesis does not say how they lie): along +y,
+/// parallel to the light's and the eye's azimuth, or along +x, so that light and eye lie in
+/// the cylinders' cross-section plane.
+#[derive(Clone, Copy)]
+enum Reading {
+    AlongY,
+    AlongX,
+}
+
 fn disk(out: &mut String) {
+    writeln!(out, "\n## Disk test: the two readings\n\nThe thesis does not say how the cylinders lie on the disk. Reading A (the tables titled \"cylinders along y\"): axes along +y, in the vertical plane of the light and the eye (both at azimuth -y). Reading B (\"cylinders along x\"): axes along +x, so that the light and the eye lie in the cylinders' cross-section plane; given for the thesis kernel with the thesis's ranges and with full ranges.").unwrap();
+    disk_reading(out, Reading::AlongY);
+    disk_reading(out, Reading::AlongX);
+}
+
+fn disk_reading(out: &mut String, reading: Reading) {
+    let (axis, which) = match reading {
+        Reading::AlongY => (Vec3::new(0.0, 1.0, 0.0), "cylinders along y"),
+        Reading::AlongX => (Vec3::new(1.0, 0.0, 0.0), "cylinders along x"),
+    };
     let eye = Vec3::new(0.0, -10.0, 10.0);
     let t = 75f64.to_radians();
     let l = Vec3::new(0.0, -t.cos(), t.sin());
@@ -174,19 +195,13 @@ fn disk(out: &mut String) {
         for i in 0..41 {
             let p = Vec3::new(-5.0 + 0.25 * i as f64, -5.0 + 0.25 * j as f64, 0.0);
             if p.length() <= 5.0 {
-                if let Some(d) = local(
-                    l,
-                    eye,
-                    p,
-                    Vec3::new(0.0, 0.0, 1.0),
-                    Vec3::new(0.0, 1.0, 0.0),
-                ) {
+                if let Some(d) = local(l, eye, p, Vec3::new(0.0, 0.0, 1.0), axis) {
                     pts.push(d);
                 }
             }
         }
     }
-    for (title, kernel, method) in [
+    let mut settings = vec![
         (
             "as the thesis computed it: thesis kernel, thesis ranges (C_max 0.3, l0 1.5)",
             Kernel::Thesis,
@@ -197,13 +212,16 @@ fn disk(out: &mut String) {
             Kernel::Thesis,
             full_analytic(),
         ),
-        (
+    ];
+    if let Reading::AlongY = reading {
+        settings.push((
             "radiometric kernel, full ranges (physically right)",
             Kernel::Radiometric,
             full_analytic(),
-        ),
-    ] {
-        writeln!(out, "\n## Disk test (Table 5.2, Fig. 5.14): {title}\n\n{} disk points; rho_d 0.4, rho_s 0.7, d 2, r 1, h 0.\n", pts.len()).unwrap();
+        ));
+    }
+    for (title, kernel, method) in settings {
+        writeln!(out, "\n## Disk test (Table 5.2, Fig. 5.14), {which}: {title}\n\n{} disk points; rho_d 0.4, rho_s 0.7, d 2, r 1, h 0.\n", pts.len()).unwrap();
         writeln!(out, "| n | max I_ss | max I_ss/I_s | max I_2 | max I_2/I_1 | share I_ss | share I_sd | share I_ds | share I_dd |\n|---|---|---|---|---|---|---|---|---|").unwrap();
         for n in [
             1.0, 2.0, 4.0, 8.0, 12.0, 16.0, 20.0, 24.0, 32.0, 40.0, 55.0, 70.0, 90.0,
@@ -233,7 +251,7 @@ fn disk(out: &mut String) {
                 100.0 * share[3] / tot
             )
             .unwrap();
-            eprintln!("disk n {n}: max I_2 {m2:.4}");
+            eprintln!("disk {which} n {n}: max I_2 {m2:.4}");
         }
     }
 }
