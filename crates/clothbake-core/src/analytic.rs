@@ -30,6 +30,7 @@ use crate::reflect::Reflection;
 use crate::shadowing::{
     mean_occluded_length, occluded_arc, occluded_length, ActiveTable, ArcOcclusion, Occluder,
 };
+use crate::unit_index::UnitIndex;
 use crate::vec3::{UnitVec3, Vec3};
 use crate::weave::Group;
 use std::f64::consts::PI;
@@ -272,33 +273,42 @@ fn occluder_at(
 
 /// Occluders on one side (`dir` = +1 or -1 along c) of the cross-section of `seg` at crossing
 /// `cross` (the thesis's profile, sec. 3.2): one period of neighbours plus the segment's own
-/// repetition, a float spanning several neighbours counted once.
-fn side_profile(geo: &Geometry, seg: &Segment, cross: isize, dir: isize) -> Vec<Occluder> {
-    let mut out = Vec::new();
+/// repetition, a float spanning several neighbours counted once; produced on demand, outward
+/// (non-decreasing u: each neighbour, disc or rectangle, lies beyond the previous one).
+fn side_profile<'a>(
+    geo: &'a Geometry,
+    seg: &'a Segment,
+    cross: isize,
+    dir: isize,
+) -> impl Iterator<Item = Occluder> + 'a {
     let mut last_box = None;
-    for m in 1..=geo.fabric.weave().n(seg.group) as isize {
+    (1..=geo.fabric.weave().n(seg.group) as isize).filter_map(move |m| {
         let (o, id) = occluder_at(geo, seg, m, cross, dir);
         if id.is_some() && id == last_box {
-            continue;
+            return None;
         }
         last_box = id;
-        out.push(o);
-    }
-    out
+        Some(o)
+    })
 }
 
 /// Occluders beyond one end (`dir` = +1: the +axis end) of a finite segment, along its axis:
-/// crossing threads seen end-on (discs) and the thread's own next floats (rectangles).
-fn end_profile(geo: &Geometry, seg: &Segment, top: f64, dir: isize) -> Vec<Occluder> {
+/// crossing threads seen end-on (discs) and the thread's own next floats (rectangles);
+/// produced on demand, outward.
+fn end_profile<'a>(
+    geo: &'a Geometry,
+    seg: &'a Segment,
+    top: f64,
+    dir: isize,
+) -> impl Iterator<Item = Occluder> + 'a {
     let g = seg.group;
     let c = g.other();
-    let weave = &geo.fabric.weave();
+    let weave = geo.fabric.weave();
     let nc = weave.n(c);
     let (y0, y1) = seg.extent.expect("finite float");
     let (a, f) = (seg.float.start as isize, seg.float.len as isize);
-    let mut out = Vec::new();
     let mut last_box = None;
-    for j in 0..nc as isize {
+    (0..nc as isize).filter_map(move |j| {
         let k = if dir > 0 { a + f + j } else { a - 1 - j };
         let p = geo.position(c, k);
         if weave.on_top(g, seg.thread, rem(k, nc)) {
@@ -306,33 +316,58 @@ fn end_profile(geo: &Geometry, seg: &Segment, top: f64, dir: isize) -> Vec<Occlu
             let (e0, e1) = extent_near(&geo.segments[si], p, geo.period_along(g));
             let key = (si, (e0 * 1e6).round() as i64);
             if last_box == Some(key) {
-                continue;
+                return None;
             }
             last_box = Some(key);
             let u = if dir > 0 { e0 - y1 } else { y0 - e1 };
-            out.push(Occluder {
+            Some(Occluder {
                 u,
                 z: top,
                 rho: 0.0,
-            });
+            })
         } else {
             let yarn = geo.fabric.group(c).threads[rem(k, nc)];
             let u = if dir > 0 { p - y1 } else { y0 - p };
-            out.push(Occluder {
+            last_box = None;
+            Some(Occluder {
                 u,
                 z: yarn.height,
                 rho: yarn.radius,
-            });
-            last_box = None;
+            })
+        }
+    })
+}
+
+/// The distinct (radius, height) of a group's threads: the shapes its threads take as discs in
+/// a profile.
+fn disc_shapes(fabric: &Fabric, g: Group) -> Vec<(f64, f64)> {
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for y in &fabric.group(g).threads {
+        if !out.iter().any(|&(r, h)| r == y.radius && h == y.height) {
+            out.push((y.radius, y.height));
         }
     }
     out
 }
 
-fn table_key(t: &ActiveTable, out: &mut Vec<f64>) {
+/// Two pieces are one unit when every component of their keys agrees to within this.
+const KEY_TOLERANCE: f64 = 1e-9;
+
+/// The unit of length of unit keys: the fabric's smallest radius. Only ratios of lengths
+/// matter, so keys compare lengths relative to the yarns: a fabric scaled down must not merge
+/// pieces that differ, nor one scaled up keep apart pieces that differ by rounding.
+fn key_length_unit(fabric: &Fabric) -> f64 {
+    [Group::Warp, Group::Weft]
+        .iter()
+        .flat_map(|&g| fabric.group(g).threads.iter().map(|y| y.radius))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Appends an active table to a unit key, lengths divided by `unit`.
+fn table_key(t: &ActiveTable, unit: f64, out: &mut Vec<f64>) {
     out.push(t.entries.len() as f64);
     for (psi, o) in &t.entries {
-        out.extend([*psi, o.u, o.z, o.rho]);
+        out.extend([*psi, o.u / unit, o.z / unit, o.rho / unit]);
     }
 }
 
@@ -349,15 +384,26 @@ impl AnalyticModel {
         let grid = CellGrid::new(&geo.warp_pos, geo.period.0, &geo.weft_pos, geo.period.1);
         let (nx, ny) = grid.dims();
         let mut cell_units = vec![u32::MAX; nx * ny];
-        let mut units: Vec<(Vec<f64>, Unit)> = Vec::new();
+        let mut units: Vec<Unit> = Vec::new();
+        let mut index = UnitIndex::new(KEY_TOLERANCE);
+        let unit_len = key_length_unit(fabric);
+        let discs = [
+            disc_shapes(fabric, Group::Warp),
+            disc_shapes(fabric, Group::Weft),
+        ];
         for seg in &geo.segments {
             let g = seg.group;
             let c = g.other();
             let top = equal_area_height(seg.radius, seg.height);
+            // What the profiles can hold (scan_ordered): along the axis, the crossing threads
+            // end-on and this thread's own floats side-on, within a period and a half.
+            let mut end_shapes = discs[c as usize].clone();
+            end_shapes.push((0.0, top));
+            let end_u = 3.0 * geo.period_along(g);
             let (end_plus, end_minus) = match seg.extent {
                 Some(_) => (
-                    ActiveTable::scan(&end_profile(&geo, seg, top, 1)),
-                    ActiveTable::scan(&end_profile(&geo, seg, top, -1)),
+                    ActiveTable::scan_ordered(end_profile(&geo, seg, top, 1), &end_shapes, end_u),
+                    ActiveTable::scan_ordered(end_profile(&geo, seg, top, -1), &end_shapes, end_u),
                 ),
                 None => Default::default(),
             };
@@ -384,6 +430,12 @@ impl AnalyticModel {
                     Some((_, y1)) if m == f - 1 => y1,
                     _ => mid(k + 1),
                 };
+                // Across it: the parallel threads end-on and crossing thread k side-on, within
+                // a period.
+                let cross_yarn = fabric.group(c).threads[rem(k, geo.fabric.weave().n(c))];
+                let mut side_shapes = discs[g as usize].clone();
+                side_shapes.push((0.0, equal_area_height(cross_yarn.radius, cross_yarn.height)));
+                let side_u = 2.0 * geo.period_across(g);
                 let neighbour = |dir: isize| {
                     let (o, id) = occluder_at(&geo, seg, 1, k, dir);
                     if id.is_some() {
@@ -412,19 +464,28 @@ impl AnalyticModel {
                     seg: data.clone(),
                     range: (lo, hi),
                     neighbours: [neighbour(1), neighbour(-1)],
-                    side_plus: ActiveTable::scan(&side_profile(&geo, seg, k, 1)),
-                    side_minus: ActiveTable::scan(&side_profile(&geo, seg, k, -1)),
+                    side_plus: ActiveTable::scan_ordered(
+                        side_profile(&geo, seg, k, 1),
+                        &side_shapes,
+                        side_u,
+                    ),
+                    side_minus: ActiveTable::scan_ordered(
+                        side_profile(&geo, seg, k, -1),
+                        &side_shapes,
+                        side_u,
+                    ),
                     count: 1,
                 };
-                // Key: everything the unit's reflection depends on, relative to its segment.
+                // Key: everything the unit's reflection depends on, relative to its segment,
+                // lengths in units of `unit_len`.
                 let origin = seg.extent.map_or(lo, |e| e.0);
                 let mut key = vec![
                     g as u8 as f64,
-                    seg.radius,
-                    seg.height,
-                    seg.extent.map_or(-1.0, |e| e.1 - e.0),
-                    lo - origin,
-                    hi - origin,
+                    seg.radius / unit_len,
+                    seg.height / unit_len,
+                    seg.extent.map_or(-1.0, |e| (e.1 - e.0) / unit_len),
+                    (lo - origin) / unit_len,
+                    (hi - origin) / unit_len,
                 ];
                 let mat = data.material;
                 key.extend(mat.albedo);
@@ -439,29 +500,26 @@ impl AnalyticModel {
                     &data.end_plus,
                     &data.end_minus,
                 ] {
-                    table_key(t, &mut key);
+                    table_key(t, unit_len, &mut key);
                 }
 
-                let same = |k2: &Vec<f64>| {
-                    k2.len() == key.len() && k2.iter().zip(&key).all(|(x, y)| (x - y).abs() < 1e-9)
-                };
-                let index = match units.iter_mut().position(|(k2, _)| same(k2)) {
+                let u = match index.find_or_insert(key) {
                     Some(i) => {
-                        units[i].1.count += 1;
+                        units[i].count += 1;
                         i
                     }
                     None => {
-                        units.push((key, unit));
+                        units.push(unit);
                         units.len() - 1
                     }
                 };
-                cell_units[grid.index(grid.crossing(g, seg.thread, k))] = index as u32;
+                cell_units[grid.index(grid.crossing(g, seg.thread, k))] = u as u32;
             }
         }
         AnalyticModel {
             facet,
             variant,
-            units: units.into_iter().map(|(_, u)| u).collect(),
+            units,
             grid,
             cell_units,
         }
@@ -966,5 +1024,173 @@ mod tests {
             let y = m2.intensity(wi, wo).i_s[0];
             assert!((x - y).abs() < 1e-8 * x.max(1e-3), "{x} {y}");
         }
+    }
+
+    /// A fabric file for `pattern` (rows of 0/1) with every length times `scale`, warp threads
+    /// given their own float lengths.
+    fn scaled(pattern: &[Vec<u8>], scale: f64, warp_segments: Option<&[f64]>) -> Fabric {
+        let seg = warp_segments.map_or(String::new(), |v| {
+            let v: Vec<f64> = v.iter().map(|x| x * scale).collect();
+            format!(r#", "segment_length": {v:?}"#)
+        });
+        fabric(&format!(
+            r#"{{"pattern": {pattern:?}, "warp": {{"radius": {}, "spacing": {}{seg}}},
+                "weft": {{"radius": {}, "spacing": {}}}}}"#,
+            1.5 * scale,
+            3.1 * scale,
+            1.5 * scale,
+            3.1 * scale
+        ))
+    }
+
+    fn directions() -> Vec<(UnitVec3, UnitVec3)> {
+        (0..12)
+            .map(|k| {
+                (
+                    UnitVec3::from_degrees(5.0 + 6.5 * k as f64, 31.0 * k as f64),
+                    UnitVec3::from_degrees(80.0 - 6.0 * k as f64, 200.0 + 47.0 * k as f64),
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_tiled_period_reflects_as_its_tile() {
+        // The twill repeated 20 x 20 times is the same cloth: one period of 3600 cells, pieces
+        // merged into the twill's units with 400 times the counts, the same intensity.
+        let tile: Vec<Vec<u8>> = vec![vec![1, 1, 0], vec![0, 1, 1], vec![1, 0, 1]];
+        let big: Vec<Vec<u8>> = (0..60)
+            .map(|j| (0..60).map(|i| tile[j % 3][i % 3]).collect())
+            .collect();
+        let small = AnalyticModel::new(&scaled(&tile, 1.0, None), FacetModel::Huo);
+        let large = AnalyticModel::new(&scaled(&big, 1.0, None), FacetModel::Huo);
+        let counts = |m: &AnalyticModel| m.units().iter().map(|u| u.count).collect::<Vec<_>>();
+        assert_eq!(
+            counts(&large),
+            counts(&small).iter().map(|c| c * 400).collect::<Vec<_>>()
+        );
+        let opts = SecondaryOptions::default();
+        for (wi, wo) in directions() {
+            let (a, b) = (
+                small.intensity_with(wi, wo, Some(&opts)),
+                large.intensity_with(wi, wo, Some(&opts)),
+            );
+            let (x, y) = (a.total()[0], b.total()[0]);
+            assert!((x - y).abs() <= 1e-12 * x.abs().max(1e-12), "{x} {y}");
+        }
+    }
+
+    #[test]
+    fn only_ratios_of_lengths_matter() {
+        // A plain weave whose two warp threads have floats of different lengths: at scale 1e-9
+        // the two kinds of piece differ by less than 1e-9 in absolute terms and must still stay
+        // apart (they were merged once, giving 0.1386 instead of 0.1431 for one pair).
+        let plain: Vec<Vec<u8>> = vec![vec![1, 0], vec![0, 1]];
+        let seg = [1.0, 1.5];
+        let one = AnalyticModel::new(&scaled(&plain, 1.0, Some(&seg)), FacetModel::Huo);
+        for scale in [1e-9, 1e-3, 1e3, 1e8] {
+            let other = AnalyticModel::new(&scaled(&plain, scale, Some(&seg)), FacetModel::Huo);
+            assert_eq!(one.units().len(), other.units().len(), "scale {scale}");
+            for (wi, wo) in directions() {
+                let (x, y) = (
+                    one.intensity(wi, wo).total()[0],
+                    other.intensity(wi, wo).total()[0],
+                );
+                assert!(
+                    (x - y).abs() <= 1e-12 * x.abs().max(1e-12),
+                    "scale {scale}: {x} {y}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn profiles_come_outward_and_scan_as_a_whole() {
+        // scan_ordered needs each profile in order of u and every shape it can meet listed;
+        // on varied fabrics (per-thread radii and heights, given float lengths, long floats)
+        // its tables are those of the full scan of the whole profile.
+        let sources = [
+            TWILL.to_string(),
+            r#"{"pattern": [[0,1,1,1,1],[1,1,0,1,1],[1,1,1,1,0],[1,0,1,1,1],[1,1,1,0,1]],
+                "warp": {"radius": [1.5,1.2,1.5,1.0,1.4], "height": [0,0.3,-0.2,0,0.5], "spacing": 3.1},
+                "weft": {"radius": 1.1, "spacing": [2.5,3.0,2.2,4.0,2.4], "segment_length": 2.0}}"#
+                .to_string(),
+            r#"{"pattern": [[1,0,0,1,0,1,1],[0,0,1,1,1,0,1],[1,1,0,0,1,0,0],[0,1,1,0,0,1,1]],
+                "warp": {"radius": 1.5, "spacing": 3.1, "segment_length": [2,3,2,3,2,3,2]},
+                "weft": {"radius": [1.0,1.5,1.0,1.5], "spacing": 3.1}}"#
+                .to_string(),
+        ];
+        for src in &sources {
+            let f = fabric(src);
+            let geo = Geometry::new(&f);
+            let discs = [disc_shapes(&f, Group::Warp), disc_shapes(&f, Group::Weft)];
+            let mut tables = 0;
+            for seg in &geo.segments {
+                let (g, c) = (seg.group, seg.group.other());
+                let check = |profile: Vec<Occluder>, shapes: &[(f64, f64)], u_max: f64| {
+                    assert!(profile.windows(2).all(|w| w[0].u <= w[1].u), "{profile:?}");
+                    assert!(profile.iter().all(|o| o.u <= u_max));
+                    assert_eq!(
+                        ActiveTable::scan_ordered(profile.iter().copied(), shapes, u_max),
+                        ActiveTable::scan(&profile)
+                    );
+                };
+                let top = equal_area_height(seg.radius, seg.height);
+                if seg.extent.is_some() {
+                    let mut shapes = discs[c as usize].clone();
+                    shapes.push((0.0, top));
+                    for dir in [1, -1] {
+                        check(
+                            end_profile(&geo, seg, top, dir).collect(),
+                            &shapes,
+                            3.0 * geo.period_along(g),
+                        );
+                        tables += 1;
+                    }
+                }
+                for m in 0..seg.float.len as isize {
+                    let k = seg.float.start as isize + m;
+                    let y = f.group(c).threads[rem(k, f.weave().n(c))];
+                    let mut shapes = discs[g as usize].clone();
+                    shapes.push((0.0, equal_area_height(y.radius, y.height)));
+                    for dir in [1, -1] {
+                        check(
+                            side_profile(&geo, seg, k, dir).collect(),
+                            &shapes,
+                            2.0 * geo.period_across(g),
+                        );
+                        tables += 1;
+                    }
+                }
+            }
+            assert!(tables >= 12, "{tables}");
+        }
+    }
+
+    #[test]
+    fn periods_beyond_the_limits_are_refused() {
+        use crate::fabric::{check_period, MAX_CELLS, MAX_THREADS};
+        assert!(check_period(1024, 1024).is_ok());
+        assert!(check_period(MAX_THREADS, 16).is_ok());
+        let (problem, fix) = check_period(MAX_THREADS + 1, 1).unwrap_err();
+        assert!(problem.contains("65537 warp threads"), "{problem}");
+        assert!(fix.contains("docs/limits.md"), "{fix}");
+        let (problem, _) = check_period(1025, 1024).unwrap_err();
+        assert!(
+            problem.contains(&format!("1049600 cells, more than the {MAX_CELLS}")),
+            "{problem}"
+        );
+        // The one constructor refuses such a period, naming the field, before any work on it.
+        let rows = vec![vec![true, false]; MAX_CELLS / 2 + 1];
+        let e = Fabric::from_json_str(
+            &format!(
+                r#"{{"pattern": {:?}, "warp": {{"radius": 1, "spacing": 2}}, "weft": {{"radius": 1, "spacing": 2}}}}"#,
+                rows.iter().map(|r| r.iter().map(|&b| b as u8).collect::<Vec<_>>()).collect::<Vec<_>>()
+            ),
+            "big.json",
+        )
+        .unwrap_err();
+        assert_eq!(e.field, "pattern");
+        assert!(e.problem.contains("weft threads (rows)"), "{e}");
     }
 }

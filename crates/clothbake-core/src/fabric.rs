@@ -52,6 +52,12 @@ pub const MIN_LENGTH: f64 = 1e-9;
 /// Largest length a fabric may give, in its own unit.
 pub const MAX_LENGTH: f64 = 1e9;
 
+/// Most threads of one group in a period (pattern columns or rows).
+pub const MAX_THREADS: usize = 1 << 16;
+/// Most cells of a period (columns x rows): preprocessing and memory grow in proportion (a
+/// random 1024 x 1024 period takes about 10 s and 100 MB to preprocess; docs/limits.md).
+pub const MAX_CELLS: usize = 1 << 20;
+
 /// A validated fabric: weave period, both yarn groups. Every invariant the model relies on holds:
 /// the fields are private and [`Fabric::new`] is the one constructor (fabric files, WIF drafts,
 /// Python dicts and material overrides all go through it).
@@ -66,6 +72,8 @@ pub struct Fabric {
 /// A field of a fabric that [`Fabric::new`] checks, for naming it in errors.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Field {
+    /// The weave period as a whole (its size).
+    Pattern,
     /// A thread's `radius`.
     Radius,
     /// A thread's `height`.
@@ -103,6 +111,7 @@ impl Naming for PlainNaming<'_> {
     fn field(&self, g: Group, field: Field, thread: usize) -> String {
         let g = g.name();
         match field {
+            Field::Pattern => "pattern".into(),
             Field::Radius => format!("{g}.radius[{thread}]"),
             Field::Height => format!("{g}.height[{thread}]"),
             Field::Spacing => format!("{g}.spacing[{thread}]"),
@@ -237,7 +246,8 @@ impl Ctx<'_> {
 
 impl Fabric {
     /// The one constructor: checks every invariant the model relies on and names the offending
-    /// field through `naming`. Checked: one thread per pattern column (warp) and row (weft);
+    /// field through `naming`. Checked: a period of at most [`MAX_THREADS`] threads per group
+    /// and [`MAX_CELLS`] cells; one thread per pattern column (warp) and row (weft);
     /// finite numbers; radius > 0; |height| < radius; neighbours that touch but do not overlap
     /// ([`crate::yarn::spacing_fits`]); segment lengths > 0 that fit their room
     /// ([`crate::yarn::float_room`]); albedos and rho_s in [0, 1]; exponent >= 0.
@@ -248,6 +258,12 @@ impl Fabric {
         weft: YarnGroup,
         naming: &dyn Naming,
     ) -> Result<Fabric, FabricError> {
+        check_period(weave.n_warp(), weave.n_weft()).map_err(|(problem, fix)| FabricError {
+            file: naming.file().to_string(),
+            field: naming.field(Group::Warp, Field::Pattern, 0),
+            problem,
+            fix,
+        })?;
         let fabric = Fabric {
             name,
             weave,
@@ -564,6 +580,7 @@ impl Fabric {
     }
 
     fn check_segment_lengths(&self, g: Group, naming: &dyn Naming) -> Result<(), FabricError> {
+        let (pos, period) = self.group(g.other()).positions();
         for (t, yarn) in self.group(g).threads.iter().enumerate() {
             let Some(len) = yarn.segment_length else {
                 continue;
@@ -572,7 +589,7 @@ impl Fabric {
                 if fl.endless {
                     continue;
                 }
-                let room = float_room(self.group(g.other()), fl);
+                let room = float_room(self.group(g.other()), &pos, period, fl);
                 let room = room.1 - room.0;
                 if len > room + 1e-9 {
                     return Err(FabricError {
@@ -590,6 +607,35 @@ impl Fabric {
         }
         Ok(())
     }
+}
+
+/// Whether a period of `columns` warp threads by `rows` weft threads is within [`MAX_THREADS`]
+/// and [`MAX_CELLS`]; else what is wrong and how to fix it.
+pub fn check_period(columns: usize, rows: usize) -> Result<(), (String, String)> {
+    let fix = format!(
+        "give one repeat of the weave, at most {MAX_THREADS} threads per group and {MAX_CELLS} cells (docs/limits.md)"
+    );
+    if columns > MAX_THREADS || rows > MAX_THREADS {
+        let (n, what) = if columns > MAX_THREADS {
+            (columns, "warp threads (columns)")
+        } else {
+            (rows, "weft threads (rows)")
+        };
+        return Err((
+            format!("the period has {n} {what}, more than the {MAX_THREADS} clothbake takes"),
+            fix,
+        ));
+    }
+    let cells = columns * rows;
+    if cells > MAX_CELLS {
+        return Err((
+            format!(
+                "the period has {columns} x {rows} = {cells} cells, more than the {MAX_CELLS} clothbake takes"
+            ),
+            fix,
+        ));
+    }
+    Ok(())
 }
 
 /// Names fields as the file gave them: an index only where the file gave an array.
@@ -610,6 +656,9 @@ impl Naming for JsonNaming<'_> {
             Group::Weft => self.weft,
         };
         let name = g.name();
+        if field == Field::Pattern {
+            return "pattern".into();
+        }
         let indexed = |f: &str, v: Option<&Value>| {
             if v.is_some_and(Value::is_array) {
                 format!("{name}.{f}[{thread}]")
@@ -641,6 +690,7 @@ impl Naming for JsonNaming<'_> {
             }
             Field::Specular => format!("{name}.material.specular"),
             Field::Exponent => format!("{name}.material.exponent"),
+            Field::Pattern => unreachable!("named above"),
         }
     }
 }

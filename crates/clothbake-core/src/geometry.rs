@@ -17,7 +17,7 @@
 
 use crate::fabric::Fabric;
 use crate::weave::{Float, Group};
-use crate::yarn::{float_extent, float_room};
+use crate::yarn::{float_extent, float_room, unwrapped_position};
 use std::f64::consts::PI;
 
 /// One cylinder segment (a float) of the period.
@@ -59,7 +59,13 @@ pub struct Geometry {
     pub period: (f64, f64),
     /// All segments of one period.
     pub segments: Vec<Segment>,
+    /// Per group, the segment covering each (thread, crossing) cell: `at[g][thread * n_c + c]`,
+    /// or [`NOT_ON_TOP`]; built once so that [`Geometry::segment_at`] is O(1).
+    at: [Vec<u32>; 2],
 }
+
+/// Marks a cell of [`Geometry`]'s index where the thread is under.
+const NOT_ON_TOP: u32 = u32::MAX;
 
 /// Area of a cylinder's cross-section above the floor, for radius `r` and axis height `h`.
 pub fn area_above_floor(r: f64, h: f64) -> f64 {
@@ -78,8 +84,18 @@ impl Geometry {
     pub fn new(fabric: &Fabric) -> Geometry {
         let (warp_pos, px) = fabric.warp().positions();
         let (weft_pos, py) = fabric.weft().positions();
+        let weave = fabric.weave();
         let mut segments = Vec::new();
+        let mut at = [
+            vec![NOT_ON_TOP; weave.n_warp() * weave.n_weft()],
+            vec![NOT_ON_TOP; weave.n_warp() * weave.n_weft()],
+        ];
         for g in [Group::Warp, Group::Weft] {
+            let nc = weave.n(g.other());
+            let (cross_pos, cross_period) = match g {
+                Group::Warp => (&weft_pos, py),
+                Group::Weft => (&warp_pos, px),
+            };
             let pos = match g {
                 Group::Warp => &warp_pos,
                 Group::Weft => &weft_pos,
@@ -87,8 +103,13 @@ impl Geometry {
             for (t, yarn) in fabric.group(g).threads.iter().enumerate() {
                 for fl in fabric.weave().floats(g, t) {
                     let extent = (!fl.endless).then(|| {
-                        float_extent(float_room(fabric.group(g.other()), fl), yarn.segment_length)
+                        let room = float_room(fabric.group(g.other()), cross_pos, cross_period, fl);
+                        float_extent(room, yarn.segment_length)
                     });
+                    let id = u32::try_from(segments.len()).expect("period within MAX_CELLS");
+                    for k in 0..fl.len {
+                        at[g as usize][t * nc + (fl.start + k) % nc] = id;
+                    }
                     segments.push(Segment {
                         group: g,
                         thread: t,
@@ -107,6 +128,7 @@ impl Geometry {
             weft_pos,
             period: (px, py),
             segments,
+            at,
         }
     }
 
@@ -116,8 +138,7 @@ impl Geometry {
             Group::Warp => (&self.warp_pos, self.period.0),
             Group::Weft => (&self.weft_pos, self.period.1),
         };
-        let n = pos.len() as isize;
-        pos[k.rem_euclid(n) as usize] + k.div_euclid(n) as f64 * p
+        unwrapped_position(pos, p, k)
     }
 
     /// Period length along the axis of group `g` (the direction its threads run).
@@ -141,11 +162,10 @@ impl Geometry {
     pub fn segment_at(&self, g: Group, thread: usize, cross: isize) -> Option<usize> {
         let n = self.fabric.weave().n(g.other());
         let c = cross.rem_euclid(n as isize) as usize;
-        self.segments.iter().position(|s| {
-            s.group == g
-                && s.thread == thread
-                && (s.float.endless || (c + n - s.float.start) % n < s.float.len)
-        })
+        match self.at[g as usize][thread * n + c] {
+            NOT_ON_TOP => None,
+            i => Some(i as usize),
+        }
     }
 
     /// Highest point of any yarn above the floor.

@@ -24,6 +24,7 @@ pub mod source;
 pub mod symmetry;
 pub mod trig;
 pub mod truth;
+mod unit_index;
 pub mod validate;
 pub mod weave;
 pub mod wif;

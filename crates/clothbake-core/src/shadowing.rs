@@ -110,6 +110,88 @@ impl ActiveTable {
         ActiveTable { entries }
     }
 
+    /// The same table as [`ActiveTable::scan`], bit for bit, for a profile whose occluders
+    /// `source` yields in order of non-decreasing `u`, reading it only as far as needed: cost
+    /// that grows with the table and the width of the neighbourhood that decides it, not with
+    /// the period. `shapes` lists every (rho, z) an occluder of the source can have and `u_max`
+    /// bounds every `u` from above; they bound what the occluders not yet read can do.
+    ///
+    /// Why it may stop reading: a common tangent of elevation psi in (0, pi/2) between the
+    /// current occluder c and a farther one o solves du sin psi = d_rho + dz cos psi (eq. 3.7's
+    /// form), so sin psi <= max(rho_o - rho_c, top_o - top_c) / du; an occluder of c's own shape
+    /// gives exactly psi = 0. Once no shape can beat the best tangent found (or 0) by a margin of
+    /// 1e-9 in sin psi, far beyond rounding, the rest cannot change the table. A source that is
+    /// not ordered after all is read to its end and scanned whole.
+    pub fn scan_ordered(
+        source: impl Iterator<Item = Occluder>,
+        shapes: &[(f64, f64)],
+        u_max: f64,
+    ) -> ActiveTable {
+        let mut lazy = Lazy {
+            source,
+            shapes,
+            buf: Vec::new(),
+            ordered: true,
+        };
+        let r_max = shapes.iter().map(|s| s.0).fold(0.0, f64::max);
+        // First occluder met by the vertical scan line: the first smallest near edge. For k
+        // onward, u_k - rho_k >= u_k - r_max.
+        let mut first: Option<(f64, usize)> = None;
+        let mut k = 0;
+        while let Some(o) = lazy.get(k) {
+            if first.is_some_and(|(m, _)| o.u - r_max >= m) {
+                break;
+            }
+            if first.is_none_or(|(m, _)| o.near_edge() < m) {
+                first = Some((o.near_edge(), k));
+            }
+            k += 1;
+        }
+        let Some((_, mut j)) = first else {
+            return ActiveTable::scan(&lazy.rest());
+        };
+        let mut entries = Vec::new();
+        let mut upper = FRAC_PI_2;
+        loop {
+            if !lazy.ordered {
+                return ActiveTable::scan(&lazy.rest());
+            }
+            let cur = lazy.buf[j];
+            let mut best: Option<(f64, usize)> = None;
+            // Occluders before j lie no farther out than cur (order): never candidates.
+            let mut k = j + 1;
+            while let Some(o) = lazy.get(k) {
+                let du = o.u - cur.u;
+                if du > 0.0 && !beatable(&cur, du, u_max, shapes, best.map(|b| b.0)) {
+                    break;
+                }
+                if o.u > cur.u {
+                    if let Some(psi) = common_tangent(&cur, &o) {
+                        if psi > 0.0 && psi < upper && best.is_none_or(|(b, _)| psi > b) {
+                            best = Some((psi, k));
+                        }
+                    }
+                }
+                k += 1;
+            }
+            if !lazy.ordered {
+                return ActiveTable::scan(&lazy.rest());
+            }
+            match best {
+                Some((psi, k)) => {
+                    entries.push((psi, cur));
+                    upper = psi;
+                    j = k;
+                }
+                None => {
+                    entries.push((0.0, cur));
+                    break;
+                }
+            }
+        }
+        ActiveTable { entries }
+    }
+
     /// The active occluder for elevation `psi` in (0, pi/2].
     pub fn active(&self, psi: f64) -> Option<&Occluder> {
         self.entries
@@ -118,6 +200,60 @@ impl ActiveTable {
             .or(self.entries.last())
             .map(|(_, o)| o)
     }
+}
+
+/// Occluders read on demand from an iterator, checking that `u` never decreases and that
+/// each has one of the shapes given.
+struct Lazy<'a, I> {
+    source: I,
+    shapes: &'a [(f64, f64)],
+    buf: Vec<Occluder>,
+    /// False once an occluder read breaks the order or has a shape not listed.
+    ordered: bool,
+}
+
+impl<I: Iterator<Item = Occluder>> Lazy<'_, I> {
+    /// Occluder `k`, reading the source up to it.
+    fn get(&mut self, k: usize) -> Option<Occluder> {
+        while self.buf.len() <= k {
+            let o = self.source.next()?;
+            if self.buf.last().is_some_and(|p| o.u < p.u)
+                || !self.shapes.iter().any(|&(rho, z)| rho == o.rho && z == o.z)
+            {
+                self.ordered = false;
+            }
+            self.buf.push(o);
+        }
+        Some(self.buf[k])
+    }
+
+    /// Every occluder of the source.
+    fn rest(mut self) -> Vec<Occluder> {
+        self.buf.extend(self.source);
+        self.buf
+    }
+}
+
+/// Whether an occluder at least `du` (> 0) beyond `cur`, of one of `shapes`, at `u` at most
+/// `u_max`, may have a common tangent with `cur` steeper than `best` (or than 0): see
+/// [`ActiveTable::scan_ordered`].
+fn beatable(cur: &Occluder, du: f64, u_max: f64, shapes: &[(f64, f64)], best: Option<f64>) -> bool {
+    const MARGIN: f64 = 1e-9;
+    let threshold = best.map_or(0.0, f64::sin) - MARGIN;
+    shapes.iter().any(|&(rho, z)| {
+        if rho == cur.rho && z == cur.z {
+            // Same shape: dz = d_rho = 0 give exactly psi = 0 (atan2(0, du) + asin(0)).
+            return false;
+        }
+        let numer = (rho - cur.rho).max(rho + z - (cur.rho + cur.z));
+        // sin psi <= numer / du' for every du' in [du, u_max - cur.u].
+        let sup = if numer >= 0.0 {
+            numer / du
+        } else {
+            numer / (u_max - cur.u).max(du)
+        };
+        sup >= threshold || sup.is_nan()
+    })
 }
 
 /// What a neighbour hides of a circle's arc on the side it stands.
@@ -406,5 +542,87 @@ mod tests {
             let got = t.active(psi).unwrap().support(sp, cp);
             assert!((got - best).abs() < 1e-9, "psi {psi}: {got} vs {best}");
         }
+    }
+
+    #[test]
+    fn ordered_scan_is_the_full_scan() {
+        // Profiles of a few shapes (discs of two sizes and heights, corners of two heights) at
+        // increasing u, some neighbours touching, long runs of equal shapes as in cloth: the
+        // scan that stops reading early gives the full scan's table bit for bit.
+        let mut rng = crate::rng::Rng::new(3);
+        let shapes = [
+            (1.5, 0.0),
+            (0.0, 1.178),
+            (1.2, 0.3),
+            (0.0, 0.5),
+            (2.0, -0.5),
+        ];
+        let mut longest = 0;
+        let mut entries = 0;
+        let (mut read, mut total) = (0, 0);
+        for case in 0..4000 {
+            let k = 1 + (case % 5);
+            let used = &shapes[..k];
+            let n = 1 + (rng.next_u64() % 60) as usize;
+            let mut u = 1.0 + rng.next_f64();
+            let mut occ = Vec::new();
+            for _ in 0..n {
+                let (rho, z) = used[(rng.next_u64() % k as u64) as usize];
+                occ.push(Occluder { u, z, rho });
+                // Mostly whole spacings, sometimes touching, sometimes the same u.
+                u += match rng.next_u64() % 8 {
+                    0 => 0.0,
+                    1 => 3.0,
+                    _ => 3.1 * (1 + rng.next_u64() % 3) as f64,
+                };
+            }
+            let full = ActiveTable::scan(&occ);
+            let mut count = 0;
+            let source = occ.iter().copied().inspect(|_| count += 1);
+            let ordered = ActiveTable::scan_ordered(source, used, u + 10.0);
+            if k == 2 {
+                // One yarn size: discs and the crossing thread's corners.
+                read += count;
+                total += occ.len();
+            }
+            assert_eq!(full, ordered, "case {case}: {occ:?}");
+            longest = longest.max(full.entries.len());
+            entries += full.entries.len();
+        }
+        assert!(longest >= 3 && entries > 4000, "{longest} {entries}");
+        // ... while reading a fraction of the profiles of cloth-like shapes.
+        assert!(read * 3 < total, "read {read} of {total}");
+    }
+
+    #[test]
+    fn ordered_scan_falls_back_on_a_source_out_of_order() {
+        let occ = [
+            Occluder {
+                u: 5.0,
+                z: 0.0,
+                rho: 1.0,
+            },
+            Occluder {
+                u: 2.0,
+                z: 0.0,
+                rho: 1.5,
+            },
+            Occluder {
+                u: 9.0,
+                z: 1.0,
+                rho: 0.0,
+            },
+        ];
+        let shapes = [(1.0, 0.0), (1.5, 0.0), (0.0, 1.0)];
+        let full = ActiveTable::scan(&occ);
+        assert_eq!(
+            ActiveTable::scan_ordered(occ.iter().copied(), &shapes, 20.0),
+            full
+        );
+        // A shape not listed also makes it read everything.
+        assert_eq!(
+            ActiveTable::scan_ordered(occ.iter().copied(), &shapes[..2], 20.0),
+            full
+        );
     }
 }

@@ -660,6 +660,7 @@ impl Naming for WifNaming<'_> {
         };
         let t = thread + 1;
         match field {
+            Field::Pattern => "[WARP] Threads / [WEFT] Threads".into(),
             Field::Radius => format!("[{s}] Thickness (thread {t})"),
             Field::Spacing => format!("[{s}] Spacing (thread {t})"),
             Field::Height | Field::SegmentLength | Field::Specular | Field::Exponent => {

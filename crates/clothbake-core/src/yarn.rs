@@ -91,17 +91,17 @@ impl YarnGroup {
         (pos, acc)
     }
 
-    /// Unwrapped position of thread `k` (any integer).
-    pub fn position(&self, k: isize) -> f64 {
-        let n = self.threads.len() as isize;
-        let (pos, period) = self.positions();
-        pos[k.rem_euclid(n) as usize] + k.div_euclid(n) as f64 * period
-    }
-
     /// Radius of thread `k` (any integer, taken modulo the period).
     pub fn radius(&self, k: isize) -> f64 {
         self.threads[k.rem_euclid(self.threads.len() as isize) as usize].radius
     }
+}
+
+/// Unwrapped position of thread `k` (any integer) of a group whose threads sit at `pos` in a
+/// period of length `period` ([`YarnGroup::positions`]): P_{k mod n} + floor(k / n) period.
+pub fn unwrapped_position(pos: &[f64], period: f64, k: isize) -> f64 {
+    let n = pos.len() as isize;
+    pos[k.rem_euclid(n) as usize] + k.div_euclid(n) as f64 * period
 }
 
 /// Whether threads of radii `r` and `r_next` may stand `spacing` apart: they may touch but not
@@ -111,12 +111,13 @@ pub fn spacing_fits(spacing: f64, r: f64, r_next: f64) -> bool {
 }
 
 /// The room a float `fl` has along its axis between the surfaces of the `crossing` group's
-/// threads before and after it (unwrapped coordinates).
-pub fn float_room(crossing: &YarnGroup, fl: Float) -> (f64, f64) {
+/// threads before and after it (unwrapped coordinates); `pos` and `period` are the crossing
+/// group's [`YarnGroup::positions`].
+pub fn float_room(crossing: &YarnGroup, pos: &[f64], period: f64, fl: Float) -> (f64, f64) {
     let a = fl.start as isize;
     let b = a + fl.len as isize; // first crossing thread after the float
-    let lo = crossing.position(a - 1) + crossing.radius(a - 1);
-    let hi = crossing.position(b) - crossing.radius(b);
+    let lo = unwrapped_position(pos, period, a - 1) + crossing.radius(a - 1);
+    let hi = unwrapped_position(pos, period, b) - crossing.radius(b);
     (lo, hi)
 }
 
