@@ -83,6 +83,21 @@ fn check(precision: Precision) {
     );
     assert_eq!(attrs["clothbake.units"], "1/sr");
     assert_eq!(attrs["clothbake.tool"], "clothbake 0.1.0");
+    // The self-explaining attributes, as another library reads them.
+    let layout = attrs["clothbake.layout"].as_str().unwrap();
+    assert!(
+        layout.contains("x = pi * 5 + po, y = ti * 4 + to (15 x 8 pixels)"),
+        "{layout}"
+    );
+    let dirs = attrs["clothbake.directions"].as_str().unwrap();
+    assert!(
+        dirs.contains("theta_i = (ti + 0.5) * 90 / 2, phi_i = (pi + 0.5) * 360 / 3"),
+        "{dirs}"
+    );
+    assert!(attrs["clothbake.values"]
+        .as_str()
+        .unwrap()
+        .starts_with("R, G, B: f_r in 1/sr"));
     assert_eq!(got["crc32"]["ok"], true, "{}", got["crc32"]);
     let meta: Metadata = serde_json::from_value(got["metadata"].clone()).unwrap();
     assert_eq!(meta, table.meta);

@@ -10,7 +10,7 @@ use crate::atomic::write_atomic_as;
 use crate::bytes::{hex, CHUNK_VALUES};
 use crate::error::TableError;
 use crate::stored::{Samples, StoredTable};
-use crate::table::{check_format_version, Metadata, Precision, Table, FORMAT_VERSION};
+use crate::table::{check_format_version, Grid, Metadata, Precision, Table, FORMAT_VERSION};
 
 /// The 4 magic bytes that open every OpenEXR file.
 pub const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
@@ -25,10 +25,52 @@ pub const ATTR_GRID: &str = "clothbake.grid";
 pub const ATTR_UNITS: &str = "clothbake.units";
 /// EXR header attribute naming the tool that wrote the file.
 pub const ATTR_TOOL: &str = "clothbake.tool";
+/// EXR header attribute explaining which pixel holds which cell ([`layout_text`]).
+pub const ATTR_LAYOUT: &str = "clothbake.layout";
+/// EXR header attribute giving the cell centres and the direction conventions
+/// ([`directions_text`]).
+pub const ATTR_DIRECTIONS: &str = "clothbake.directions";
+/// EXR header attribute saying what the channels hold ([`values_text`]).
+pub const ATTR_VALUES: &str = "clothbake.values";
 /// EXR header attribute holding a CRC-32, as 8 lowercase hex digits, of the
 /// [`ATTR_METADATA`] text followed by every sample as f32 little-endian, pixels in row-major
 /// order, R, G, B per pixel. Readers verify it when present, as EXR itself has no checksum.
 pub const ATTR_CRC32: &str = "clothbake.crc32";
+
+/// The pixel-to-cell layout in words, with the grid's numbers: for the reader of `exrheader`.
+pub fn layout_text(g: &Grid) -> String {
+    format!(
+        "pixel (x, y) holds cell (ti, pi, to, po) with x = pi * {npo} + po, y = ti * {nto} + to \
+         ({w} x {h} pixels): one tile of {npo} x {nto} pixels (phi_o across, theta_o down) per \
+         incident direction (ti, pi); cell index ((ti * {npi} + pi) * {nto} + to) * {npo} + po",
+        npo = g.n_phi_o,
+        nto = g.n_theta_o,
+        npi = g.n_phi_i,
+        w = g.exr_width(),
+        h = g.exr_height(),
+    )
+}
+
+/// The cell centres and direction conventions in words, with the grid's numbers (the formulas
+/// of [`Grid::polar_centre_deg`] and [`Grid::azimuth_centre_deg`]).
+pub fn directions_text(g: &Grid) -> String {
+    format!(
+        "cell centres in degrees: theta_i = (ti + 0.5) * 90 / {}, phi_i = (pi + 0.5) * 360 / {}, \
+         theta_o = (to + 0.5) * 90 / {}, phi_o = (po + 0.5) * 360 / {}; theta from the macro \
+         normal +Z, phi from +X (the weft) toward +Y (the warp); i toward the light, o toward \
+         the eye",
+        g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o
+    )
+}
+
+/// What the channels hold, in words.
+pub fn values_text(meta: &Metadata) -> String {
+    format!(
+        "R, G, B: {} in {} at each cell centre (the BRDF, f_r = I / (pi cos theta_i)); the \
+         metadata and the bake's fabric and options are in clothbake.metadata",
+        meta.quantity, meta.units
+    )
+}
 
 /// Version-field flags of multi-part and deep EXR files (not written by clothbake).
 const EXR_MULTIPART: u32 = 0x1000;
@@ -206,6 +248,9 @@ mod exr_io {
             Text::from(ATTR_GRID),
             text(&format!("{grid}, cell-centred, degrees")),
         );
+        other.insert(Text::from(ATTR_LAYOUT), text(&layout_text(&grid)));
+        other.insert(Text::from(ATTR_DIRECTIONS), text(&directions_text(&grid)));
+        other.insert(Text::from(ATTR_VALUES), text(&values_text(&table.meta)));
         other.insert(Text::from(ATTR_UNITS), text(&table.meta.units));
         other.insert(Text::from(ATTR_TOOL), text(&table.meta.tool));
         other.insert(Text::from(ATTR_CRC32), text(&format!("{crc:08x}")));
@@ -495,7 +540,8 @@ mod exr_io {
 /// One RGB layer of f16 or f32 samples, `n_phi_i * n_phi_o` wide and `n_theta_i * n_theta_o`
 /// high: pixel `(pi * n_phi_o + po, ti * n_theta_o + to)` holds cell `(ti, pi, to, po)`. The
 /// header carries the [`Metadata`] as JSON in [`ATTR_METADATA`] and, for humans and other tools,
-/// [`ATTR_FORMAT_VERSION`], [`ATTR_GRID`], [`ATTR_UNITS`] and [`ATTR_TOOL`], and a checksum
+/// [`ATTR_FORMAT_VERSION`], [`ATTR_GRID`], [`ATTR_LAYOUT`], [`ATTR_DIRECTIONS`],
+/// [`ATTR_VALUES`], [`ATTR_UNITS`] and [`ATTR_TOOL`] (readers ignore these), and a checksum
 /// in [`ATTR_CRC32`]. With [`Precision::F16`], values beyond the half-float range (65504) are
 /// an error.
 pub fn write_exr(

@@ -207,6 +207,111 @@ fn exr_layout_is_tiles_of_outgoing_directions() {
     assert_eq!(meta, table.meta);
 }
 
+/// The number after `key` in `text` (e.g. `x = pi * ` -> 5).
+fn number_after(text: &str, key: &str) -> u32 {
+    let at = text
+        .find(key)
+        .unwrap_or_else(|| panic!("no {key:?} in {text:?}"))
+        + key.len();
+    let digits: String = text[at..]
+        .chars()
+        .take_while(char::is_ascii_digit)
+        .collect();
+    digits
+        .parse()
+        .unwrap_or_else(|_| panic!("no number after {key:?} in {text:?}"))
+}
+
+#[test]
+fn exr_header_explains_the_table() {
+    // The layout and direction attributes, read with the exr crate and followed to the letter,
+    // lead from every pixel to the cell the loader finds at those directions.
+    let d = dir();
+    let path = d.path().join("t.exr");
+    // Every value distinct, at least 1/360 from any other, and no steep slopes: a pixel
+    // mistaken for another cell shows, the lookup's rounding of angles does not.
+    let n = GRID.len() * 3;
+    let values = (0..n).map(|i| 1.0 + i as f32 / n as f32).collect();
+    let table = Table::new(sample_meta(GRID), values).unwrap();
+    write_exr(&path, &table, Precision::F32, false).unwrap();
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        &path,
+        |res, _| (res.width(), vec![[0f32; 3]; res.width() * res.height()]),
+        |(w, px), Vec2(x, y), (r, g, b, _a): (f32, f32, f32, f32)| px[y * *w + x] = [r, g, b],
+    )
+    .unwrap();
+    let layer = &image.layer_data;
+    let attr = |name: &str| match layer.attributes.other.get(&Text::from(name)) {
+        Some(AttributeValue::Text(t)) => t.to_string(),
+        other => panic!("{name}: {other:?}"),
+    };
+    let layout = attr("clothbake.layout");
+    let (x_stride, y_stride) = (
+        number_after(&layout, "x = pi * "),
+        number_after(&layout, "y = ti * "),
+    );
+    assert!(layout.contains("15 x 8 pixels"), "{layout}");
+    let dirs = attr("clothbake.directions");
+    let count = |axis: &str, idx: &str, span: u32| {
+        number_after(&dirs, &format!("{axis} = ({idx} + 0.5) * {span} / "))
+    };
+    let (nti, npi, nto, npo) = (
+        count("theta_i", "ti", 90),
+        count("phi_i", "pi", 360),
+        count("theta_o", "to", 90),
+        count("phi_o", "po", 360),
+    );
+    for needle in [
+        "theta from the macro normal +Z",
+        "phi from +X (the weft) toward +Y (the warp)",
+        "i toward the light, o toward the eye",
+    ] {
+        assert!(dirs.contains(needle), "{dirs}");
+    }
+    let values = attr("clothbake.values");
+    assert!(values.starts_with("R, G, B: f_r in 1/sr"), "{values}");
+
+    let brdf = clothbake_loader::Brdf::from_table(table.clone(), Default::default()).unwrap();
+    let unit = |theta: f64, phi: f64| {
+        let (t, p) = (theta.to_radians(), phi.to_radians());
+        [
+            (t.sin() * p.cos()) as f32,
+            (t.sin() * p.sin()) as f32,
+            t.cos() as f32,
+        ]
+    };
+    let (w, px) = &layer.channel_data.pixels;
+    let mut checked = 0;
+    for ti in 0..nti {
+        for pi in 0..npi {
+            for to in 0..nto {
+                for po in 0..npo {
+                    let (x, y) = ((pi * x_stride + po) as usize, (ti * y_stride + to) as usize);
+                    let wi = unit(
+                        (f64::from(ti) + 0.5) * 90.0 / f64::from(nti),
+                        (f64::from(pi) + 0.5) * 360.0 / f64::from(npi),
+                    );
+                    let wo = unit(
+                        (f64::from(to) + 0.5) * 90.0 / f64::from(nto),
+                        (f64::from(po) + 0.5) * 360.0 / f64::from(npo),
+                    );
+                    let (pixel, looked_up) = (px[y * w + x], brdf.eval(wi, wo));
+                    for k in 0..3 {
+                        let (a, b) = (pixel[k], looked_up[k]);
+                        assert!(
+                            (a - b).abs() <= 5e-4,
+                            "cell ({ti},{pi},{to},{po}) channel {k}: pixel {a}, lookup {b}"
+                        );
+                    }
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(checked, GRID.len());
+}
+
 #[test]
 fn f16_refuses_values_beyond_half_range() {
     let d = dir();

@@ -357,7 +357,7 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
         Some(s) => format!("symmetry {s}"),
     };
     let total = done.cells as u64;
-    Ok(format!(
+    let mut summary = format!(
         "wrote {}: {what}, {} of {} cells evaluated ({symmetry}), {secs:.2} s, {} cells/s, {} \
          thread{}\n",
         plan.output.display(),
@@ -366,7 +366,23 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
         thousands((total as f64 / secs.max(1e-9)).round() as u64),
         plan.threads,
         if plan.threads == 1 { "" } else { "s" },
-    ))
+    );
+    if plan.shard.is_none() {
+        summary.push_str(&next_steps(&plan.weave, &plan.output));
+    }
+    Ok(summary)
+}
+
+/// The line after a baked table's summary: what to try with it next.
+pub fn next_steps(weave: &Path, table: &Path) -> String {
+    format!(
+        "next: `clothbake info {t}` (what it holds), `clothbake render --table {t} -o {png}` \
+         (a picture), `clothbake eval --weave {w} --wi 30,0 --wo 45,180` (one pair of \
+         directions)\n",
+        t = table.display(),
+        png = table.with_extension("png").display(),
+        w = weave.display(),
+    )
 }
 
 #[cfg(test)]

@@ -23,10 +23,13 @@ pub use clothbake_bake::settings::{DEFAULT_SAMPLES, DEFAULT_SEED};
     name = "clothbake",
     version,
     args_conflicts_with_subcommands = true,
-    after_help = "Without a subcommand, `clothbake --weave FILE [options]` bakes a table (the options of \
-                  `clothbake bake`). Angles are in degrees: theta from the macro normal +Z (0 to 90), phi \
-                  from +X (the weft direction) toward +Y (the warp direction). Fabric files: see \
-                  docs/fabric-format.md and tables/*.json; baking: docs/baking.md."
+    override_usage = "clothbake --weave FILE [BAKE OPTIONS]   (bake a table: `clothbake bake --help`)\n       \
+                      clothbake <COMMAND> [OPTIONS]",
+    after_help = "Without a subcommand, `clothbake --weave FILE [options]` bakes a table: the options of \
+                  `clothbake bake`, listed by `clothbake bake --help`. Angles are in degrees: theta from \
+                  the macro normal +Z (0 to 90), phi from +X (the weft direction) toward +Y (the warp \
+                  direction). Fabric files: see docs/fabric-format.md and `clothbake fabrics`; baking: \
+                  docs/baking.md."
 )]
 pub struct Cli {
     /// What to do; without a subcommand clothbake bakes the fabric given with --weave.
@@ -34,7 +37,8 @@ pub struct Cli {
     pub command: Option<Command>,
 
     /// Fabric description to bake into a BRDF table (JSON, see docs/fabric-format.md, or a
-    /// WIF weaving draft, *.wif, see docs/wif.md).
+    /// WIF weaving draft, *.wif, see docs/wif.md), or a shipped fabric's name (`clothbake
+    /// fabrics`), e.g. twill.
     #[arg(long, value_name = "FILE")]
     pub weave: Option<PathBuf>,
 
@@ -65,13 +69,62 @@ pub enum Command {
     Render(RenderArgs),
     /// Plot a BRDF: slices in the plane of incidence or a hemisphere map (PNG, SVG).
     Plot(PlotArgs),
+    /// List the shipped fabrics (usable by name: `--weave twill`).
+    Fabrics,
+    /// Print a shell completion script on stdout, e.g. `clothbake completions bash >
+    /// ~/.local/share/bash-completion/completions/clothbake`.
+    Completions(CompletionsArgs),
+    /// Print a man page (roff) on stdout, e.g. `clothbake man | man -l -`, `clothbake man bake`.
+    Man(ManArgs),
+}
+
+/// `clothbake completions`.
+#[derive(Args, Debug)]
+pub struct CompletionsArgs {
+    /// The shell to complete in.
+    #[arg(value_enum, value_name = "SHELL")]
+    pub shell: clap_complete::Shell,
+}
+
+/// `clothbake man`.
+#[derive(Args, Debug)]
+pub struct ManArgs {
+    /// The subcommand whose page to print, e.g. bake [default: the top-level page].
+    #[arg(value_name = "COMMAND")]
+    pub command: Option<String>,
+}
+
+/// The argument ids of [`Cli`] that its help shows; the rest, the default mode's bake options,
+/// are listed by `clothbake bake --help` (the same options) instead.
+const TOP_LEVEL_SHOWN: [&str; 3] = ["weave", "help", "version"];
+
+/// The command line that `clothbake` parses: [`Cli`] with the default mode's bake options kept
+/// out of the top-level help, so that `clothbake -h` shows the commands. Completions use
+/// [`Cli::command`] itself, which completes every option.
+pub fn command() -> clap::Command {
+    use clap::CommandFactory;
+    Cli::command().mut_args(|a| {
+        if TOP_LEVEL_SHOWN.contains(&a.get_id().as_str()) {
+            a
+        } else {
+            a.hide(true)
+        }
+    })
+}
+
+/// The names of the subcommands, in the order of `clothbake --help`.
+pub fn subcommand_names() -> Vec<String> {
+    command()
+        .get_subcommands()
+        .map(|c| c.get_name().to_string())
+        .collect()
 }
 
 /// `clothbake bake`.
 #[derive(Args, Debug)]
 pub struct BakeCmd {
     /// Fabric description to bake (JSON, see docs/fabric-format.md, or a WIF draft, *.wif, see
-    /// docs/wif.md), e.g. tables/twill.json.
+    /// docs/wif.md), e.g. tables/twill.json, or a shipped fabric's name (`clothbake fabrics`).
     #[arg(long, value_name = "FILE")]
     pub weave: PathBuf,
 
@@ -274,7 +327,7 @@ pub struct InfoArgs {
 )]
 pub struct ExportArgs {
     /// Export the analytic model of this fabric (JSON, see docs/fabric-format.md, or a WIF
-    /// draft), e.g. tables/twill.json. Give this or --table.
+    /// draft), e.g. tables/twill.json, or a shipped fabric's name. Give this or --table.
     #[arg(long, value_name = "FILE")]
     pub weave: Option<PathBuf>,
 
@@ -391,7 +444,7 @@ pub struct DiffArgs {
 #[derive(Args, Debug)]
 pub struct EvalArgs {
     /// Fabric description (JSON, see docs/fabric-format.md, or a WIF draft, *.wif, see
-    /// docs/wif.md), e.g. tables/twill.json.
+    /// docs/wif.md), e.g. tables/twill.json, or a shipped fabric's name (`clothbake fabrics`).
     #[arg(long, value_name = "FILE")]
     pub weave: PathBuf,
 
@@ -928,7 +981,8 @@ pub struct ModelArgs {
 /// Where the BRDF of `render` and `plot` comes from, and the model's options.
 #[derive(Args, Debug, Clone)]
 pub struct BrdfArgs {
-    /// Shade with the analytic model of this fabric (JSON, see docs/fabric-format.md).
+    /// Shade with the analytic model of this fabric (JSON, see docs/fabric-format.md, a WIF
+    /// draft, or a shipped fabric's name).
     #[arg(long, value_name = "FILE")]
     pub weave: Option<PathBuf>,
 

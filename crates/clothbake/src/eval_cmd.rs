@@ -3,10 +3,11 @@
 use crate::cli::{DraftArgs, EvalArgs, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
 use crate::report::{self, Report};
+use clothbake_core::interreflection::Ranges;
 use clothbake_core::pathtrace::PathOptions;
-use clothbake_core::Secondary;
 use clothbake_core::{
-    AnalyticModel, Fabric, FabricError, FacetModel, PlainNaming, RayTracer, Reflection,
+    AnalyticModel, Caps, Fabric, FabricError, FacetModel, Kernel, PlainNaming, RayTracer,
+    Reflection, Secondary, SecondaryMethod, SecondaryOptions, Variant,
 };
 use std::path::Path;
 
@@ -122,11 +123,28 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     } else {
         reflection.brdf(wi)
     };
+    let bounces = match args.bounces.bounces {
+        1 => "1 bounce".to_string(),
+        n => format!("{n} bounces"),
+    };
+    let settings = match args.method {
+        Method::Analytic => format!(
+            "variant {}, {bounces}",
+            Variant::from(args.model.variant).name()
+        ),
+        Method::Raytrace => format!("caps {}, {bounces}", caps_name(args.caps.into())),
+    };
+    let secondary = secondary.map(|o| match args.method {
+        Method::Analytic => describe_secondary(&o),
+        Method::Raytrace => format!("path tracer, {} kernel", kernel_name(o.kernel)),
+    });
     let rep = Report {
         fabric_name: fabric.name(),
         file: &args.weave,
         method: args.method,
         facet,
+        settings,
+        secondary,
         wi: args.wi,
         wo: args.wo,
         horizon,
@@ -138,10 +156,56 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     Ok(if args.json { rep.json() } else { rep.table() })
 }
 
-/// Reads the fabric of `--weave` (JSON or WIF draft, with the draft's size flags) and applies the
-/// material overrides.
+/// How the analytic model computes I_2, in words: the solution with its quadrature orders or
+/// sampling settings, and the kernel.
+pub fn describe_secondary(o: &SecondaryOptions) -> String {
+    let how = match &o.method {
+        SecondaryMethod::Analytic { ranges, orders } => {
+            let nodes = if orders.tol > 0.0 {
+                format!(
+                    "adaptive along C1 (tol {}), {},{}",
+                    orders.tol, orders.beta, orders.axial
+                )
+            } else {
+                format!("{},{},{}", orders.theta, orders.beta, orders.axial)
+            };
+            let ranges = match ranges {
+                Ranges::Full => "full ranges".to_string(),
+                Ranges::Thesis { .. } => "the thesis's ranges".to_string(),
+            };
+            format!("analytic solution (sec. 5.3), orders {nodes} (theta,beta,axial), {ranges}")
+        }
+        SecondaryMethod::Sampling(p) => format!(
+            "two-level sampling (sec. 5.2), {} first-level samples, steps {} rad and {}, l0 {}, \
+             {} solid angles",
+            p.first_level,
+            p.d_alpha,
+            p.d_l,
+            p.l0,
+            if p.exact_solid_angle { "exact" } else { "area" }
+        ),
+    };
+    format!("{how}, {} kernel", kernel_name(o.kernel))
+}
+
+fn kernel_name(k: Kernel) -> &'static str {
+    match k {
+        Kernel::Thesis => "thesis",
+        Kernel::Radiometric => "radiometric",
+    }
+}
+
+fn caps_name(c: Caps) -> &'static str {
+    match c {
+        Caps::Excluded => "excluded",
+        Caps::Shaded => "shaded",
+    }
+}
+
+/// Reads the fabric of `--weave` (JSON or WIF draft, with the draft's size flags; or a shipped
+/// fabric's name, [`crate::fabrics`]) and applies the material overrides.
 pub fn load_fabric(weave: &Path, draft: &DraftArgs, m: &MaterialArgs) -> Result<Fabric, CliError> {
-    if draft.any() && !clothbake_core::source::is_wif(weave) {
+    if draft.any() && !crate::fabrics::is_draft(weave) {
         return Err(CliError::new(
             format!(
                 "--radius and --spacing apply only to a WIF draft (*.wif), and {} is a fabric file, which gives its sizes itself",
@@ -150,7 +214,7 @@ pub fn load_fabric(weave: &Path, draft: &DraftArgs, m: &MaterialArgs) -> Result<
             "drop them, or edit radius and spacing in the fabric file",
         ));
     }
-    let fabric = Fabric::from_path_with(weave, &draft.options())?;
+    let fabric = crate::fabrics::read(weave, &draft.options())?;
     Ok(apply_material(fabric, m)?)
 }
 

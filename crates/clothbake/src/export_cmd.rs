@@ -48,7 +48,10 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
         (Some(weave), None) => {
             let secondary = args.bounces.options()?;
             let secondary = (args.bounces.bounces == 2).then_some(secondary);
-            let fabric = apply_material(Fabric::from_path(weave)?, &args.material)?;
+            let fabric = apply_material(
+                crate::fabrics::read(weave, &Default::default())?,
+                &args.material,
+            )?;
             refuse_existing(args)?;
             let facet = FacetModel::from(args.facet.unwrap_or(crate::cli::FacetArg::Huo));
             let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);

@@ -9,13 +9,15 @@ mod diff_cmd;
 mod error;
 mod eval_cmd;
 mod export_cmd;
+mod fabrics;
+mod help_cmd;
 mod info_cmd;
 mod merge_cmd;
 mod render_cmd;
 mod report;
 
-use clap::error::ErrorKind;
-use clap::Parser;
+use clap::error::{ContextKind, ErrorKind};
+use clap::FromArgMatches;
 use cli::{Cli, Command};
 use error::CliError;
 use std::io::Write;
@@ -52,27 +54,16 @@ fn main() -> ExitCode {
 /// Runs the command line; returns the exit status of a successful run (0, or 1 for `diff`
 /// beyond its tolerance).
 fn run() -> Result<u8, CliError> {
-    let cli = match Cli::try_parse() {
+    let parsed = cli::command()
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m));
+    let cli = match parsed {
         Ok(cli) => cli,
         Err(e) if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) => {
             let _ = e.print();
             return Ok(0);
         }
-        Err(e) => {
-            let first = std::env::args().skip(1).find(|a| !a.starts_with('-'));
-            let sub = match first.as_deref() {
-                Some("eval") => "clothbake eval",
-                Some("bake") => "clothbake bake",
-                Some("info") => "clothbake info",
-                Some("diff") => "clothbake diff",
-                Some("export") => "clothbake export",
-                Some("merge") => "clothbake merge",
-                Some("render") => "clothbake render",
-                Some("plot") => "clothbake plot",
-                _ => "clothbake",
-            };
-            return Err(error::from_clap(&e, sub));
-        }
+        Err(e) => return Err(parse_error(&e)),
     };
     let (out, code) = match cli.command {
         Some(Command::Eval(args)) => (eval_cmd::run(&args)?, 0),
@@ -83,9 +74,12 @@ fn run() -> Result<u8, CliError> {
         Some(Command::Merge(args)) => (merge_cmd::run(&args)?, 0),
         Some(Command::Render(args)) => (render_cmd::run_render(&args)?, 0),
         Some(Command::Plot(args)) => (render_cmd::run_plot(&args)?, 0),
+        Some(Command::Fabrics) => (fabrics::list(), 0),
+        Some(Command::Completions(args)) => (help_cmd::completions(args.shell), 0),
+        Some(Command::Man(args)) => (help_cmd::man(args.command.as_deref())?, 0),
         None => match &cli.weave {
             Some(w) => (bake_cmd::run(w, &cli.bake)?, 0),
-            None => return Err(no_command()),
+            None => return Err(help_cmd::no_command()),
         },
     };
     let mut stdout = std::io::stdout().lock();
@@ -101,11 +95,30 @@ fn run() -> Result<u8, CliError> {
     }
 }
 
-/// `clothbake` alone.
-fn no_command() -> CliError {
-    CliError::new(
-        "no command given",
-        "bake a table with `clothbake --weave FILE` (e.g. tables/twill.json), or see \
-         `clothbake --help` for eval, info, diff and export",
-    )
+/// A command line clap rejected, as one line that points to the help of the command meant: a
+/// subcommand's, the bake's (the default mode, `--weave` given) or the top level's. A fabric
+/// given where a command goes gets the `--weave` spelling.
+fn parse_error(e: &clap::Error) -> CliError {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let names = cli::subcommand_names();
+    let first = args.iter().find(|a| !a.starts_with('-'));
+    let sub = match first {
+        Some(f) if names.contains(f) => format!("clothbake {f}"),
+        _ if args
+            .iter()
+            .any(|a| a == "--weave" || a.starts_with("--weave=")) =>
+        {
+            "clothbake bake".into()
+        }
+        _ => "clothbake".into(),
+    };
+    if e.kind() == ErrorKind::InvalidSubcommand {
+        if let Some(hint) = e
+            .get(ContextKind::InvalidSubcommand)
+            .and_then(|v| help_cmd::fabric_given_as_command(&v.to_string()))
+        {
+            return hint;
+        }
+    }
+    error::from_clap(e, &sub)
 }

@@ -7,7 +7,7 @@ use crate::cli::{
 };
 use crate::error::{table_error, CliError};
 use crate::eval_cmd::apply_material;
-use clothbake_core::{Fabric, FacetModel, Vec3};
+use clothbake_core::{FacetModel, Vec3};
 use clothbake_render::camera::{Camera, CameraError};
 use clothbake_render::plot::{self, Plot, Source};
 use clothbake_render::scene::Scene;
@@ -28,7 +28,10 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
         ComponentArg::Secondary => Component::Secondary,
         ComponentArg::Iss => Component::SecondarySpecular,
     };
-    let fabric = apply_material(Fabric::from_path(weave)?, &b.material)?;
+    let fabric = apply_material(
+        crate::fabrics::read(weave, &Default::default())?,
+        &b.material,
+    )?;
     Shader::model(
         &fabric,
         FacetModel::from(b.model.facet),

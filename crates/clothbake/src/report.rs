@@ -38,6 +38,11 @@ pub struct Report<'a> {
     pub method: Method,
     /// Facet model used.
     pub facet: FacetModel,
+    /// The rest of the model's settings in words (variant or caps, bounces), e.g.
+    /// `variant refined, 1 bounce`.
+    pub settings: String,
+    /// With two bounces: how I_2 was computed (solution, orders or sampling, kernel).
+    pub secondary: Option<String>,
     /// Toward the light.
     pub wi: Direction,
     /// Toward the eye.
@@ -93,12 +98,16 @@ impl Report<'_> {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "fabric  {} ({})\nmethod  {}, {} facets",
+            "fabric  {} ({})\nmethod  {}, {} facets, {}",
             self.fabric_name,
             self.file.display(),
             self.method.name(),
-            self.facet.name()
+            self.facet.name(),
+            self.settings
         );
+        if let Some(how) = &self.secondary {
+            let _ = writeln!(s, "I_2 by  {how}");
+        }
         let _ = writeln!(
             s,
             "wi      theta {:6.2}  phi {:7.2}  (toward the light, degrees)",

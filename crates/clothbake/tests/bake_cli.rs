@@ -26,7 +26,12 @@ fn default_mode_writes_a_table_that_info_reads() {
     let d = fresh_dir("default");
     let twill = fabric("twill");
     let out = succeeds(&run_in(&d, &["--weave", &twill, "--res", SMALL]));
-    assert_eq!(out.lines().count(), 1, "{out}");
+    assert_eq!(out.lines().count(), 2, "{out}");
+    assert!(out
+        .lines()
+        .nth(1)
+        .unwrap()
+        .starts_with("next: `clothbake info twill.exr`"));
     for w in [
         "wrote twill.exr",
         "4x8x4x8",
