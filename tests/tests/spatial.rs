@@ -9,25 +9,22 @@ use clothbake_core::{
 use std::collections::HashMap;
 use std::path::Path;
 
-const SHIPPED: [&str; 9] = [
-    "plain.json",
-    "basket.json",
-    "twill.json",
-    "twill31.json",
-    "satin5.json",
-    "parallel.json",
-    "gingham.wif",
-    "denim.wif",
-    "twill22.wif",
-];
+fn tables() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables")
+}
 
 fn fabric(file: &str) -> Fabric {
-    Fabric::from_path(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../tables")
-            .join(file),
-    )
-    .unwrap()
+    Fabric::from_path(&tables().join(file)).unwrap()
+}
+
+/// Every shipped fabric (JSON and WIF) by file name.
+fn shipped() -> Vec<String> {
+    let files = clothbake_bake::golden::fabric_files(&tables()).unwrap();
+    assert!(files.len() >= 9, "{files:?}");
+    files
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect()
 }
 
 fn pairs() -> Vec<(UnitVec3, UnitVec3)> {
@@ -49,7 +46,8 @@ fn coverage_weighted_mean_over_a_fine_grid_is_the_average() {
     // in proportion to its area; irregular drafts are not multiples of the grid, hence the
     // tolerance rather than rounding error.
     const N: usize = 240;
-    for file in SHIPPED {
+    for file in &shipped() {
+        let file = file.as_str();
         let model = AnalyticModel::new(&fabric(file), FacetModel::Huo);
         for two in [false, true] {
             let opts = two.then(SecondaryOptions::default);
@@ -144,7 +142,8 @@ fn each_cell_matches_the_ray_traced_truth() {
     // relative error under 4%, worst direction under 12%. Per cell the model makes the same
     // error as on average: measured worst cell 9.1% (gingham at wi 70/270, wo 65/30), worst
     // coverage difference 0.027 (docs/validation.md).
-    for file in SHIPPED {
+    for file in &shipped() {
+        let file = file.as_str();
         let f = fabric(file);
         let model = AnalyticModel::new(&f, FacetModel::Huo);
         let truth = RayTracer::new(&f, FacetModel::Huo);

@@ -6,17 +6,6 @@ use clothbake_core::{AnalyticModel, Cell, Fabric, FacetModel, RayTracer};
 use std::fmt::Write as _;
 use std::path::Path;
 
-const FABRICS: [&str; 9] = [
-    "plain.json",
-    "basket.json",
-    "twill.json",
-    "twill31.json",
-    "satin5.json",
-    "parallel.json",
-    "gingham.wif",
-    "denim.wif",
-    "twill22.wif",
-];
 const PAIRS: usize = 12;
 const SAMPLES: usize = 400_000;
 /// Cells with fewer truth hits are left out of the errors of I (their truth is too noisy).
@@ -41,8 +30,8 @@ pub fn run(root: &Path) {
          |---|---|---|---|---|---|"
     )
     .unwrap();
-    for file in FABRICS {
-        let f = Fabric::from_path(&root.join("tables").join(file)).unwrap();
+    for path in clothbake_bake::golden::fabric_files(&root.join("tables")).unwrap() {
+        let f = Fabric::from_path(&path).unwrap();
         let model = AnalyticModel::new(&f, FacetModel::Huo);
         let truth = RayTracer::new(&f, FacetModel::Huo);
         let (nx, ny) = model.cells().dims();
@@ -67,7 +56,7 @@ pub fn run(root: &Path) {
                 }
             }
         }
-        let name = file.split('.').next().unwrap();
+        let name = path.file_stem().unwrap().to_string_lossy();
         writeln!(
             out,
             "| {name} | {} | {:.2}% | {:.2}% | {:.3} | {:.2}% |",

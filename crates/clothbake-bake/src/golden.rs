@@ -43,14 +43,26 @@ pub fn bake_golden(fabric: &Fabric) -> Result<Table, BakeError> {
 /// The shipped fabrics: every `*.json` in `tables_dir`, as (name, path), sorted by name.
 pub fn shipped_fabrics(tables_dir: &Path) -> std::io::Result<Vec<(String, PathBuf)>> {
     let mut v = Vec::new();
-    for e in std::fs::read_dir(tables_dir)? {
-        let p = e?.path();
-        if p.extension().is_some_and(|x| x == "json") && p.is_file() {
+    for p in fabric_files(tables_dir)? {
+        if p.extension().is_some_and(|x| x == "json") {
             let name = p
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default();
             v.push((name, p));
+        }
+    }
+    v.sort();
+    Ok(v)
+}
+
+/// Every fabric file (`*.json` and `*.wif` drafts) directly in `tables_dir`, sorted by path.
+pub fn fabric_files(tables_dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut v = Vec::new();
+    for e in std::fs::read_dir(tables_dir)? {
+        let p = e?.path();
+        if p.extension().is_some_and(|x| x == "json" || x == "wif") && p.is_file() {
+            v.push(p);
         }
     }
     v.sort();
