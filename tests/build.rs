@@ -8,5 +8,5 @@ include!("../crates/clothbake-loader/build/probe.rs");
 fn main() {
     println!("cargo::rerun-if-changed=build.rs");
     println!("cargo::rerun-if-changed=../crates/clothbake-loader/build/probe.rs");
-    emit(&[PYTHON, NUMPY, MITSUBA, OPENEXR, SLURM]);
+    emit(&[PYTHON, NUMPY, MITSUBA, OPENEXR, SLURM, PKG_CONFIG]);
 }

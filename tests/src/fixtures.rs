@@ -66,3 +66,30 @@ pub fn bake_and_open(fabric: &Fabric, path: &Path) -> Brdf {
     };
     Brdf::open(path, options).expect("the table reads back")
 }
+
+/// The directions and random numbers of examples/c/sample.c, as it spells them.
+pub const SAMPLE_C_WI: [f32; 3] = [0.3, 0.1, 0.948_683_3];
+/// See [`SAMPLE_C_WI`].
+pub const SAMPLE_C_WO: [f32; 3] = [-0.4, 0.2, 0.894_427_2];
+/// See [`SAMPLE_C_WI`].
+pub const SAMPLE_C_U: (f32, f32) = (0.25, 0.75);
+
+/// Checks what examples/c/sample.c printed against the Rust loader's `b` on the same table:
+/// every number (printed with 9 significant digits, enough to give the f32 back) equal.
+pub fn check_sample_c_output(stdout: &str, b: &Brdf) {
+    let numbers = |line: &str| -> Vec<f32> {
+        line.split_whitespace()
+            .filter_map(|w| w.parse::<f32>().ok())
+            .collect()
+    };
+    let mut lines = stdout.lines();
+    let f = numbers(lines.next().expect("an f_r line"));
+    assert_eq!(f, b.eval(SAMPLE_C_WI, SAMPLE_C_WO), "{stdout}");
+    let s = numbers(lines.next().expect("a sample line"));
+    let want = b.sample(SAMPLE_C_WO, SAMPLE_C_U.0, SAMPLE_C_U.1);
+    let mut expected = want.wi.to_vec();
+    expected.extend(want.weight);
+    expected.push(want.pdf);
+    assert_eq!(s, expected, "{stdout}");
+    assert!(want.pdf > 0.0, "the example's sample is a real one");
+}

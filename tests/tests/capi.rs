@@ -131,3 +131,69 @@ fn the_c_program_agrees_with_the_rust_loader() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A small twill table (8 x 16 x 8 x 16, f16 EXR) in `dir`, and the Rust loader on it.
+fn small_twill(dir: &Path) -> (PathBuf, Brdf) {
+    let fabric = Fabric::from_path(&root().join("tables/twill.json")).unwrap();
+    let opts = BakeOptions {
+        grid: Grid {
+            n_theta_i: 8,
+            n_phi_i: 16,
+            n_theta_o: 8,
+            n_phi_o: 16,
+        },
+        ..BakeOptions::default()
+    };
+    let table = bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false))
+        .unwrap()
+        .table;
+    let path = dir.join("twill.exr");
+    write_exr(&path, &table, Precision::F16, false).unwrap();
+    let b = Brdf::open(&path, Options::default()).unwrap();
+    (path, b)
+}
+
+#[test]
+fn the_documented_example_compiles_as_given_and_runs() {
+    // docs/loader.md shows examples/c/sample.c whole.
+    let example = std::fs::read_to_string(root().join("examples/c/sample.c")).unwrap();
+    let doc = std::fs::read_to_string(root().join("docs/loader.md")).unwrap();
+    assert!(
+        doc.contains(&format!("```c\n{example}```")),
+        "the C block of docs/loader.md is not examples/c/sample.c"
+    );
+    let dir = temp_dir("capi-example");
+    let (table, b) = small_twill(&dir);
+    let exe = dir.join("sample");
+    // The documented command line, with the warnings a careful C programmer turns on.
+    let cc = Command::new("cc")
+        .current_dir(root())
+        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"])
+        .args(["-I", "crates/clothbake-capi/include", "examples/c/sample.c"])
+        .arg(static_lib())
+        .args(["-lpthread", "-ldl", "-lm", "-o"])
+        .arg(&exe)
+        .output()
+        .expect("the C compiler `cc` runs");
+    assert!(
+        cc.status.success(),
+        "cc failed:\n{}",
+        String::from_utf8_lossy(&cc.stderr)
+    );
+    let run = Command::new(&exe).arg(&table).output().unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    clothbake_tests::fixtures::check_sample_c_output(&stdout, &b);
+    // A missing table: the loader's message on stderr, exit 1.
+    let run = Command::new(&exe)
+        .arg(dir.join("none.exr"))
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("none.exr"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

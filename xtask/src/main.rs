@@ -2,6 +2,8 @@
 //!
 //! * `test [ARGS]`: the whole suite on a fresh machine: a local `.venv` with numpy, pytest,
 //!   OpenEXR and mitsuba, then fmt, clippy and `cargo test --workspace [ARGS]` (see `test.rs`).
+//! * `install-capi PREFIX`: the C API's header, libraries and pkg-config file under PREFIX (see
+//!   `install_capi.rs`).
 //! * `ch5`: the comparisons of thesis sec. 5.4 (sphere, disk, convergence) into
 //!   `docs/interreflection-results.md`.
 //! * `figures`: the thesis's rendered scenes (Figs 4.5, 5.10, 5.11, 5.17) into `docs/figures/`.
@@ -24,6 +26,7 @@ use clothbake_bake::golden::{bake_golden, golden_path, shipped_fabrics};
 use clothbake_bake::{bake, BakeOptions};
 mod ch5;
 mod figures;
+mod install_capi;
 mod ir_accuracy;
 mod spatial;
 mod test;
@@ -47,6 +50,7 @@ fn main() {
     let task = std::env::args().nth(1).unwrap_or_default();
     match task.as_str() {
         "test" => test::run_all(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
+        "install-capi" => install_capi::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
         "validate" => validate(),
         "validate-spatial" => spatial::run(&root()),
         "ch5" => ch5::run(&root()),
@@ -60,7 +64,7 @@ fn main() {
         "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask test [CARGO TEST ARGS] | validate | validate-spatial | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
+                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | golden | ch5 | figures [fig4-5|disks|fig5-17] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
             );
             std::process::exit(2);
         }

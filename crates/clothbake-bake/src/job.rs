@@ -13,6 +13,7 @@
 use crate::checkpoint::{checkpoint_path, Checkpointer, DEFAULT_INTERVAL};
 use crate::merge::orbits_of;
 use crate::output::{preflight, write_table, Format};
+use crate::settings::Naming;
 use crate::shard::{read_part, shard_rows, write_part, Kind, Part, ShardId};
 use crate::sweep::{BakeError, BakeOptions, Baker, Row};
 use clothbake_core::Fabric;
@@ -59,6 +60,8 @@ pub struct Job<'a> {
     pub overwrite: bool,
     /// Time between checkpoints.
     pub checkpoint_every: Duration,
+    /// How messages spell options (`--resume` or `resume=True`).
+    pub naming: Naming,
 }
 
 impl<'a> Job<'a> {
@@ -71,6 +74,7 @@ impl<'a> Job<'a> {
             resume: false,
             overwrite: false,
             checkpoint_every: DEFAULT_INTERVAL,
+            naming: Naming::Cli,
         }
     }
 }
@@ -118,6 +122,8 @@ pub struct Interrupted {
     pub checkpoint: Option<PathBuf>,
     /// Why the checkpoint could not be saved, if it could not.
     pub save_error: Option<TableError>,
+    /// How the message spells resuming.
+    pub naming: Naming,
 }
 
 /// Why a job produced nothing. Every message names the problem and the fix.
@@ -147,12 +153,14 @@ impl std::fmt::Display for Interrupted {
             ),
             (None, Some(ck)) if self.saved > 0 => write!(
                 f,
-                "interrupted; no {} was written, {} of {} rows are saved in {}; run the same \
-                 command with --resume to continue",
+                "interrupted; no {} was written, {} of {} rows are saved in {}; {} with {} to \
+                 continue",
                 self.what,
                 self.saved,
                 self.rows,
-                ck.display()
+                ck.display(),
+                self.naming.again(),
+                self.naming.switch("resume"),
             ),
             _ => f.write_str("interrupted; nothing was written"),
         }
@@ -294,7 +302,9 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
                     output.expect("a checkpoint has an output").display()
                 ),
                 format!(
-                    "continue it with the same command and --resume, or delete {} to start again",
+                    "continue it: {} with {}; or delete {} to start again",
+                    job.naming.again(),
+                    job.naming.switch("resume"),
                     ck.display()
                 ),
             ))
@@ -354,6 +364,7 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
                 rows: rows.len(),
                 checkpoint: ck_path,
                 save_error,
+                naming: job.naming,
             })));
         }
         Err(e) => return Err(bake_error(e)),

@@ -39,6 +39,22 @@ impl Naming {
         }
     }
 
+    /// The switch `name` turned on: `--resume` or `resume=True`.
+    pub fn switch(self, name: &str) -> String {
+        match self {
+            Naming::Cli => format!("--{name}"),
+            Naming::Python => format!("{name}=True"),
+        }
+    }
+
+    /// Doing it again the same way: `the same command` or `bake() again`.
+    pub fn again(self) -> &'static str {
+        match self {
+            Naming::Cli => "run the same command",
+            Naming::Python => "call bake() again",
+        }
+    }
+
     /// The option `name` set to the number `value`: `--bounces 2` or `bounces=2`.
     pub fn number(self, name: &str, value: &str) -> String {
         match self {

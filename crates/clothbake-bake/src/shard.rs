@@ -13,6 +13,7 @@
 //! (rows in increasing order, each [`Row`] in cell order, RGB): exactly the f32 values the
 //! single-process bake computes, so a merge is bit-identical to it.
 
+use crate::settings::Naming;
 use crate::sweep::{row_cell, Orbits, Row};
 use clothbake_loader::container::{read_container, write_container_chunks, ContainerKind};
 use clothbake_loader::{Grid, Metadata, TableError};
@@ -86,25 +87,36 @@ struct Header {
     metadata: Metadata,
 }
 
-/// Parses `K/N` (0-based K, 0 <= K < N); the message says what is wrong and the fix.
+/// Parses `K/N` (0-based K, 0 <= K < N); the message says what is wrong and the fix, in the
+/// command line's words.
 pub fn parse_shard_id(s: &str) -> Result<ShardId, String> {
-    const FIX: &str =
-        "give --shard K/N with K from 0 to N-1 (0-based), e.g. --shard 0/4, or --shard auto";
+    parse_shard_id_as(s, Naming::Cli)
+}
+
+/// [`parse_shard_id`] with the fix spelled as `n` spells options (`--shard 0/4`,
+/// `shard="0/4"`).
+pub fn parse_shard_id_as(s: &str, naming: Naming) -> Result<ShardId, String> {
+    let fix = match naming {
+        Naming::Cli => {
+            "give --shard K/N with K from 0 to N-1 (0-based), e.g. --shard 0/4, or --shard auto"
+        }
+        Naming::Python => "give shard=\"K/N\" with K from 0 to N-1 (0-based), e.g. shard=\"0/4\"",
+    };
     let (k, n) = s
         .split_once('/')
-        .ok_or_else(|| format!("shard `{s}` is not K/N; {FIX}"))?;
+        .ok_or_else(|| format!("shard `{s}` is not K/N; {fix}"))?;
     let num = |t: &str, what: &str| {
         t.trim()
             .parse::<u32>()
-            .map_err(|_| format!("shard {what} `{}` is not a whole number; {FIX}", t.trim()))
+            .map_err(|_| format!("shard {what} `{}` is not a whole number; {fix}", t.trim()))
     };
     let (index, count) = (num(k, "index K")?, num(n, "count N")?);
     if count == 0 {
-        return Err(format!("shard count N is 0; {FIX}"));
+        return Err(format!("shard count N is 0; {fix}"));
     }
     if index >= count {
         return Err(format!(
-            "shard index {index} is not below the count {count} (K is 0-based); {FIX}"
+            "shard index {index} is not below the count {count} (K is 0-based); {fix}"
         ));
     }
     Ok(ShardId { index, count })
@@ -413,6 +425,12 @@ mod tests {
         ] {
             let e = parse_shard_id(bad).unwrap_err();
             assert!(e.contains(needle), "{bad}: {e}");
+            let e = parse_shard_id_as(bad, Naming::Python).unwrap_err();
+            assert!(e.contains(needle), "{bad}: {e}");
+            assert!(
+                e.contains("shard=\"0/4\"") && !e.contains("--"),
+                "{bad}: {e}"
+            );
         }
     }
 

@@ -70,6 +70,14 @@ fn cancelled_then_resumed_equals_the_uninterrupted_bake() {
     let never = AtomicBool::new(false);
     let e = run(&job, &hooks(&|_, _| {}, &|_| {}, &never)).unwrap_err();
     assert!(e.to_string().contains("--resume"), "{e}");
+    // Python's spelling, for the same refusal.
+    job.naming = clothbake_bake::settings::Naming::Python;
+    let e = run(&job, &hooks(&|_, _| {}, &|_| {}, &never)).unwrap_err();
+    assert!(
+        e.to_string().contains("call bake() again with resume=True")
+            && !e.to_string().contains("--"),
+        "{e}"
+    );
     job.resume = true;
     let notes = std::sync::Mutex::new(Vec::new());
     let note = |m: &str| notes.lock().unwrap().push(m.to_string());

@@ -74,6 +74,20 @@ pub const SLURM: Dependency = Dependency {
     check: slurm_ready,
 };
 
+/// pkg-config (the test of `cargo xtask install-capi`, which compiles the C example with it).
+#[allow(dead_code)]
+pub const PKG_CONFIG: Dependency = Dependency {
+    name: "pkgconfig",
+    needs: "pkg-config",
+    install: "apt-get install pkg-config (or your system's package of it)",
+    uses_path: true,
+    check: || match std::process::Command::new("pkg-config").arg("--version").output() {
+        Ok(out) if out.status.success() => Ok(()),
+        Ok(out) => Err(format!("pkg-config --version failed ({})", out.status)),
+        Err(e) => Err(format!("pkg-config cannot be run: {e}")),
+    },
+};
+
 /// A processor with AVX2, FMA and F16C (the loader's AVX2 kernel).
 #[allow(dead_code)]
 pub const AVX2: Dependency = Dependency {

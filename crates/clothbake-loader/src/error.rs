@@ -22,8 +22,9 @@ pub enum TableError {
         /// The cause.
         source: io::Error,
     },
-    /// The target exists and overwriting was not asked for.
-    #[error("{}: the file already exists; use --force to overwrite it", .path.display())]
+    /// The target exists and overwriting was not asked for. (The front ends name their own
+    /// switch: `--force` on the command line, `overwrite=True` in Python.)
+    #[error("{}: the file already exists; ask for it to be overwritten (overwrite = true) to replace it", .path.display())]
     AlreadyExists {
         /// The existing file.
         path: PathBuf,

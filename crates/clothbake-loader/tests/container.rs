@@ -208,7 +208,7 @@ fn writing_refuses_existing_files_and_bad_headers() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("part.shard: the file already exists; use --force"),
+        e.contains("part.shard: the file already exists; ask for it to be overwritten"),
         "{e}"
     );
     assert_eq!(fs::read(&path).unwrap(), bytes);

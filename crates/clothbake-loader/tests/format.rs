@@ -524,11 +524,16 @@ fn existing_file_is_not_overwritten_without_force() {
     let table = sample_table(GRID);
     let e = message(write_binary(&path, &table, false).unwrap_err());
     assert!(
-        e.contains("t.bin: the file already exists; use --force"),
+        e.contains(
+            "t.bin: the file already exists; ask for it to be overwritten (overwrite = true)"
+        ),
         "{e}"
     );
     let e = message(write_exr(&path, &table, Precision::F16, false).unwrap_err());
-    assert!(e.contains("use --force"), "{e}");
+    assert!(
+        e.contains("(overwrite = true)") && !e.contains("--force"),
+        "{e}"
+    );
     assert_eq!(fs::read(&path).unwrap(), b"precious");
     assert_eq!(listing(d.path()), ["t.bin"]);
 

@@ -7,7 +7,7 @@ use crate::table::{table_err, PyTable};
 use clothbake_bake::job::{self, Hooks, Job, JobError, Target};
 use clothbake_bake::output::Format;
 use clothbake_bake::settings::{parse_orders, parse_sampling, Bounces, Naming, Settings};
-use clothbake_bake::shard::parse_shard_id;
+use clothbake_bake::shard::parse_shard_id_as;
 use clothbake_core::{Caps, Kernel, Variant};
 use clothbake_loader::{Grid, Precision, StoredTable};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
@@ -191,7 +191,7 @@ pub fn bake(
         .options(Naming::Python)
         .map_err(PyValueError::new_err)?;
     let shard = shard
-        .map(parse_shard_id)
+        .map(|s| parse_shard_id_as(s, Naming::Python))
         .transpose()
         .map_err(|e| bad("shard", e))?;
     let checkpoint_every = match checkpoint_every {
@@ -251,6 +251,7 @@ pub fn bake(
         resume,
         overwrite,
         checkpoint_every,
+        naming: Naming::Python,
     };
 
     let (print, callback) = match &progress {
@@ -313,20 +314,7 @@ pub fn bake(
             "{error}; or delete {} to start the bake again",
             path.display()
         )),
-        JobError::Interrupted(i) => {
-            let msg = match (&i.save_error, &i.checkpoint) {
-                (None, Some(ck)) if i.saved > 0 => format!(
-                    "interrupted; no {} was written, {} of {} rows are saved in {}; call bake \
-                     again with resume=True to continue",
-                    i.what,
-                    i.saved,
-                    i.rows,
-                    ck.display()
-                ),
-                _ => i.to_string(),
-            };
-            PyKeyboardInterrupt::new_err(msg)
-        }
+        JobError::Interrupted(i) => PyKeyboardInterrupt::new_err(i.to_string()),
     })?;
     match done.table {
         None => Ok(None),

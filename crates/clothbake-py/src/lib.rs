@@ -31,12 +31,13 @@ pub(crate) fn bench_directions(n: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
     (0..n).map(|_| (dir(), dir())).unzip()
 }
 
-/// The native module: `Fabric`, `Table`, `bake`.
+/// The native module: `Fabric`, `Table`, `bake`, `__version__` (the crate's version).
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<fabric::PyFabric>()?;
     m.add_class::<table::PyTable>()?;
     m.add_function(wrap_pyfunction!(bake::bake, m)?)?;
     m.add("UNIT_TOLERANCE", vectors::UNIT_TOLERANCE)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

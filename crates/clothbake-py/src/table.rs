@@ -21,7 +21,10 @@ pub fn table_err(e: TableError) -> PyErr {
             PyFileNotFoundError::new_err(msg)
         }
         TableError::Io { .. } | TableError::NoSuchFolder { .. } => PyOSError::new_err(msg),
-        TableError::AlreadyExists { .. } => PyFileExistsError::new_err(msg),
+        TableError::AlreadyExists { path } => PyFileExistsError::new_err(format!(
+            "{}: the file already exists; pass overwrite=True to replace it",
+            path.display()
+        )),
         _ => PyValueError::new_err(msg),
     }
 }
@@ -239,7 +242,8 @@ impl PyTable {
     }
 
     /// Writes the table atomically: OpenEXR (`.exr`, precision "f16" or "f32") or the binary
-    /// format (any other extension, f32). An existing file is kept unless `overwrite=True`.
+    /// format (any other extension, f32). An existing file is kept, with FileExistsError,
+    /// unless `overwrite=True`.
     #[pyo3(signature = (path, precision="f16", overwrite=false))]
     fn save(
         &self,

@@ -293,3 +293,44 @@ def test_bake_options_reach_the_table(twill_path):
 def test_bad_bake_options_name_the_option(twill_path, kwargs, words):
     with pytest.raises(ValueError, match=__import__("re").escape(words)):
         clothbake.bake(clothbake.Fabric(twill_path), res=(2, 4, 2, 4), **kwargs)
+
+
+def test_version_is_the_crates_version():
+    """Independent: the workspace's Cargo.toml, read as text."""
+    import pathlib
+    import re
+
+    cargo = (pathlib.Path(__file__).resolve().parents[3] / "Cargo.toml").read_text()
+    workspace = cargo[cargo.index("[workspace.package]"):]
+    expected = re.search(r'^version\s*=\s*"([^"]+)"', workspace, re.M).group(1)
+    assert clothbake.__version__ == expected
+    assert "__version__" in clothbake.__all__
+
+
+def test_messages_name_python_arguments_not_flags(tmp_path, twill_path):
+    """What a Python user is told to do is spelled as a Python argument, never a CLI flag."""
+    fab = clothbake.Fabric(twill_path)
+    res = (4, 8, 4, 8)
+    t = clothbake.bake(fab, res=res)
+    t.save(tmp_path / "t.exr")
+    with pytest.raises(FileExistsError) as e:
+        t.save(tmp_path / "t.exr")
+    assert "overwrite=True" in str(e.value) and "--" not in str(e.value), e.value
+    t.save(tmp_path / "t.exr", overwrite=True)
+    with pytest.raises(FileExistsError) as e:
+        clothbake.bake(fab, res=res, output=tmp_path / "t.exr")
+    assert "overwrite=True" in str(e.value) and "--" not in str(e.value), e.value
+
+    out = tmp_path / "stop.bin"
+    with pytest.raises(KeyboardInterrupt) as e:
+        clothbake.bake(fab, res=(8, 16, 8, 16), output=out, progress=lambda d, n: d < n // 2,
+                       bounces=2, orders="fast")
+    assert "call bake() again with resume=True" in str(e.value), e.value
+    assert "--" not in str(e.value), e.value
+    with pytest.raises(ValueError) as e:
+        clothbake.bake(fab, res=(8, 16, 8, 16), output=out, bounces=2, orders="fast")
+    assert "resume=True" in str(e.value) and "--" not in str(e.value), e.value
+
+    with pytest.raises(ValueError) as e:
+        clothbake.bake(fab, res=res, output=tmp_path / "x.shard", shard="4")
+    assert 'shard="0/4"' in str(e.value) and "--" not in str(e.value), e.value

@@ -312,6 +312,7 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
         resume: o.resume,
         overwrite: o.run.force,
         checkpoint_every: plan.checkpoint_every,
+        naming: Naming::Cli,
     };
     install_ctrlc();
     let start = Instant::now();

@@ -73,6 +73,10 @@ pub fn table_error(e: &clothbake_loader::TableError) -> CliError {
                 io_fix(source, reading),
             )
         }
+        TableError::AlreadyExists { path } => CliError::new(
+            format!("{}: the file already exists", path.display()),
+            "use --force to overwrite it",
+        ),
         other => CliError::line(other.to_string()),
     }
 }

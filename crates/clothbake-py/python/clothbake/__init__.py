@@ -9,6 +9,6 @@ toward the eye; directions are unit vectors, arrays of shape (N, 3). f_r is in 1
 * :mod:`clothbake.mitsuba`: a Mitsuba 3 BSDF plugin (``register()``).
 """
 
-from ._native import UNIT_TOLERANCE, Fabric, Table, bake
+from ._native import UNIT_TOLERANCE, Fabric, Table, __version__, bake
 
-__all__ = ["Fabric", "Table", "bake", "UNIT_TOLERANCE"]
+__all__ = ["Fabric", "Table", "bake", "UNIT_TOLERANCE", "__version__"]

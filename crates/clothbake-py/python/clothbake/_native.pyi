@@ -7,6 +7,9 @@ from typing import Any, Callable, Dict, Optional, Tuple, Union, overload
 import numpy as np
 import numpy.typing as npt
 
+__version__: str
+"""The package's version (the Rust crates' version, e.g. "0.1.0")."""
+
 UNIT_TOLERANCE: float
 """How far from 1 a direction's length may be before it is rejected."""
 
@@ -64,7 +67,8 @@ class Table:
     def pdf1(self, wo: Vec3, wi: Vec3) -> float: ...
     def save(self, path: Union[str, "os.PathLike[str]"], precision: str = "f16",
              overwrite: bool = False) -> None:
-        """Writes atomically: .exr (f16 or f32) or the binary format (other extensions)."""
+        """Writes atomically: .exr (f16 or f32) or the binary format (other extensions). An
+        existing file raises FileExistsError unless ``overwrite=True``."""
     def _rust_batch_seconds(self, n: int, repeats: int = 5) -> float: ...
 
 def bake(fabric: Fabric, res: Tuple[int, int, int, int] = (32, 64, 32, 64), bounces: int = 1,
