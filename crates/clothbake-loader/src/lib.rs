@@ -26,7 +26,7 @@ pub mod sampling;
 pub mod stored;
 mod table;
 
-pub use atomic::write_atomic_as;
+pub use atomic::{check_target, write_atomic_as};
 pub use binary::{read_binary, write_binary};
 pub use clothbake_bsdf::{Bsdf, BsdfSample, UnitVec3};
 pub use container::{

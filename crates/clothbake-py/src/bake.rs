@@ -251,6 +251,7 @@ pub fn bake(
         resume,
         overwrite,
         checkpoint_every,
+        inputs: fabric.path.iter().cloned().collect(),
     };
 
     let (print, callback) = match &progress {
