@@ -39,4 +39,4 @@ pub use half::f16;
 pub use lookup::{Brdf, LengthMismatch, Memory, Options, Sample, SimdPath, HORIZON_COS};
 pub use read::{read_table, read_table_stored};
 pub use stored::{Samples, StoredTable};
-pub use table::{Grid, Metadata, Precision, Table, FORMAT_VERSION, MAX_CELLS};
+pub use table::{Grid, Metadata, Precision, Table, FORMAT_VERSION, MAX_CELLS, MAX_VALUE};
