@@ -11,11 +11,13 @@
 //! size, on the shard split or on resuming.
 
 use crate::checkpoint::{checkpoint_path, Checkpointer, DEFAULT_INTERVAL};
+use crate::lock::{LockError, OutputLock};
+use crate::memory::{self, Kept};
 use crate::merge::orbits_of;
 use crate::output::{preflight, write_table, Format};
 use crate::settings::Naming;
 use crate::shard::{read_part, shard_rows, write_part, Kind, Part, ShardId};
-use crate::sweep::{BakeError, BakeOptions, Baker, Row};
+use crate::sweep::{check_options, BakeError, BakeOptions, Baker, Row};
 use clothbake_core::Fabric;
 use clothbake_loader::{Metadata, Table, TableError};
 use std::collections::BTreeMap;
@@ -62,6 +64,9 @@ pub struct Job<'a> {
     pub checkpoint_every: Duration,
     /// How messages spell options (`--resume` or `resume=True`).
     pub naming: Naming,
+    /// The files the fabric was read from (the fabric file, a draft): the output may not be
+    /// one of them, and errors about the fabric's values name the first.
+    pub inputs: Vec<PathBuf>,
 }
 
 impl<'a> Job<'a> {
@@ -75,6 +80,7 @@ impl<'a> Job<'a> {
             overwrite: false,
             checkpoint_every: DEFAULT_INTERVAL,
             naming: Naming::Cli,
+            inputs: Vec::new(),
         }
     }
 }
@@ -271,14 +277,34 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
     };
     if let Some(out) = output {
         let what = if shard.is_some() { "shard" } else { "table" };
-        preflight(out, what, job.overwrite)?;
+        let inputs: Vec<&Path> = job.inputs.iter().map(PathBuf::as_path).collect();
+        preflight(&[(out, what)], job.overwrite, &inputs)?;
     }
+    check_options(&job.options).map_err(bake_error)?;
+    let available = memory::available_bytes();
+    check_memory(job, None, available)?;
+    // Held until this function returns: one bake at a time writes this output and its
+    // checkpoint.
+    let _lock = match output.map(OutputLock::take) {
+        None => None,
+        Some(Ok(lock)) => Some(lock),
+        Some(Err(e @ LockError::Unavailable { .. })) => {
+            (hooks.warn)(&format!(
+                "{e}; the bake goes on unlocked (do not start another bake to this output)"
+            ));
+            None
+        }
+        Some(Err(e)) => return Err(JobError::Invalid(e.to_string())),
+    };
     let baker = Baker::new(job.fabric, &job.options).map_err(bake_error)?;
     let orbits = baker.orbits();
     let rows = match shard {
         Some(id) => shard_rows(orbits, id),
         None => 0..orbits.rows(),
     };
+    if shard.is_some() {
+        check_memory(job, Some(rows.len()), available)?;
+    }
     let ck_path = output.map(checkpoint_path);
     let exists = ck_path
         .as_deref()
@@ -384,8 +410,12 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
             None
         }
         target => {
-            let all: Vec<Row> = done.into_values().collect();
-            let table = baker.table(&all).map_err(bake_error)?;
+            // The rows are dropped before the table is written (see `memory`).
+            let table = {
+                let all: Vec<Row> = done.into_values().collect();
+                check_values(&all, &baker, job)?;
+                baker.table(&all).map_err(bake_error)?
+            };
             if let Target::Table { path, format } = target {
                 write_table(path, &table, *format, job.overwrite)?;
             }
@@ -414,6 +444,91 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
         cells,
         symmetry: (!baker.symmetries().is_empty()).then(|| baker.metadata().symmetry.clone()),
     })
+}
+
+/// Refuses a job whose estimated peak memory ([`memory::peak_bytes`]) exceeds `available`
+/// (bytes; `None`: unknown, no check). A shard's rows are known once its orbits are
+/// (`shard_rows`); before, an even split of the rows is counted, and the rows' costs that
+/// the split reads (8 bytes a row).
+pub fn check_memory(
+    job: &Job<'_>,
+    shard_rows: Option<usize>,
+    available: Option<u64>,
+) -> Result<(), JobError> {
+    let g = job.options.grid;
+    let per_row = u64::from(g.n_theta_o) * u64::from(g.n_phi_o);
+    let rows = u64::from(g.n_theta_i) * u64::from(g.n_phi_i);
+    let (baked, kept, shard, extra) = match &job.target {
+        Target::Shard { id, .. } => {
+            let even = rows.div_ceil(u64::from(id.count.max(1)));
+            let r = shard_rows.map_or(even, |r| r as u64);
+            (r, Kept::Shard, Some(*id), 8 * rows)
+        }
+        Target::Table { format, .. } => (rows, Kept::Table(Some(*format)), None, 0),
+        Target::Memory => (rows, Kept::Table(None), None, 0),
+    };
+    let cells = baked * per_row;
+    let need = memory::peak_bytes(&g, baked, kept).saturating_add(extra);
+    match available {
+        Some(have) if need > have => Err(invalid(
+            format!(
+                "grid {},{},{},{} ({} cells{}) needs about {} of memory to bake, but {} is \
+                 available",
+                g.n_theta_i,
+                g.n_phi_i,
+                g.n_theta_o,
+                g.n_phi_o,
+                g.len(),
+                shard.map_or(String::new(), |id| format!(", {cells} in shard {id}")),
+                memory::describe(need),
+                memory::describe(have)
+            ),
+            "give a smaller --res (halving every axis needs 1/16 of the memory), or bake \
+             it in parts with --shard K/N (merging still holds the whole table)",
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Refuses rows holding a value that is not finite or negative, naming the fabric file and
+/// the cell's directions (a table file would be refused on reading anyway).
+fn check_values(rows: &[Row], baker: &Baker, job: &Job<'_>) -> Result<(), JobError> {
+    for (row, values) in rows.iter().enumerate() {
+        if let Some(k) = values
+            .iter()
+            .flatten()
+            .position(|v| !v.is_finite() || *v < 0.0)
+        {
+            let v = values[k / 3][k % 3];
+            let g = baker.orbits().grid();
+            let (ti, pi, to, po) = baker
+                .orbits()
+                .evaluated_cell(row, k / 3)
+                .expect("a value of the row");
+            let (wi, wo) = (
+                (g.theta_i_deg(ti), g.phi_i_deg(pi)),
+                (g.theta_o_deg(to), g.phi_o_deg(po)),
+            );
+            let source = job
+                .inputs
+                .first()
+                .map_or("the fabric".to_string(), |p| p.display().to_string());
+            return Err(invalid(
+                format!(
+                    "{source}: the model gives f_r = {v} (channel {}) at theta_i {:.2}, phi_i \
+                     {:.2}, theta_o {:.2}, phi_o {:.2} degrees, not a finite non-negative value",
+                    ['R', 'G', 'B'][k % 3],
+                    wi.0,
+                    wi.1,
+                    wo.0,
+                    wo.1
+                ),
+                "check the fabric's sizes and materials (docs/limits.md gives the ranges that \
+                 compute); nothing was written",
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn bake_error(e: BakeError) -> JobError {

@@ -4,7 +4,8 @@
 //! through the model's BSDF and returns the table (its items are re-exported here: [`bake`],
 //! [`BakeOptions`], [`Baker`]); [`shard`], [`merge`] and [`checkpoint`] split a bake into
 //! shards, assemble them and resume an interrupted one (docs/cluster.md); [`job`] runs a whole
-//! bake (checkpoints, resume, shard or table file, cancellation) for the CLI and Python;
+//! bake (checkpoints, resume, shard or table file, cancellation) for the CLI and Python, under
+//! the output's [`lock`] and after the [`memory`] check;
 //! [`settings`] checks and resolves the options as users give them; [`output`] checks outputs
 //! and writes tables with reproducible bytes; [`compare`] holds two tables against each other
 //! (`clothbake diff`, the golden tables of [`golden`]); [`albedo`] integrates a table's
@@ -17,6 +18,8 @@ pub mod checkpoint;
 pub mod compare;
 pub mod golden;
 pub mod job;
+pub mod lock;
+pub mod memory;
 pub mod merge;
 pub mod output;
 pub mod settings;

@@ -1,23 +1,58 @@
 //! Writing a baked table through the loader's atomic writers (EXR bytes are reproducible:
-//! the loader sorts the header attributes).
+//! the loader sorts the header attributes), after the one output check of every command that
+//! writes ([`preflight`]).
 
-use clothbake_loader::{write_binary, write_exr, Precision, Table, TableError};
-use std::path::Path;
+use clothbake_loader::{check_target, write_binary, write_exr, Precision, Table, TableError};
+use std::path::{Path, PathBuf};
 
-/// Refuses an output that would fail only after the work: an existing file unless
-/// `overwrite`, a missing folder, a folder that is not one or that may not be written into
-/// (probed by creating and removing a hidden file next to `out`). `what` names the file in
-/// errors (`table`, `shard`, `PNG image`).
-pub fn preflight(out: &Path, what: &str, overwrite: bool) -> Result<(), TableError> {
-    if !overwrite && std::fs::symlink_metadata(out).is_ok() {
-        return Err(TableError::AlreadyExists {
+/// Refuses outputs that would fail, or do harm, only after the work; every command that writes
+/// files (bake, merge, export, render, plot, Python's `bake`) calls it before any work, with
+/// every file it will write (`(path, what)`, `what` naming the file in errors: `table`,
+/// `shard`, `PNG image`) and every file it reads (`inputs`). Refused, in this order:
+///
+/// * an output that is one of the inputs (the same file by device and inode, or by canonical
+///   path: a link or a hard link to an input counts), even with `overwrite`;
+/// * two outputs that are the same file;
+/// * a folder or a special file (device, FIFO, socket), even with `overwrite`, and an existing
+///   file unless `overwrite` ([`check_target`]);
+/// * a missing folder, a folder that is not one, or one that may not be written into (probed
+///   by creating and removing a hidden file next to the output).
+pub fn preflight(
+    outputs: &[(&Path, &str)],
+    overwrite: bool,
+    inputs: &[&Path],
+) -> Result<(), TableError> {
+    for (k, &(out, what)) in outputs.iter().enumerate() {
+        let unwritable = |reason: String| TableError::Unwritable {
             path: out.to_path_buf(),
-        });
+            what: what.to_string().into(),
+            reason,
+        };
+        if let Some(input) = inputs.iter().find(|i| same_file(out, i)) {
+            return Err(unwritable(format!(
+                "it is an input of this command{}, which would be replaced; give another output \
+                 path",
+                if **input == *out {
+                    String::new()
+                } else {
+                    format!(" ({})", input.display())
+                }
+            )));
+        }
+        if let Some((_, other)) = outputs[..k].iter().find(|(o, _)| same_file(out, o)) {
+            return Err(unwritable(format!(
+                "the {other} is written to the same file; give each output its own path"
+            )));
+        }
+        check_target(out, what, overwrite)?;
+        check_folder(out, what)?;
     }
-    let dir = match out.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
+    Ok(())
+}
+
+/// The folder of `out` exists, is a folder and may be written into.
+fn check_folder(out: &Path, what: &str) -> Result<(), TableError> {
+    let dir = folder(out);
     match std::fs::metadata(dir) {
         Ok(m) if m.is_dir() => {}
         Ok(_) => {
@@ -66,6 +101,46 @@ pub fn preflight(out: &Path, what: &str, overwrite: bool) -> Result<(), TableErr
             source: e,
         }),
     }
+}
+
+/// The folder a file `p` lies in (`.` for a bare name).
+fn folder(p: &Path) -> &Path {
+    match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// Whether `a` and `b` name the same file: the same device and inode where both exist (a link
+/// or a hard link counts), else the same canonical folder and file name.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+        return same_inode(a, &x, b, &y);
+    }
+    match (identity(a), identity(b)) {
+        (Some(x), Some(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+#[cfg(unix)]
+fn same_inode(_: &Path, x: &std::fs::Metadata, _: &Path, y: &std::fs::Metadata) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    x.dev() == y.dev() && x.ino() == y.ino()
+}
+
+#[cfg(not(unix))]
+fn same_inode(a: &Path, _: &std::fs::Metadata, b: &Path, _: &std::fs::Metadata) -> bool {
+    matches!(
+        (std::fs::canonicalize(a), std::fs::canonicalize(b)),
+        (Ok(x), Ok(y)) if x == y
+    )
+}
+
+/// The canonical folder of `p` joined with its file name (`p` itself need not exist).
+fn identity(p: &Path) -> Option<PathBuf> {
+    let name = p.file_name()?;
+    Some(std::fs::canonicalize(folder(p)).ok()?.join(name))
 }
 
 /// The table formats.

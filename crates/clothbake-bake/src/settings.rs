@@ -7,6 +7,43 @@ use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
 use clothbake_core::{Caps, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, Variant};
 use clothbake_loader::Grid;
 
+/// The most worker threads a command starts (`--threads`): far more than cores gains nothing
+/// (the work is CPU-bound) and a pool of 100 000 threads takes minutes to start, during which
+/// SIGTERM waits.
+pub const MAX_THREADS: usize = 1024;
+
+/// Checks a worker thread count given as text: a whole number from 1 to [`MAX_THREADS`].
+/// `flag` spells the option in messages (`--threads`).
+pub fn parse_threads(s: &str, flag: &str) -> Result<usize, String> {
+    let t = s.trim();
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let too_many = || {
+        format!(
+            "{flag} {t} is too large (at most {MAX_THREADS}); this machine has {cores} cores: \
+             give e.g. {flag} {cores}, or leave it out to use them all"
+        )
+    };
+    match t.parse::<usize>() {
+        Ok(0) => Err(format!(
+            "the thread count must be at least 1; give e.g. {flag} 2 (or leave it out to use \
+             all cores)"
+        )),
+        Ok(n) if n > MAX_THREADS => Err(too_many()),
+        Ok(n) => Ok(n),
+        Err(_) if is_whole(t) => Err(too_many()),
+        Err(_) => Err(format!(
+            "`{t}` is not a whole number of threads; give e.g. {flag} 2"
+        )),
+    }
+}
+
+/// Whether `s` is written as a whole number (ASCII digits, an optional leading `+`), however
+/// large.
+pub fn is_whole(s: &str) -> bool {
+    let d = s.strip_prefix('+').unwrap_or(s);
+    !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit())
+}
+
 /// Rays per cell of the ray tracer unless given.
 pub const DEFAULT_SAMPLES: usize = 100_000;
 /// The ray tracer's base seed unless given.

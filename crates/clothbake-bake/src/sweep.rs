@@ -327,6 +327,20 @@ impl Orbits {
         self.per_phi_i[pi as usize] * self.grid.n_theta_o as usize
     }
 
+    /// The cell `(ti, pi, to, po)` of value `k` of `row`'s [`Row`] (its `k`-th canonical
+    /// cell, in cell order).
+    pub fn evaluated_cell(&self, row: usize, k: usize) -> Option<(u32, u32, u32, u32)> {
+        let (ti, pi) = row_cell(&self.grid, row);
+        let npo = self.grid.n_phi_o;
+        let canon: Vec<u32> = (0..npo)
+            .filter(|&po| self.canonical(pi as usize, po as usize))
+            .collect();
+        let per_to = canon.len().max(1);
+        let to = u32::try_from(k / per_to).ok()?;
+        let po = *canon.get(k % per_to)?;
+        (to < self.grid.n_theta_o).then_some((ti, pi, to, po))
+    }
+
     /// Cells evaluated in the whole grid.
     pub fn evaluations(&self) -> usize {
         (0..self.rows()).map(|r| self.row_evaluations(r)).sum()
@@ -466,10 +480,12 @@ impl Baker {
         let wi = direction(ti, nti, pi, npi);
         let mut out = Vec::with_capacity(self.orbits.row_evaluations(row));
         for to in 0..nto {
-            if cancel.load(Ordering::Relaxed) {
-                return None;
-            }
             for po in 0..npo {
+                // Checked per cell: a row may hold millions of cells (a relaxed load costs
+                // nothing beside an evaluation).
+                if cancel.load(Ordering::Relaxed) {
+                    return None;
+                }
                 if !self.orbits.canonical(pi as usize, po as usize) {
                     continue;
                 }

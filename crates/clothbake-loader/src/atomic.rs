@@ -31,7 +31,8 @@ impl Drop for TempGuard {
 /// is written in error messages, e.g. `"table"`, `"PNG image"` or `"checkpoint"` (`cannot
 /// write the PNG image: ...`).
 ///
-/// Refuses an existing `path` unless `overwrite`. Otherwise calls `write` on a temporary file
+/// Refuses an existing `path` unless `overwrite`, and a folder or special file always
+/// ([`check_target`]). Otherwise calls `write` on a temporary file
 /// `.<name>.tmp-<pid>-<n>` in the same folder, flushes and fsyncs it, and renames it over
 /// `path` (without `overwrite`, it is hard-linked instead, so that a file created meanwhile is
 /// never clobbered). The temporary file is removed on any error.
@@ -42,20 +43,12 @@ pub fn write_atomic_as(
     write: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
 ) -> Result<(), TableError> {
     let action = |verb: &str| format!("{verb} the {what}");
-    let name = path.file_name().ok_or_else(|| TableError::Unwritable {
-        path: path.to_path_buf(),
-        what: what.to_string().into(),
-        reason: "the path does not name a file".to_string(),
-    })?;
+    check_target(path, what, overwrite)?;
+    let name = path.file_name().expect("checked by check_target");
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    if !overwrite && fs::symlink_metadata(path).is_ok() {
-        return Err(TableError::AlreadyExists {
-            path: path.to_path_buf(),
-        });
-    }
     match fs::metadata(dir) {
         Ok(m) if m.is_dir() => {}
         Ok(_) => {
@@ -109,6 +102,9 @@ pub fn write_atomic_as(
         Ok::<(), TableError>(())
     };
     if overwrite {
+        // Checked again just before the rename: a folder or special file that appeared
+        // meanwhile is not replaced.
+        check_target(path, what, overwrite)?;
         rename(&mut guard)?;
     } else {
         // A hard link fails if the target appeared meanwhile; the guard then removes the
@@ -133,6 +129,74 @@ pub fn write_atomic_as(
     }
     drop(guard);
     sync_dir(dir);
+    Ok(())
+}
+
+/// What kind of file system object `t` is, in words, when it is neither a regular file, a
+/// folder nor a symbolic link (a device, a FIFO, a socket).
+pub(crate) fn special_kind(t: &fs::FileType) -> Option<&'static str> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_char_device() {
+            return Some("a character device");
+        }
+        if t.is_block_device() {
+            return Some("a block device");
+        }
+        if t.is_fifo() {
+            return Some("a FIFO (named pipe)");
+        }
+        if t.is_socket() {
+            return Some("a socket");
+        }
+    }
+    if t.is_file() || t.is_dir() || t.is_symlink() {
+        None
+    } else {
+        Some("a special file")
+    }
+}
+
+/// Checks that `path` may be written as a new regular file by [`write_atomic_as`]: it names a
+/// file, and what is there now (if anything) is a regular file (or a link to one) that may be
+/// replaced (`overwrite`). A folder and a special file (a device such as `/dev/full`, a FIFO,
+/// a socket; or a link to one) are refused even with `overwrite`: the atomic write would
+/// replace the node itself, never write into it. `what` names the file in errors (`table`,
+/// `PNG image`).
+pub fn check_target(path: &Path, what: &str, overwrite: bool) -> Result<(), TableError> {
+    let unwritable = |reason: String| TableError::Unwritable {
+        path: path.to_path_buf(),
+        what: what.to_string().into(),
+        reason,
+    };
+    if path.file_name().is_none() {
+        return Err(unwritable(
+            "the path does not name a file; give a file name".to_string(),
+        ));
+    }
+    let Ok(node) = fs::symlink_metadata(path) else {
+        return Ok(()); // Nothing there (or nothing we may see: the write will say).
+    };
+    // A link counts as what it points to; a dangling link as a file to replace.
+    let target = fs::metadata(path).unwrap_or_else(|_| node.clone());
+    if target.is_dir() {
+        return Err(unwritable(
+            "it is a folder, not a file; give the path of a file, e.g. inside that folder"
+                .to_string(),
+        ));
+    }
+    if let Some(kind) = special_kind(&node.file_type()).or(special_kind(&target.file_type())) {
+        return Err(unwritable(format!(
+            "it is {kind}, not a regular file; write to a regular file (clothbake never \
+             replaces a device, FIFO or socket)"
+        )));
+    }
+    if !overwrite {
+        return Err(TableError::AlreadyExists {
+            path: path.to_path_buf(),
+        });
+    }
     Ok(())
 }
 

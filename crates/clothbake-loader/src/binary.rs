@@ -140,7 +140,10 @@ mod legacy {
             .deserialize(&header)
             .map_err(|e| TableError::Corrupted {
                 path: path.to_path_buf(),
-                reason: format!("the metadata header cannot be decoded ({e})"),
+                reason: format!(
+                    "the metadata header cannot be decoded ({})",
+                    header_fault(&header).unwrap_or_else(|| e.to_string())
+                ),
             })?;
         if meta.format_version != FORMAT_VERSION {
             return Err(TableError::Version {
@@ -151,5 +154,113 @@ mod legacy {
             });
         }
         Table::new(meta, values).map_err(|e| e.in_file(path))
+    }
+
+    /// The fields of a version-1 header, in order: `(name, false)` for a u32, `(name, true)`
+    /// for a string (a u64 length and UTF-8 bytes); the grid is four u32.
+    const FIELDS: [(&str, bool); 12] = [
+        ("format_version", false),
+        ("tool", true),
+        ("grid.n_theta_i", false),
+        ("grid.n_phi_i", false),
+        ("grid.n_theta_o", false),
+        ("grid.n_phi_o", false),
+        ("centring", true),
+        ("quantity", true),
+        ("units", true),
+        ("fabric_json", true),
+        ("options_json", true),
+        ("symmetry", true),
+    ];
+
+    /// The first field of a version-1 header that cannot be read, in words (bincode's own
+    /// message for a string longer than the header is an empty I/O error): `None` when every
+    /// field reads.
+    pub(super) fn header_fault(header: &[u8]) -> Option<String> {
+        let mut at = 0usize;
+        for (name, string) in FIELDS {
+            let left = header.len() - at;
+            let width = if string { 8 } else { 4 };
+            if left < width {
+                return Some(format!(
+                    "the header ends inside field `{name}` ({left} of its {width} bytes are there)"
+                ));
+            }
+            let word = &header[at..at + width];
+            at += width;
+            if !string {
+                continue;
+            }
+            let len = u64::from_le_bytes(word.try_into().expect("8 bytes"));
+            let left = (header.len() - at) as u64;
+            if len > left {
+                return Some(format!(
+                    "field `{name}` says it is {len} bytes long, but only {left} bytes of the \
+                     header are left"
+                ));
+            }
+            let bytes = &header[at..at + len as usize];
+            if let Err(e) = std::str::from_utf8(bytes) {
+                return Some(format!("field `{name}` is not UTF-8 text ({e})"));
+            }
+            at += len as usize;
+        }
+        (at < header.len()).then(|| {
+            format!(
+                "{} bytes follow the last field `symmetry`",
+                header.len() - at
+            )
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::legacy::header_fault;
+
+    fn string(s: &str) -> Vec<u8> {
+        let mut v = (s.len() as u64).to_le_bytes().to_vec();
+        v.extend_from_slice(s.as_bytes());
+        v
+    }
+
+    fn header(tool_len: Option<u64>) -> Vec<u8> {
+        let mut h = 1u32.to_le_bytes().to_vec();
+        match tool_len {
+            Some(n) => h.extend_from_slice(&n.to_le_bytes()),
+            None => h.extend(string("clothbake 0.1.0")),
+        }
+        for n in [2u32, 3, 2, 4] {
+            h.extend_from_slice(&n.to_le_bytes());
+        }
+        for s in ["cell", "f_r", "1/sr", "{}", "{}", "none"] {
+            h.extend(string(s));
+        }
+        h
+    }
+
+    #[test]
+    fn a_good_header_has_no_fault() {
+        assert_eq!(header_fault(&header(None)), None);
+    }
+
+    #[test]
+    fn faults_name_the_field() {
+        let e = header_fault(&header(Some(1 << 60))).unwrap();
+        assert!(
+            e.contains("field `tool` says it is 1152921504606846976 bytes long"),
+            "{e}"
+        );
+        let h = header(None);
+        let e = header_fault(&h[..h.len() - 2]).unwrap();
+        assert!(
+            e.contains("field `symmetry` says it is 4 bytes long"),
+            "{e}"
+        );
+        let e = header_fault(&h[..6]).unwrap();
+        assert!(e.contains("ends inside field `tool`"), "{e}");
+        let mut more = h.clone();
+        more.push(0);
+        assert!(header_fault(&more).unwrap().contains("1 bytes follow"));
     }
 }

@@ -125,16 +125,34 @@ impl Source<'_> {
     }
 }
 
-/// Reads exactly `buf.len()` bytes, hashing them; a short read is reported as truncation
-/// inside `what`.
-/// Opens `path` for reading and measures it; an empty file is refused. `noun` names it in
+/// Opens `path` for reading after checking that it is a regular file (or a link to one): a
+/// folder, a device (`/dev/zero` reads without end), a FIFO (opening blocks until a writer
+/// comes) or a socket is refused with an error naming what it is. `noun` names the file in
 /// errors ("table", "shard", ...).
+pub(crate) fn open_regular(path: &Path, noun: &str) -> Result<std::fs::File, TableError> {
+    let not = |kind: &str| TableError::Foreign {
+        path: path.to_path_buf(),
+        what: noun.to_string().into(),
+        reason: format!("it is {kind}, not a regular file; give the path of a {noun} file"),
+    };
+    let meta =
+        std::fs::metadata(path).map_err(|e| TableError::io(path, format!("open the {noun}"), e))?;
+    if meta.is_dir() {
+        return Err(not("a folder"));
+    }
+    if let Some(kind) = crate::atomic::special_kind(&meta.file_type()) {
+        return Err(not(kind));
+    }
+    std::fs::File::open(path).map_err(|e| TableError::io(path, format!("open the {noun}"), e))
+}
+
+/// Opens `path` for reading ([`open_regular`]) and measures it; an empty file is refused.
+/// `noun` names it in errors ("table", "shard", ...).
 pub(crate) fn open_sized<'a>(
     path: &'a Path,
     noun: &'a str,
 ) -> Result<(std::fs::File, Source<'a>), TableError> {
-    let file = std::fs::File::open(path)
-        .map_err(|e| TableError::io(path, format!("open the {noun}"), e))?;
+    let file = open_regular(path, noun)?;
     let len = file
         .metadata()
         .map_err(|e| TableError::io(path, format!("read the {noun}"), e))?
@@ -147,6 +165,8 @@ pub(crate) fn open_sized<'a>(
     Ok((file, Source { path, len, noun }))
 }
 
+/// Reads exactly `buf.len()` bytes, hashing them; a short read is reported as truncation
+/// inside `what`.
 pub(crate) fn read_hashed(
     r: &mut impl Read,
     hasher: &mut crc32fast::Hasher,

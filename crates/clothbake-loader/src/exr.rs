@@ -2,7 +2,6 @@
 //! attributes (`docs/table-format.md`). Written byte-reproducibly ([`write_exr`]), read
 //! without trusting the decoder not to panic ([`read_exr`]).
 
-use std::fs;
 use std::io::{self, Cursor, Write};
 use std::path::Path;
 
@@ -301,7 +300,13 @@ mod exr_io {
     }
 
     pub(super) fn read(path: &Path) -> Result<StoredTable, TableError> {
-        let bytes = fs::read(path).map_err(|e| TableError::io(path, "read the table", e))?;
+        let bytes = {
+            let mut file = crate::bytes::open_regular(path, "table")?;
+            let mut bytes = Vec::new();
+            io::Read::read_to_end(&mut file, &mut bytes)
+                .map_err(|e| TableError::io(path, "read the table", e))?;
+            bytes
+        };
         if bytes.is_empty() {
             return Err(TableError::Empty {
                 path: path.to_path_buf(),

@@ -26,7 +26,7 @@ pub mod sampling;
 pub mod stored;
 mod table;
 
-pub use atomic::write_atomic_as;
+pub use atomic::{check_target, write_atomic_as};
 pub use binary::{read_binary, write_binary};
 pub use clothbake_bsdf::{Bsdf, BsdfSample, UnitVec3};
 pub use container::{
@@ -39,4 +39,4 @@ pub use half::f16;
 pub use lookup::{Brdf, LengthMismatch, Memory, Options, Sample, SimdPath, HORIZON_COS};
 pub use read::{read_table, read_table_stored};
 pub use stored::{Samples, StoredTable};
-pub use table::{Grid, Metadata, Precision, Table, FORMAT_VERSION, MAX_CELLS};
+pub use table::{Grid, Metadata, Precision, Table, FORMAT_VERSION, MAX_CELLS, MAX_VALUE};

@@ -1,10 +1,9 @@
 //! Reading a table in either format, recognised by its first bytes.
 
-use std::fs::File;
 use std::path::Path;
 
 use crate::binary::read_binary;
-use crate::bytes::{hex, read_up_to};
+use crate::bytes::{hex, open_regular, read_up_to};
 use crate::container::BINARY_MAGIC;
 use crate::error::TableError;
 use crate::exr::{read_exr_stored, EXR_MAGIC};
@@ -19,7 +18,7 @@ pub fn read_table(path: &Path) -> Result<Table, TableError> {
 /// Reads a table in either format like [`read_table`], keeping the samples at their stored
 /// precision: half for half-float EXR tables, f32 otherwise.
 pub fn read_table_stored(path: &Path) -> Result<StoredTable, TableError> {
-    let mut file = File::open(path).map_err(|e| TableError::io(path, "open the table", e))?;
+    let mut file = open_regular(path, "table")?;
     let mut head = [0u8; 8];
     let n =
         read_up_to(&mut file, &mut head).map_err(|e| TableError::io(path, "read the table", e))?;

@@ -8,7 +8,7 @@
 use half::f16;
 
 use crate::error::TableError;
-use crate::table::{check_values, Metadata, Precision, Table};
+use crate::table::{check_values, is_physical, Metadata, Precision, Table};
 
 /// The RGB values of a table, interleaved as in [`Table::values`], at one precision.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,14 +57,15 @@ impl Samples {
         }
     }
 
-    /// Index and widened value of the first value that is not finite, if any.
-    fn first_non_finite(&self) -> Option<(usize, f32)> {
+    /// Index and widened value of the first value that is not physical (not finite,
+    /// negative, or above [`crate::table::MAX_VALUE`]), if any.
+    fn first_unphysical(&self) -> Option<(usize, f32)> {
         match self {
             Samples::F16(v) => v
                 .iter()
-                .position(|h| !h.is_finite())
+                .position(|h| !is_physical(h.to_f32()))
                 .map(|i| (i, v[i].to_f32())),
-            Samples::F32(v) => v.iter().position(|x| !x.is_finite()).map(|i| (i, v[i])),
+            Samples::F32(v) => v.iter().position(|x| !is_physical(*x)).map(|i| (i, v[i])),
         }
     }
 }
@@ -79,9 +80,9 @@ pub struct StoredTable {
 }
 
 impl StoredTable {
-    /// A table, after the checks of [`Table::new`] (metadata, number of values, all finite).
+    /// A table, after the checks of [`Table::new`] (metadata, number of values, all physical).
     pub fn new(meta: Metadata, samples: Samples) -> Result<StoredTable, TableError> {
-        check_values(&meta, samples.len(), samples.first_non_finite())?;
+        check_values(&meta, samples.len(), samples.first_unphysical())?;
         Ok(StoredTable { meta, samples })
     }
 

@@ -15,6 +15,18 @@ pub const FORMAT_VERSION: u32 = 1;
 /// Largest number of cells a grid may have (2^31).
 pub const MAX_CELLS: u64 = 1 << 31;
 
+/// Largest value a table may hold, in 1/sr (10^30). Far beyond any physical BRDF (a mirror
+/// tabulated in cells of 0.01 degrees stays below 10^8), and small enough that every sum and
+/// weight the loader forms stays finite in f32: the importance sampling's density is at least
+/// [`crate::sampling::DEFENSIVE`] / (2 pi) per steradian, so its weights f_r cos(theta) / pdf
+/// are at most about 630 f_r (f32 overflows at 3.4 10^38).
+pub const MAX_VALUE: f32 = 1e30;
+
+/// Whether `v` may be a table's value: finite, not negative, at most [`MAX_VALUE`].
+pub(crate) fn is_physical(v: f32) -> bool {
+    (0.0..=MAX_VALUE).contains(&v)
+}
+
 /// The 4-D grid of incident and outgoing directions, cell-centred, in degrees.
 ///
 /// Polar angles cover [0, 90] degrees from +Z, azimuths [0, 360) degrees from +X toward +Y.
@@ -252,7 +264,7 @@ pub struct Table {
 
 impl Table {
     /// A table, after checking the metadata, the number of values and that every value is
-    /// finite.
+    /// physical: finite, not negative, at most [`MAX_VALUE`].
     pub fn new(meta: Metadata, values: Vec<f32>) -> Result<Table, TableError> {
         let table = Table { meta, values };
         table.validate()?;
@@ -261,7 +273,7 @@ impl Table {
 
     /// Checks what [`Table::new`] checks; the writers call it, as the fields are public.
     pub fn validate(&self) -> Result<(), TableError> {
-        let bad = self.values.iter().position(|v| !v.is_finite());
+        let bad = self.values.iter().position(|v| !is_physical(*v));
         check_values(
             &self.meta,
             self.values.len(),
@@ -285,12 +297,13 @@ impl Table {
     }
 }
 
-/// Checks a table's metadata, its number of values (`len`) and the first non-finite value, if
-/// any (its index and value): the rules of [`Table::new`], for any sample type.
+/// Checks a table's metadata, its number of values (`len`) and the first value that is not
+/// physical ([`is_physical`]), if any (its index and value): the rules of [`Table::new`], for
+/// any sample type.
 pub(crate) fn check_values(
     meta: &Metadata,
     len: usize,
-    non_finite: Option<(usize, f32)>,
+    unphysical: Option<(usize, f32)>,
 ) -> Result<(), TableError> {
     meta.validate()?;
     let expected = meta.grid.len() * 3;
@@ -303,10 +316,20 @@ pub(crate) fn check_values(
             ),
         });
     }
-    if let Some((i, v)) = non_finite {
+    if let Some((i, v)) = unphysical {
+        let rule = if !v.is_finite() {
+            "every value must be finite".to_string()
+        } else if v < 0.0 {
+            "a BRDF is never negative".to_string()
+        } else {
+            format!(
+                "the largest value a table may hold is {MAX_VALUE:e} 1/sr (beyond it albedos \
+                 and sampling weights overflow)"
+            )
+        };
         return Err(TableError::InvalidTable {
             reason: format!(
-                "value {} of cell {} (channel {}) is {}; every value must be finite",
+                "value {} of cell {} (channel {}) is {:e}; {rule}",
                 i,
                 i / 3,
                 ['R', 'G', 'B'][i % 3],

@@ -138,3 +138,26 @@ fn damaged_version_1_tables_are_clear_errors() {
     bad[20 + h..28 + h].copy_from_slice(&(1u64 << 60).to_le_bytes());
     check(&bad, "truncated");
 }
+
+#[test]
+fn a_huge_string_length_names_its_field() {
+    // The tool name's length (after magic 8, version 4, header length 8, format_version 4)
+    // set to 2^60, with the checksum made right again: only the header's decoding can fail.
+    let bytes = fs::read(&golden()[0]).unwrap();
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("legacy-string");
+    fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("long.bin");
+    let mut bad = bytes.clone();
+    bad[24..32].copy_from_slice(&(1u64 << 60).to_le_bytes());
+    let n = bad.len();
+    let crc = crc32fast::hash(&bad[..n - 4]);
+    bad[n - 4..].copy_from_slice(&crc.to_le_bytes());
+    fs::write(&path, &bad).unwrap();
+    let m = read_table(&path).unwrap_err().to_string();
+    assert!(m.starts_with(&path.display().to_string()), "{m}");
+    assert!(
+        m.contains("field `tool` says it is 1152921504606846976 bytes long"),
+        "{m}"
+    );
+    assert!(!m.contains("io error: )"), "{m}");
+}

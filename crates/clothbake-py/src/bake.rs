@@ -252,6 +252,7 @@ pub fn bake(
         overwrite,
         checkpoint_every,
         naming: Naming::Python,
+        inputs: fabric.path.iter().cloned().collect(),
     };
 
     let (print, callback) = match &progress {

@@ -37,6 +37,8 @@ pub fn check_bounces(bounces: u32) -> PyResult<()> {
 #[pyclass(name = "Fabric", module = "clothbake", frozen)]
 pub struct PyFabric {
     pub(crate) fabric: Fabric,
+    /// The file it was read from (`None` for a dict): a bake's output may not replace it.
+    pub(crate) path: Option<std::path::PathBuf>,
     /// Analytic models, built on first use: Huo's facets, Lewis's.
     models: [OnceLock<AnalyticModel>; 2],
 }
@@ -74,6 +76,7 @@ impl PyFabric {
     #[new]
     fn new(source: &Bound<'_, PyAny>) -> PyResult<Self> {
         let py = source.py();
+        let mut path = None;
         let fabric = if source.is_instance_of::<PyDict>() {
             let text: String = py
                 .import("json")?
@@ -82,16 +85,19 @@ impl PyFabric {
                 .extract()?;
             Fabric::from_json_str(&text, "<dict>")
         } else {
-            let path: std::path::PathBuf = source.extract().map_err(|_| {
+            let p: std::path::PathBuf = source.extract().map_err(|_| {
                 PyValueError::new_err(
                     "Fabric: pass a path to a fabric file (e.g. tables/twill.json) or a dict",
                 )
             })?;
-            Fabric::from_path(&path)
+            let fabric = Fabric::from_path(&p);
+            path = Some(p);
+            fabric
         }
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
         Ok(PyFabric {
             fabric,
+            path,
             models: [OnceLock::new(), OnceLock::new()],
         })
     }

@@ -3,6 +3,7 @@ relations between the split terms, a quadrature of the albedo, the ray tracer; a
 
 import json
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -227,6 +228,26 @@ def test_sharded_bake_merged_equals_the_whole_bake(tmp_path, twill_path):
     with pytest.raises(FileExistsError, match="whole.bin"):
         clothbake.bake(fab, res=res, output=tmp_path / "whole.bin")
     clothbake.bake(fab, res=res, output=tmp_path / "whole.bin", overwrite=True)
+
+
+def test_bake_never_replaces_its_fabric_a_folder_or_a_device(tmp_path, twill_path):
+    """The output check of every command (`output::preflight`, through `job::run`): an input,
+    a folder or a special file is refused even with overwrite=True, and nothing changes."""
+    src = tmp_path / "twill.json"
+    src.write_bytes(twill_path.read_bytes())
+    fab = clothbake.Fabric(src)
+    res = (2, 4, 2, 4)
+    with pytest.raises(Exception, match="an input of this command"):
+        clothbake.bake(fab, res=res, output=src, overwrite=True)
+    assert src.read_bytes() == twill_path.read_bytes()
+    (tmp_path / "folder.exr").mkdir()
+    with pytest.raises(Exception, match="it is a folder"):
+        clothbake.bake(fab, res=res, output=tmp_path / "folder.exr", overwrite=True)
+    if pathlib.Path("/dev/null").is_char_device():
+        with pytest.raises(Exception, match="character device"):
+            clothbake.bake(fab, res=res, output="/dev/null", overwrite=True)
+        assert pathlib.Path("/dev/null").is_char_device()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["folder.exr", "twill.json"]
 
 
 def test_resumed_bake_equals_an_uninterrupted_one(tmp_path, twill_path):

@@ -182,11 +182,13 @@ pub fn plan_with_env(
     })
 }
 
-/// Refuses an output that would fail only after the work (bake, merge, render, plot, export):
+/// Refuses outputs that would fail or do harm only after the work (bake, merge, render, plot,
+/// export): an input given as an output, two outputs to one file, a folder or special file,
 /// an existing file without --force, a missing folder, a folder we may not write into (the
-/// library's check, as one line); `what` names the file (`table`, `PNG image`).
-pub fn preflight(out: &Path, what: &str, force: bool) -> Result<(), CliError> {
-    clothbake_bake::output::preflight(out, what, force).map_err(|e| table_error(&e))
+/// library's check, [`clothbake_bake::output::preflight`], as one line); each output's `what`
+/// names it (`table`, `PNG image`).
+pub fn preflight(outputs: &[(&Path, &str)], force: bool, inputs: &[&Path]) -> Result<(), CliError> {
+    clothbake_bake::output::preflight(outputs, force, inputs).map_err(|e| table_error(&e))
 }
 
 fn install_ctrlc() {
@@ -286,7 +288,7 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     } else {
         "table"
     };
-    preflight(&plan.output, what, o.run.force)?;
+    preflight(&[(&plan.output, what)], o.run.force, &[&plan.weave])?;
     if let Some((_, Some(how))) = &plan.shard {
         if !o.run.quiet {
             eprintln!("clothbake: {how}");
@@ -313,6 +315,7 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
         overwrite: o.run.force,
         checkpoint_every: plan.checkpoint_every,
         naming: Naming::Cli,
+        inputs: vec![plan.weave.clone()],
     };
     install_ctrlc();
     let start = Instant::now();

@@ -910,6 +910,12 @@ pub fn parse_res(s: &str) -> Result<Grid, String> {
                 ))
             }
             Ok(x) => x,
+            Err(_) if clothbake_bake::settings::is_whole(p) => {
+                return Err(format!(
+                    "{name} {p} is too large (at most {}, the limit of 2^31 cells in all); {FIX}",
+                    clothbake_loader::MAX_CELLS
+                ))
+            }
             Err(_) => {
                 return Err(format!(
                     "{name} `{p}` is not a whole number of cells; {FIX}"
@@ -932,20 +938,9 @@ pub fn parse_res(s: &str) -> Result<Grid, String> {
     Ok(g)
 }
 
-/// Parses `--threads N`, N >= 1.
+/// Parses `--threads N`, 1 <= N <= `MAX_THREADS` (1024).
 pub fn parse_threads(s: &str) -> Result<usize, String> {
-    match s.trim().parse::<usize>() {
-        Ok(0) => Err(
-            "the thread count must be at least 1; give e.g. --threads 2 (or leave it \
-                      out to use all cores)"
-                .into(),
-        ),
-        Ok(n) => Ok(n),
-        Err(_) => Err(format!(
-            "`{}` is not a whole number of threads; give e.g. --threads 2",
-            s.trim()
-        )),
-    }
+    clothbake_bake::settings::parse_threads(s, "--threads")
 }
 
 /// Parses `--bounces 1|2`.

@@ -70,7 +70,7 @@ pub fn table_error(e: &clothbake_loader::TableError) -> CliError {
             let reading = action.contains("read") || action.starts_with("open the table");
             CliError::new(
                 format!("{}: cannot {action}: {}", path.display(), os_cause(source)),
-                io_fix(source, reading),
+                io_fix(source, reading, written(action)),
             )
         }
         TableError::AlreadyExists { path } => CliError::new(
@@ -90,8 +90,23 @@ fn os_cause(e: &std::io::Error) -> String {
     }
 }
 
-/// What to do about an I/O error while reading or writing a table.
-fn io_fix(e: &std::io::Error, reading: bool) -> String {
+/// What an action writes, from its words: `write the PNG image` -> `PNG image`, `move the
+/// table into place` -> `table`, `create the temporary file` -> `file`.
+fn written(action: &str) -> &str {
+    let what = action.split_once(" the ").map_or("file", |(_, w)| w);
+    let what = what
+        .strip_suffix(" to disk")
+        .or_else(|| what.strip_suffix(" into place"))
+        .unwrap_or(what);
+    match what {
+        "temporary file" | "" => "file",
+        w => w,
+    }
+}
+
+/// What to do about an I/O error while reading or writing a file (`what`: `table`, `PNG
+/// image`, ...).
+fn io_fix(e: &std::io::Error, reading: bool, what: &str) -> String {
     use std::io::ErrorKind;
     // ENOSPC, EDQUOT (Linux 122, macOS 69), EROFS: the numbers of Linux and macOS.
     let raw = e.raw_os_error();
@@ -104,12 +119,12 @@ fn io_fix(e: &std::io::Error, reading: bool) -> String {
     }
     let nothing = "nothing was written";
     if raw == Some(28) || (cfg!(target_os = "linux") && raw == Some(122)) {
-        format!("the disk is full: free some space or write the table elsewhere with -o PATH ({nothing})")
+        format!("the disk is full: free some space or write the {what} elsewhere with -o PATH ({nothing})")
     } else if raw == Some(30) {
-        format!("the file system is read-only: write the table elsewhere with -o PATH ({nothing})")
+        format!("the file system is read-only: write the {what} elsewhere with -o PATH ({nothing})")
     } else if e.kind() == ErrorKind::PermissionDenied {
         format!(
-            "you may not write there: write the table into a folder you own with -o PATH, or \
+            "you may not write there: write the {what} into a folder you own with -o PATH, or \
              change the folder's permissions ({nothing})"
         )
     } else {
@@ -157,6 +172,20 @@ pub fn from_clap(err: &clap::Error, command: &str) -> CliError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fixes_name_what_is_written() {
+        assert_eq!(written("write the PNG image"), "PNG image");
+        assert_eq!(written("flush the table to disk"), "table");
+        assert_eq!(
+            written("move the OpenEXR image into place"),
+            "OpenEXR image"
+        );
+        assert_eq!(written("create the temporary file"), "file");
+        let full = std::io::Error::from_raw_os_error(28);
+        let fix = io_fix(&full, false, written("write the PNG image"));
+        assert!(fix.contains("write the PNG image elsewhere"), "{fix}");
+    }
 
     #[test]
     fn new_is_one_line() {

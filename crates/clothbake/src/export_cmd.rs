@@ -128,13 +128,19 @@ fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
 
 /// Checks every output before any work is done ([`preflight`]).
 fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
-    for out in [&args.rgl, &args.rgl_spectral, &args.merl]
+    let outputs: Vec<(&std::path::Path, &str)> = [
+        (&args.rgl, "RGL file"),
+        (&args.rgl_spectral, "spectral RGL file"),
+        (&args.merl, "MERL file"),
+    ]
+    .into_iter()
+    .filter_map(|(p, what)| Some((p.as_deref()?, what)))
+    .collect();
+    let inputs: Vec<&std::path::Path> = [&args.weave, &args.table]
         .into_iter()
-        .flatten()
-    {
-        preflight(out, "export", args.run.force)?;
-    }
-    Ok(())
+        .filter_map(|p| p.as_deref())
+        .collect();
+    preflight(&outputs, args.run.force, &inputs)
 }
 
 /// Writes every requested file from `brdf`; `source` opens the RGL description.

@@ -21,7 +21,8 @@ pub fn run(a: &MergeArgs) -> Result<String, CliError> {
             "give a file name with -o TABLE, e.g. -o twill.exr",
         ));
     }
-    preflight(&a.output, "table", a.out.force)?;
+    let inputs: Vec<&std::path::Path> = a.shards.iter().map(|p| p.as_path()).collect();
+    preflight(&[(&a.output, "table")], a.out.force, &inputs)?;
     let mut parts = Vec::with_capacity(a.shards.len());
     for p in &a.shards {
         let part = read_part(p, orbits_of)?;

@@ -113,6 +113,15 @@ fn sources(b: &BrdfArgs, most: usize) -> Result<Vec<Named>, CliError> {
     Ok(out)
 }
 
+/// The files a BRDF is read from (its fabric file and tables): no output may be one of them.
+fn inputs(b: &BrdfArgs) -> Vec<&Path> {
+    b.weave
+        .iter()
+        .chain(&b.table)
+        .map(PathBuf::as_path)
+        .collect()
+}
+
 fn file_name(p: &Path) -> String {
     p.file_name().map_or_else(
         || p.display().to_string(),
@@ -131,10 +140,11 @@ const RENDER_BAR: &str = "{elapsed_precise} [{wide_bar}] {percent:>3}% {pos}/{le
 pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
     let mut srcs = sources(&a.brdf, 1)?;
     let (_, shader) = srcs.pop().expect("one source");
-    preflight(&a.output, "PNG image", a.run.force)?;
+    let mut outputs = vec![(a.output.as_path(), "PNG image")];
     if let Some(e) = &a.exr {
-        preflight(e, "EXR image", a.run.force)?;
+        outputs.push((e.as_path(), "OpenEXR image"));
     }
+    preflight(&outputs, a.run.force, &inputs(&a.brdf))?;
     let scene = Scene::by_name(match a.scene {
         SceneArg::Drape => "drape",
         SceneArg::Sphere => "sphere",
@@ -233,8 +243,9 @@ pub fn run_plot(a: &PlotArgs) -> Result<String, CliError> {
                 "name the output .png or .svg (repeat -o for both)",
             ));
         }
-        preflight(o, "plot", a.force)?;
     }
+    let kinds: Vec<(&Path, &str)> = outputs.iter().map(|o| (o.as_path(), "plot")).collect();
+    preflight(&kinds, a.force, &inputs(&a.brdf))?;
     let srcs = sources(&a.brdf, 2)?;
     let sources: Vec<Source<'_>> = srcs
         .iter()
