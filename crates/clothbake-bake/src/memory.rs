@@ -51,6 +51,22 @@ pub fn peak_bytes(grid: &Grid, rows: u64, kept: Kept) -> u64 {
     BASE_BYTES + orbits + sweep.max(end)
 }
 
+/// The most memory merging shards whose files hold `shard_bytes` in all needs, in bytes,
+/// writing `format`: the shards' values (at most their files' size), the table's (at least
+/// as many: copies by symmetry are not in the shards; counted as 3 times the files' size, the
+/// most a symmetry group of 4 saves, less the copy already counted), and the writer's buffers
+/// (per cell, as for a bake).
+pub fn merge_bytes(shard_bytes: u64, format: Format) -> u64 {
+    // A cell is 12 bytes in a shard; the table may hold up to 4 times the shards' cells.
+    let cells = shard_bytes / 12 * 4;
+    let writer = match format {
+        Format::Exr(Precision::F32) => 96 * cells,
+        Format::Exr(Precision::F16) => 56 * cells,
+        Format::Binary => 0,
+    };
+    BASE_BYTES + shard_bytes + 12 * cells + writer
+}
+
 /// The memory available to this process, in bytes, where the platform says (`None`
 /// elsewhere: no check is made).
 pub fn available_bytes() -> Option<u64> {
@@ -156,6 +172,14 @@ mod tests {
         assert!(f16 >= BASE_BYTES + 60 * c, "{f16}");
         assert!(bin >= BASE_BYTES + 24 * c, "{bin}");
         assert_eq!(of(None), bin);
+    }
+
+    #[test]
+    fn a_merge_holds_its_shards_and_the_table() {
+        // 12 MB of shards: 1 M cells, up to 4 M in the table (a symmetry group of 4).
+        let m = merge_bytes(12_000_000, Format::Binary);
+        assert!(m >= BASE_BYTES + 12_000_000 + 48_000_000, "{m}");
+        assert!(merge_bytes(12_000_000, Format::Exr(Precision::F32)) > m);
     }
 
     #[test]

@@ -292,6 +292,54 @@ mod exr_io {
         }
     }
 
+    /// Bytes of a file read before its header is looked at: the header (metadata, attributes,
+    /// offset tables) of any table is far smaller.
+    const HEAD_MAX: u64 = 64 << 20;
+
+    /// Reads the file, but one larger than [`HEAD_MAX`] only after its header says how large
+    /// its image may be (every channel in f32, twice over for a compression that grows it):
+    /// a larger file is refused before it is read.
+    fn read_bounded(path: &Path) -> Result<Vec<u8>, TableError> {
+        let read_err = |e| TableError::io(path, "read the table", e);
+        let mut file = crate::bytes::open_regular(path, "table")?;
+        let len = file.metadata().map_err(read_err)?.len();
+        let head = len.min(HEAD_MAX);
+        let mut bytes = Vec::with_capacity(head as usize);
+        io::Read::read_to_end(&mut io::Read::take(&mut file, head), &mut bytes)
+            .map_err(read_err)?;
+        if len > head {
+            let header = std::panic::catch_unwind(|| {
+                exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false)
+            })
+            .map_err(|_| TableError::Corrupted {
+                path: path.to_path_buf(),
+                reason: "the OpenEXR decoder failed on this file's header".to_string(),
+            })?
+            .map_err(|e| decode_error(path, "header", e))?;
+            let pixels: u64 = header
+                .headers
+                .iter()
+                .map(|h| {
+                    let n =
+                        (h.layer_size.width() as u64).saturating_mul(h.layer_size.height() as u64);
+                    n.saturating_mul(4 * h.channels.list.len() as u64)
+                })
+                .fold(0, u64::saturating_add);
+            let most = pixels.saturating_mul(2).saturating_add(HEAD_MAX);
+            if len > most {
+                return Err(TableError::Corrupted {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "the file is {len} bytes, but its header describes at most {most} \
+                         (images of {pixels} bytes of samples)"
+                    ),
+                });
+            }
+            io::Read::read_to_end(&mut file, &mut bytes).map_err(read_err)?;
+        }
+        Ok(bytes)
+    }
+
     fn attribute_text(value: &AttributeValue) -> Option<String> {
         match value {
             AttributeValue::Text(t) => Some(String::from_utf8_lossy(t.bytes()).into_owned()),
@@ -300,13 +348,7 @@ mod exr_io {
     }
 
     pub(super) fn read(path: &Path) -> Result<StoredTable, TableError> {
-        let bytes = {
-            let mut file = crate::bytes::open_regular(path, "table")?;
-            let mut bytes = Vec::new();
-            io::Read::read_to_end(&mut file, &mut bytes)
-                .map_err(|e| TableError::io(path, "read the table", e))?;
-            bytes
-        };
+        let bytes = read_bounded(path)?;
         if bytes.is_empty() {
             return Err(TableError::Empty {
                 path: path.to_path_buf(),

@@ -111,3 +111,23 @@ fn the_largest_value_samples_with_finite_weights_whose_mean_is_the_albedo() {
         );
     }
 }
+
+#[test]
+fn an_exr_file_larger_than_its_header_allows_is_refused_before_reading() {
+    let d = dir("exr-size");
+    let p = d.join("t.exr");
+    let t = Table::new(meta(), vec![0.5; 3 * GRID.len()]).unwrap();
+    write_exr(&p, &t, Precision::F32, true).unwrap();
+    assert_eq!(read_table(&p).unwrap(), t);
+    // 64 GiB of (sparse) trailing bytes: refused after reading the first 64 MiB.
+    let f = std::fs::OpenOptions::new().write(true).open(&p).unwrap();
+    if f.set_len(64 << 30).is_err() {
+        eprintln!("no sparse files here: skipped");
+        return;
+    }
+    let e = message(read_table(&p));
+    assert!(
+        e.contains("the file is 68719476736 bytes, but its header describes at most"),
+        "{e}"
+    );
+}

@@ -519,4 +519,14 @@ fn a_grid_that_does_not_fit_in_memory_is_refused_up_front() {
         assert!(need >= 25.7, "{e}");
     }
     assert_eq!(listing(&d), Vec::<String>::new());
+    // merge: from the shards' sizes, before reading any (a sparse file of twice the memory).
+    let f = std::fs::File::create(d.join("big.shard")).unwrap();
+    if f.set_len(2 * have).is_ok() {
+        let out = run_in(&d, &["merge", "-o", "t.bin", "big.shard"]);
+        fails_with(
+            &out,
+            &["merging these 1 shards", "of memory, but", "is available"],
+        );
+        assert_eq!(listing(&d), ["big.shard"]);
+    }
 }
