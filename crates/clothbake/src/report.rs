@@ -23,6 +23,8 @@ pub struct Report<'a> {
     pub fabric_name: &'a str,
     /// Fabric file.
     pub file: &'a Path,
+    /// What reading the file did to it (a WIF draft's packed yarns), one line each.
+    pub notes: &'a [String],
     /// Method used.
     pub method: Method,
     /// Facet model used.
@@ -42,7 +44,8 @@ pub struct Report<'a> {
 }
 
 impl Report<'_> {
-    /// One JSON object: `I_d`, `I_s`, `I`, `brdf`, and for the ray tracer `std_err`, `samples`.
+    /// One JSON object: `I_d`, `I_s`, `I`, `brdf`, for the ray tracer `std_err`, `samples`, and
+    /// `notes` where reading the fabric left any.
     pub fn json(&self) -> String {
         let mut v = json!({
             "I_d": self.reflection.i_d,
@@ -60,6 +63,9 @@ impl Report<'_> {
         if let Some(rt) = &self.raytrace {
             v["std_err"] = json!(rt.std_err);
             v["samples"] = json!(rt.samples);
+        }
+        if !self.notes.is_empty() {
+            v["notes"] = json!(self.notes);
         }
         let mut s = v.to_string();
         s.push('\n');
@@ -87,6 +93,9 @@ impl Report<'_> {
             "wo      theta {:6.2}  phi {:7.2}  (toward the eye, degrees)",
             self.wo.theta, self.wo.phi
         );
+        for n in self.notes {
+            let _ = writeln!(s, "note    {n}");
+        }
         if self.horizon {
             let _ = writeln!(
                 s,
