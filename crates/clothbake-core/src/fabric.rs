@@ -67,6 +67,7 @@ pub struct Fabric {
     weave: Weave,
     warp: YarnGroup,
     weft: YarnGroup,
+    notes: Vec<String>,
 }
 
 /// A field of a fabric that [`Fabric::new`] checks, for naming it in errors.
@@ -131,6 +132,8 @@ struct FabricFile {
     name: Option<String>,
     #[serde(default)]
     description: Option<String>,
+    #[serde(default)]
+    notes: Vec<String>,
     pattern: Vec<Vec<Value>>,
     warp: GroupFile,
     weft: GroupFile,
@@ -269,6 +272,7 @@ impl Fabric {
             weave,
             warp,
             weft,
+            notes: Vec::new(),
         };
         for g in [Group::Warp, Group::Weft] {
             fabric.check_group(g, naming)?;
@@ -347,13 +351,14 @@ impl Fabric {
             warp: &raw.warp,
             weft: &raw.weft,
         };
-        Fabric::new(
+        Ok(Fabric::new(
             raw.name.clone().unwrap_or_else(|| "fabric".into()),
             weave,
             warp,
             weft,
             &naming,
-        )
+        )?
+        .with_notes(raw.notes.clone()))
     }
 
     /// The fabric as a fabric file (canonical JSON, every field explicit): reading it back gives
@@ -381,12 +386,27 @@ impl Fabric {
             }
             v
         };
-        serde_json::json!({
+        let mut v = serde_json::json!({
             "name": self.name,
             "pattern": self.weave.to_rows(),
             "warp": group(&self.warp),
             "weft": group(&self.weft),
-        })
+        });
+        if !self.notes.is_empty() {
+            v["notes"] = serde_json::json!(self.notes);
+        }
+        v
+    }
+
+    /// What a source did to its description to make this fabric (a WIF draft's yarns capped
+    /// where they pack, [`crate::wif`]), one line each, for reports; kept in [`Fabric::to_json`].
+    pub fn notes(&self) -> &[String] {
+        &self.notes
+    }
+
+    /// The fabric with `notes` ([`Fabric::notes`]) in place of its own.
+    pub fn with_notes(self, notes: Vec<String>) -> Fabric {
+        Fabric { notes, ..self }
     }
 
     /// Display name.
@@ -427,7 +447,10 @@ impl Fabric {
         let (mut warp, mut weft) = (self.warp.clone(), self.weft.clone());
         edit(Group::Warp, &mut warp);
         edit(Group::Weft, &mut weft);
-        Fabric::new(self.name.clone(), self.weave.clone(), warp, weft, naming)
+        Ok(
+            Fabric::new(self.name.clone(), self.weave.clone(), warp, weft, naming)?
+                .with_notes(self.notes.clone()),
+        )
     }
 
     /// A copy with every facet material replaced (CLI material overrides), checked by

@@ -26,7 +26,7 @@
 use crate::fabric::{Fabric, FabricError, Field, Naming, PlainNaming};
 use crate::weave::Group;
 use crate::weave::Weave;
-use crate::yarn::{spacing_fits, Material, Yarn, YarnGroup};
+use crate::yarn::{packed_radii, Material, Yarn, YarnGroup};
 use std::fmt;
 
 /// Default spacing (mm) of a group when neither the draft nor the options give any size: the
@@ -399,17 +399,17 @@ struct GroupSizes {
     unit: f64,
 }
 
-/// Group spacing and thickness (mm) from the draft, else the options, else each other (in the
-/// ratio 3.1 : 3.0 of the thesis's samples), else the other group's, else
-/// [`DEFAULT_SPACING_MM`] and [`DEFAULT_THICKNESS_MM`].
+/// Group spacing and thickness (mm): the options (`--spacing`, `--radius`) where given, else the
+/// draft's, else each other (in the ratio 3.1 : 3.0 of the thesis's samples), else the other
+/// group's, else [`DEFAULT_SPACING_MM`] and [`DEFAULT_THICKNESS_MM`].
 pub fn resolve_sizes(
     draft: (Option<f64>, Option<f64>),
     other: (Option<f64>, Option<f64>),
     opts: &WifOptions,
 ) -> (f64, f64) {
     let one = |(s, d): (Option<f64>, Option<f64>)| {
-        let s = s.or(opts.spacing);
-        let d = d.or(opts.radius.map(|r| 2.0 * r));
+        let s = opts.spacing.or(s);
+        let d = opts.radius.map(|r| 2.0 * r).or(d);
         match (s, d) {
             (Some(s), Some(d)) => Some((s, d)),
             (Some(s), None) => Some((s, s * 3.0 / 3.1)),
@@ -453,6 +453,9 @@ fn minimal_period(n: usize, same: impl Fn(usize, usize) -> bool) -> usize {
 
 /// Reads and validates a WIF draft; `file` names it in errors (and, without a `[TEXT] Title`,
 /// gives the fabric its name).
+///
+/// The number of ends or picks is checked against the period's bound
+/// ([`crate::fabric::MAX_THREADS`]) before anything of that size is allocated.
 pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifError> {
     let d = Draft {
         file,
@@ -491,6 +494,14 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
     }
     let th = d.numbered("THREADING", "end", ends_max)?;
     let ends = ends_given.unwrap_or_else(|| th.iter().map(|(n, _)| *n).max().unwrap_or(0));
+    too_many(
+        &d,
+        ends,
+        ends_given.is_some(),
+        "WARP",
+        "THREADING",
+        "warp ends",
+    )?;
     let mut threading = vec![None; ends];
     for &(n, e) in &th {
         let shafts = d.list("THREADING", e, "shaft", shaft_max)?;
@@ -582,6 +593,14 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
             format!("give [{plan_section}] a line for each pick"),
         ));
     }
+    too_many(
+        &d,
+        picks,
+        picks_given.is_some(),
+        "WEFT",
+        plan_section,
+        "picks",
+    )?;
     let mut lift: Vec<Option<Vec<usize>>> = vec![None; picks];
     for (n, s) in plan {
         lift[n - 1] = Some(s);
@@ -634,15 +653,24 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
                 .file_stem()
                 .map_or("draft".into(), |s| s.to_string_lossy().into_owned())
         });
-    let warp = group(&d, "WARP", &warp[..px])?;
-    let weft = group(&d, "WEFT", &weft[..py])?;
-    Fabric::new(name, weave, warp, weft, &WifNaming(file)).map_err(|e| WifError {
+    // Sizes in notes: in the draft's units, or in mm where the options set them.
+    let unit = |g: &str| {
+        if opts.radius.is_some() || opts.spacing.is_some() {
+            Ok((1.0, "mm, from --radius/--spacing".to_string()))
+        } else {
+            draft_unit(&d, g)
+        }
+    };
+    let (warp, warp_note) = group("WARP", &warp[..px], &unit("WARP")?);
+    let (weft, weft_note) = group("WEFT", &weft[..py], &unit("WEFT")?);
+    let fabric = Fabric::new(name, weave, warp, weft, &WifNaming(file)).map_err(|e| WifError {
         file: e.file,
         section: String::new(),
         line: None,
         problem: format!("{}: {}", e.field, e.problem),
         fix: e.fix,
-    })
+    })?;
+    Ok(fabric.with_notes(warp_note.into_iter().chain(weft_note).collect()))
 }
 
 /// Names a draft's fields by the WIF section and key they come from.
@@ -758,8 +786,15 @@ fn threads(
         }
         Ok(v)
     };
-    let spacing = per("SPACING", s)?;
-    let thickness = per("THICKNESS", t)?;
+    // The options replace the draft's sizes, its per-thread ones too (still checked).
+    let mut spacing = per("SPACING", s)?;
+    let mut thickness = per("THICKNESS", t)?;
+    if opts.spacing.is_some() {
+        spacing.fill(s);
+    }
+    if opts.radius.is_some() {
+        thickness.fill(t);
+    }
     Ok((0..n)
         .map(|k| Thread {
             albedo: albedo[k],
@@ -861,40 +896,27 @@ fn colours(d: &Draft<'_>) -> Result<Vec<(usize, [f64; 3])>, WifError> {
     Ok(out)
 }
 
-/// The clothbake yarn group of one period of threads: radii, centre-to-centre spacings, colours.
-fn group(d: &Draft<'_>, g: &str, t: &[Thread]) -> Result<YarnGroup, WifError> {
+/// The clothbake yarn group of one period of threads: radii, centre-to-centre spacings,
+/// colours; and a note when yarns thicker than their spacing allows were packed
+/// ([`packed_radii`]: round yarns capped where neighbours meet; docs/wif.md).
+fn group(g: &str, t: &[Thread], unit: &(f64, String)) -> (YarnGroup, Option<String>) {
     let n = t.len();
-    let mut threads = Vec::with_capacity(n);
-    for i in 0..n {
-        let next = &t[(i + 1) % n];
-        let spacing = 0.5 * (t[i].spacing + next.spacing);
-        let (r, r_next) = (0.5 * t[i].thickness, 0.5 * next.thickness);
-        if !spacing_fits(spacing, r, r_next) {
-            let what = if g == "WARP" { "ends" } else { "picks" };
-            return Err(d.err(
-                g,
-                d.section(g).map(|s| s.line),
-                format!(
-                    "{what} {} and {} would overlap: thicknesses {:.4} mm and {:.4} mm, centres {:.4} mm apart",
-                    i + 1,
-                    (i + 1) % n + 1,
-                    t[i].thickness,
-                    next.thickness,
-                    spacing
-                ),
-                format!(
-                    "make Thickness at most Spacing in [{g}] (or in [{g} THICKNESS] / [{g} SPACING]): clothbake's yarns are round and may touch but not overlap"
-                ),
-            ));
-        }
-        threads.push(Yarn {
-            radius: r,
+    let spacing: Vec<f64> = (0..n)
+        .map(|i| 0.5 * (t[i].spacing + t[(i + 1) % n].spacing))
+        .collect();
+    let half: Vec<f64> = t.iter().map(|x| 0.5 * x.thickness).collect();
+    let (radii, capped) = packed_radii(&half, &spacing);
+    let note = (capped > 0).then(|| packing_note(g, t, &radii, capped, unit));
+    let threads: Vec<Yarn> = (0..n)
+        .map(|i| Yarn {
+            radius: radii[i],
             height: 0.0,
-            spacing,
+            spacing: spacing[i],
             segment_length: None,
             albedo: t[i].albedo,
-        });
-    }
+        })
+        .collect();
+    let mut threads = threads;
     let mut material = Material::default();
     // One colour for the whole group: the group material's; otherwise per thread, with the
     // default albedo for threads that have no colour.
@@ -909,7 +931,88 @@ fn group(d: &Draft<'_>, g: &str, t: &[Thread]) -> Result<YarnGroup, WifError> {
             y.albedo.get_or_insert(material.albedo);
         }
     }
-    Ok(YarnGroup { threads, material })
+    (YarnGroup { threads, material }, note)
+}
+
+/// What packing did to a group, in one line for `eval` and `info`.
+fn packing_note(
+    g: &str,
+    t: &[Thread],
+    radii: &[f64],
+    capped: usize,
+    (per_unit, unit): &(f64, String),
+) -> String {
+    let (name, what) = if g == "WARP" {
+        ("warp", "ends")
+    } else {
+        ("weft", "picks")
+    };
+    let n = t.len();
+    let uniform = t
+        .iter()
+        .all(|x| x.thickness == t[0].thickness && x.spacing == t[0].spacing);
+    if uniform {
+        format!(
+            "{name}: Thickness {} > Spacing {} ({unit}); radius capped to {} mm, half the spacing (round yarns that touch), instead of {} mm",
+            mm(t[0].thickness / per_unit),
+            mm(t[0].spacing / per_unit),
+            mm(radii[0]),
+            mm(0.5 * t[0].thickness)
+        )
+    } else {
+        let lo = radii.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = radii.iter().copied().fold(0.0, f64::max);
+        let thick = t.iter().map(|x| x.thickness).fold(0.0, f64::max);
+        format!(
+            "{name}: {capped} of {n} {what} thicker than their spacing allows; radii capped where neighbours meet, now {} to {} mm (Thickness up to {} mm)",
+            mm(lo),
+            mm(hi),
+            mm(thick)
+        )
+    }
+}
+
+/// Millimetres per unit of group `g`'s sizes, and the unit's name as the draft writes it.
+fn draft_unit(d: &Draft<'_>, g: &str) -> Result<(f64, String), WifError> {
+    let name = d
+        .value(g, "Units")
+        .map_or("Decipoints".to_string(), |e| bare(&e.value).to_string());
+    Ok((group_sizes(d, g)?.unit, name))
+}
+
+/// A length for a message: 4 significant digits.
+fn mm(x: f64) -> String {
+    let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    format!("{x:.digits$}")
+}
+
+/// Refuses `n` threads beyond [`crate::fabric::MAX_THREADS`], naming `[group] Threads` when the
+/// draft gave it, else the numbered section whose largest number set it.
+fn too_many(
+    d: &Draft<'_>,
+    n: usize,
+    given: bool,
+    group: &str,
+    numbered: &str,
+    what: &str,
+) -> Result<(), WifError> {
+    let max = crate::fabric::MAX_THREADS;
+    if n <= max {
+        return Ok(());
+    }
+    let (section, field) = if given {
+        (group, format!("[{group}] Threads"))
+    } else {
+        (numbered, format!("the largest number in [{numbered}]"))
+    };
+    Err(d.err(
+        section,
+        d.section(section).map(|s| s.line),
+        format!(
+            "{field} asks for {n} {what}, more than clothbake weaves (at most {max} in one period)"
+        ),
+        format!("give one repeat of the weave (at most {max} {what})"),
+    ))
 }
 
 #[cfg(test)]
@@ -969,6 +1072,19 @@ mod tests {
             resolve_sizes((None, None), (Some(2.0), Some(1.0)), &o),
             (0.5, 0.4)
         );
+        // ... and before the draft's own sizes, one at a time.
+        assert_eq!(
+            resolve_sizes((Some(1.0), Some(0.5)), (None, None), &o),
+            (0.5, 0.4)
+        );
+        let radius_only = WifOptions {
+            radius: Some(0.2),
+            spacing: None,
+        };
+        assert_eq!(
+            resolve_sizes((Some(1.0), Some(0.5)), (None, None), &radius_only),
+            (1.0, 0.4)
+        );
         assert_eq!(
             resolve_sizes((None, None), (None, None), &none),
             (DEFAULT_SPACING_MM, DEFAULT_THICKNESS_MM)
@@ -1024,13 +1140,6 @@ mod tests {
             "{e}"
         );
 
-        let e = err(&PLAIN.replace(
-            "[WARP]\nThreads=2",
-            "[WARP]\nThreads=2\nSpacing=1\nThickness=1.2\nUnits=centimeters",
-        ));
-        assert_eq!(e.section, "WARP");
-        assert!(e.problem.contains("would overlap"), "{e}");
-
         let e = err(&PLAIN
             .replace("Units", "")
             .replace("[WARP]\n", "[WARP]\nUnits=furlongs\n"));
@@ -1049,5 +1158,59 @@ mod tests {
         let body = format!("{PLAIN}[LIFTPLAN]\n1=1,2\n2=1,2\n");
         let f = parse(&draft(&body), "t.wif", &WifOptions::default()).unwrap();
         assert_eq!(f.weave().to_rows(), vec![vec![1]]);
+    }
+
+    #[test]
+    fn yarns_thicker_than_their_spacing_are_packed_and_noted() {
+        // Warp: Thickness 1.2 cm at Spacing 1 cm: round yarns of radius 5 mm (half the spacing)
+        // that touch, the draft's 6 mm noted; the weft fits and keeps its radius exactly.
+        let body = PLAIN
+            .replace(
+                "[WARP]\nThreads=2",
+                "[WARP]\nThreads=2\nSpacing=1\nThickness=1.2\nUnits=centimeters",
+            )
+            .replace(
+                "[WEFT]\nThreads=2",
+                "[WEFT]\nThreads=2\nSpacing=1\nThickness=0.9\nUnits=centimeters",
+            );
+        let f = parse(&draft(&body), "t.wif", &WifOptions::default()).unwrap();
+        for y in &f.warp().threads {
+            assert_eq!((y.radius, y.spacing, y.height), (5.0, 10.0, 0.0));
+        }
+        assert_eq!(f.weft().threads[0].radius, 0.5 * (0.9 * 10.0));
+        assert_eq!(
+            f.notes(),
+            [
+                "warp: Thickness 1.200 > Spacing 1.000 (centimeters); radius capped to 5.000 mm, \
+              half the spacing (round yarns that touch), instead of 6.000 mm"
+            ]
+        );
+        // The notes travel with the fabric's JSON (baked tables keep it).
+        let back = Fabric::from_json_str(&f.to_json().to_string(), "t.json").unwrap();
+        assert_eq!(back.notes(), f.notes());
+        // A draft whose yarns fit has no note.
+        let plain = parse(&draft(PLAIN), "t.wif", &WifOptions::default()).unwrap();
+        assert!(plain.notes().is_empty() && plain.to_json().get("notes").is_none());
+    }
+
+    #[test]
+    fn packing_caps_only_the_threads_that_would_overlap() {
+        use crate::yarn::{packed_radii, spacing_fits};
+        // Threads 1 and 2 overlap (0.6 + 0.7 > 1.0); 3 fits both neighbours.
+        let radii = [0.4, 0.6, 0.7, 0.3];
+        let spacing = [1.1, 1.0, 1.2, 0.8];
+        let (r, capped) = packed_radii(&radii, &spacing);
+        assert_eq!(capped, 2);
+        assert_eq!((r[0], r[3]), (0.4, 0.3));
+        let f = 1.0 / 1.3;
+        assert!((r[1] - 0.6 * f).abs() < 1e-15 && (r[2] - 0.7 * f).abs() < 1e-15);
+        assert!((r[1] + r[2] - 1.0).abs() < 1e-15);
+        for i in 0..4 {
+            assert!(spacing_fits(spacing[i], r[i], r[(i + 1) % 4]), "{i}");
+        }
+        // A thread between two overlapping pairs takes the smaller factor.
+        let (r, _) = packed_radii(&[1.0, 1.0, 0.5], &[1.5, 1.0, 2.0]);
+        assert!((r[1] - 1.0 / 1.5).abs() < 1e-15, "{r:?}");
+        assert!(r[0] + r[1] <= 1.5 * (1.0 + 1e-15) && r[1] + r[2] <= 1.0 * (1.0 + 1e-15));
     }
 }

@@ -4,7 +4,7 @@
 //! * Thread i of a group sits at P_0 = 0, P_{i+1} = P_i + spacing_i across its direction; the
 //!   period is the sum of the spacings and tiles the plane.
 //! * Neighbouring threads may touch but not overlap: spacing_i >= r_i + r_{i+1}
-//!   ([`spacing_fits`]).
+//!   ([`spacing_fits`]); yarns given thicker than their spacing are packed ([`packed_radii`]).
 //! * A float over crossing threads a..=b has, along its axis, the room between the surfaces of
 //!   the crossing threads before and after it, [P_{a-1} + r_{a-1}, P_{b+1} - r_{b+1}]
 //!   ([`float_room`]); a given segment length is centred in that room ([`float_extent`]).
@@ -108,6 +108,38 @@ pub fn unwrapped_position(pos: &[f64], period: f64, k: isize) -> f64 {
 /// overlap (to a relative 1e-12, so that sizes converted between units still touch).
 pub fn spacing_fits(spacing: f64, r: f64, r_next: f64) -> bool {
     spacing >= (r + r_next) * (1.0 - 1e-12)
+}
+
+/// Radii of round yarns packed in a row: each thread's `radii[i]`, or less where it and a
+/// neighbour would overlap at the centre distances `spacing` (`spacing[i]` from thread i to
+/// thread i + 1, cyclic). An overlapping pair (i, i + 1) is scaled by f_i = spacing_i /
+/// (r_i + r_{i+1}) so that it touches; a thread in two such pairs takes the smaller factor:
+/// r'_i = r_i min(1, f_{i-1}, f_i). Threads that fit keep their radius; uniform yarns of
+/// thickness T at spacing S < T get radius S / 2 (round yarns that touch). Returns the radii
+/// and how many were capped.
+pub fn packed_radii(radii: &[f64], spacing: &[f64]) -> (Vec<f64>, usize) {
+    let n = radii.len();
+    let factor = |i: usize| {
+        let pair = radii[i] + radii[(i + 1) % n];
+        if spacing_fits(spacing[i], radii[i], radii[(i + 1) % n]) {
+            1.0
+        } else {
+            spacing[i] / pair
+        }
+    };
+    let mut capped = 0;
+    let out = (0..n)
+        .map(|i| {
+            let f = factor(i).min(factor((i + n - 1) % n));
+            if f < 1.0 {
+                capped += 1;
+                radii[i] * f
+            } else {
+                radii[i]
+            }
+        })
+        .collect();
+    (out, capped)
 }
 
 /// The room a float `fl` has along its axis between the surfaces of the `crossing` group's

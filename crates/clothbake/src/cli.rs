@@ -522,16 +522,17 @@ pub struct MaterialArgs {
     pub exponent: Option<f64>,
 }
 
-/// Yarn sizes for a WIF draft whose `[WARP]` / `[WEFT]` sections leave them out (docs/wif.md).
+/// Yarn sizes for a WIF draft, in place of its `[WARP]` / `[WEFT]` sizes (docs/wif.md).
 #[derive(Args, Debug, Default, Clone, Copy, PartialEq)]
 pub struct DraftArgs {
-    /// WIF drafts only: yarn radius in mm where the draft gives no Thickness [default: from the
-    /// spacing in the ratio 1.5 : 3.1, else 0.15].
+    /// WIF drafts only: yarn radius in mm of every thread, replacing the draft's Thickness
+    /// [default: the draft's, else from the spacing in the ratio 1.5 : 3.1, else 0.15].
     #[arg(long, value_name = "MM", value_parser = parse_length)]
     pub radius: Option<f64>,
 
-    /// WIF drafts only: thread spacing (centre to centre) in mm where the draft gives no Spacing
-    /// [default: from the thickness in the ratio 3.1 : 3.0, else 0.31].
+    /// WIF drafts only: thread spacing (centre to centre) in mm of every thread, replacing the
+    /// draft's Spacing [default: the draft's, else from the thickness in the ratio 3.1 : 3.0,
+    /// else 0.31].
     #[arg(long, value_name = "MM", value_parser = parse_length)]
     pub spacing: Option<f64>,
 }

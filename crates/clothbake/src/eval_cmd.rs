@@ -141,6 +141,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     let rep = Report {
         fabric_name: fabric.name(),
         file: &args.weave,
+        notes: fabric.notes(),
         method: args.method,
         facet,
         settings,

@@ -46,10 +46,19 @@ pub fn run(args: &InfoArgs) -> Result<String, CliError> {
     let m = &t.meta;
     let g = m.grid;
     let mut s = String::new();
-    let fabric_name = serde_json::from_str::<serde_json::Value>(&m.fabric_json)
-        .ok()
+    let fabric = serde_json::from_str::<serde_json::Value>(&m.fabric_json).ok();
+    let fabric_name = fabric
+        .as_ref()
         .and_then(|v| v["name"].as_str().map(str::to_string))
         .unwrap_or_else(|| "(unnamed)".to_string());
+    // What reading the fabric did to it (a WIF draft's packed yarns; Fabric::notes).
+    let notes: Vec<String> = fabric
+        .as_ref()
+        .and_then(|v| v["notes"].as_array().cloned())
+        .unwrap_or_default()
+        .iter()
+        .filter_map(|n| n.as_str().map(str::to_string))
+        .collect();
     let _ = writeln!(
         s,
         "table      {} ({} format, version {})",
@@ -59,6 +68,9 @@ pub fn run(args: &InfoArgs) -> Result<String, CliError> {
     );
     let _ = writeln!(s, "tool       {}", m.tool);
     let _ = writeln!(s, "fabric     {fabric_name}");
+    for n in &notes {
+        let _ = writeln!(s, "note       {n}");
+    }
     let _ = writeln!(
         s,
         "grid       theta_i {} x phi_i {} x theta_o {} x phi_o {} = {} cells, centring {} \

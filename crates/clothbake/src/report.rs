@@ -34,6 +34,8 @@ pub struct Report<'a> {
     pub fabric_name: &'a str,
     /// Fabric file.
     pub file: &'a Path,
+    /// What reading the file did to it (a WIF draft's packed yarns), one line each.
+    pub notes: &'a [String],
     /// Method used.
     pub method: Method,
     /// Facet model used.
@@ -60,7 +62,8 @@ pub struct Report<'a> {
 }
 
 impl Report<'_> {
-    /// One JSON object: `I_d`, `I_s`, `I`, `brdf`, and for the ray tracer `std_err`, `samples`.
+    /// One JSON object: `I_d`, `I_s`, `I`, `brdf`, for the ray tracer `std_err`, `samples`, and
+    /// `notes` where reading the fabric left any.
     pub fn json(&self) -> String {
         let mut v = json!({
             "I_d": self.reflection.i_d,
@@ -87,6 +90,9 @@ impl Report<'_> {
                 v["on_top"] = json!(if l.warp_on_top { "warp" } else { "weft" });
                 v["coverage"] = json!(c);
             }
+        }
+        if !self.notes.is_empty() {
+            v["notes"] = json!(self.notes);
         }
         let mut s = v.to_string();
         s.push('\n');
@@ -132,6 +138,9 @@ impl Report<'_> {
                     p.v(),
                 );
             }
+        }
+        for n in self.notes {
+            let _ = writeln!(s, "note    {n}");
         }
         if self.horizon {
             let _ = writeln!(

@@ -440,9 +440,6 @@ fn run_fabric_json() {
 }
 
 #[test]
-#[ignore = "WIF drafts with a huge [WARP] Threads, or a huge end number, allocate that many ends \
-            (tests/fuzz-corpus/wif/crash-*): the input side of issue 18 fixes it in \
-            clothbake-core's wif.rs; run it again after that merge"]
 fn fuzz_wif() {
     isolated("wif", "wif", "fuzz_wif", run_wif);
 }
