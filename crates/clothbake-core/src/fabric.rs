@@ -286,6 +286,22 @@ impl Fabric {
     /// Parses and validates a fabric description; `file` names the source in error messages.
     pub fn from_json_str(text: &str, file: &str) -> Result<Fabric, FabricError> {
         let cx = Ctx { file };
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        // The top level must be an object: say so, rather than what serde makes of a sequence.
+        let found = match text.trim_start().chars().next() {
+            None => Some("is empty"),
+            Some('{') => None,
+            Some('[') => Some("is a JSON array"),
+            Some('"') => Some("is a JSON string"),
+            Some(_) => Some("does not start with a JSON object"),
+        };
+        if let Some(what) = found {
+            return Err(cx.err(
+                "",
+                format!("the fabric file {what}; expected an object {{\"pattern\": ..., \"warp\": ..., \"weft\": ...}}"),
+                "give a fabric file (docs/fabric-format.md), e.g. tables/twill.json",
+            ));
+        }
         let de = &mut serde_json::Deserializer::from_str(text);
         let raw: FabricFile = serde_path_to_error::deserialize(de).map_err(|e| {
             let path = e.path().to_string();

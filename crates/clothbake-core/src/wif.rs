@@ -23,7 +23,7 @@
 //!   centre-to-centre distance of threads i and i+1 is (s_i + s_{i+1}) / 2. Missing sizes come
 //!   from [`WifOptions`] or the defaults of [`resolve_sizes`].
 
-use crate::fabric::{Fabric, FabricError, Field, Naming, PlainNaming};
+use crate::fabric::{check_period, Fabric, FabricError, Field, Naming, PlainNaming, MAX_THREADS};
 use crate::weave::Group;
 use crate::weave::Weave;
 use crate::yarn::{packed_radii, Material, Yarn, YarnGroup};
@@ -124,6 +124,23 @@ struct Entry {
     line: usize,
 }
 
+impl Entry {
+    /// `key=value` as messages quote it ([`clip`]ped).
+    fn shown(&self) -> String {
+        clip(&format!("{}={}", self.key, self.value)).into_owned()
+    }
+}
+
+/// Text quoted in a message, cut to 60 characters: a message stays one readable line whatever
+/// the draft holds.
+fn clip(s: &str) -> std::borrow::Cow<'_, str> {
+    const MAX: usize = 60;
+    match s.char_indices().nth(MAX) {
+        Some((i, _)) => format!("{}...", &s[..i]).into(),
+        None => s.into(),
+    }
+}
+
 struct Section {
     name: String,
     line: usize,
@@ -156,7 +173,7 @@ fn split_ini(text: &str, file: &str) -> Result<Vec<Section>, WifError> {
                 return Err(err(
                     "",
                     line,
-                    format!("`{s}` opens a section name without closing it"),
+                    format!("`{}` opens a section name without closing it", clip(s)),
                     "write the section header as [NAME]",
                 ));
             };
@@ -184,7 +201,10 @@ fn split_ini(text: &str, file: &str) -> Result<Vec<Section>, WifError> {
             return Err(err(
                 sec,
                 line,
-                format!("`{s}` is neither a [SECTION] header nor a key=value line"),
+                format!(
+                    "`{}` is neither a [SECTION] header nor a key=value line",
+                    clip(s)
+                ),
                 "write key=value, or start the line with ; to make it a comment",
             ));
         };
@@ -206,7 +226,10 @@ fn split_ini(text: &str, file: &str) -> Result<Vec<Section>, WifError> {
             return Err(err(
                 &name,
                 line,
-                format!("key `{key}` appears a second time (first at line {first})"),
+                format!(
+                    "key `{}` appears a second time (first at line {first})",
+                    clip(&key)
+                ),
                 "keep one entry per key",
             ));
         }
@@ -217,6 +240,30 @@ fn split_ini(text: &str, file: &str) -> Result<Vec<Section>, WifError> {
         });
     }
     Ok(sections)
+}
+
+/// Largest count, thread, shaft, treadle or colour number a draft may give: the most threads
+/// of a group in a period ([`MAX_THREADS`]).
+pub const MAX_COUNT: usize = MAX_THREADS;
+
+/// Most cells (ends x picks) of a whole draft before it is reduced to its repeat.
+pub const MAX_DRAFT_CELLS: usize = 1 << 24;
+
+/// Why a text is not a whole number in `usize`.
+enum Whole {
+    /// Not digits.
+    No,
+    /// Digits, too many.
+    TooLarge,
+}
+
+/// A whole number: ASCII digits only (a leading `+` allowed, as Rust's parser does).
+fn whole(t: &str) -> Result<usize, Whole> {
+    let digits = t.strip_prefix('+').unwrap_or(t);
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(Whole::No);
+    }
+    digits.parse::<usize>().map_err(|_| Whole::TooLarge)
 }
 
 fn parse_bool(v: &str) -> Option<bool> {
@@ -273,15 +320,27 @@ impl<'a> Draft<'a> {
             .find(|e| e.key.eq_ignore_ascii_case(key))
     }
 
+    /// A whole number in 0..=[`MAX_COUNT`] (counts, colour numbers).
     fn int(&self, section: &str, e: &Entry, what: &str) -> Result<usize, WifError> {
-        bare(&e.value).parse::<usize>().map_err(|_| {
-            self.err(
+        match whole(bare(&e.value)) {
+            Ok(n) if n <= MAX_COUNT => Ok(n),
+            Err(Whole::No) => Err(self.err(
                 section,
                 Some(e.line),
-                format!("{}={}: {what} is not a whole number", e.key, e.value),
+                format!("{}: {what} is not a whole number", e.shown()),
                 format!("give {what} as a whole number"),
-            )
-        })
+            )),
+            _ => Err(self.too_large(section, e, what)),
+        }
+    }
+
+    fn too_large(&self, section: &str, e: &Entry, what: &str) -> WifError {
+        self.err(
+            section,
+            Some(e.line),
+            format!("{}: {what} is too large, at most {MAX_COUNT}", e.shown()),
+            format!("give {what} up to {MAX_COUNT}: one repeat of the weave (docs/limits.md)"),
+        )
     }
 
     fn number(&self, section: &str, e: &Entry, what: &str) -> Result<f64, WifError> {
@@ -290,7 +349,7 @@ impl<'a> Draft<'a> {
             _ => Err(self.err(
                 section,
                 Some(e.line),
-                format!("{}={}: {what} is not a positive number", e.key, e.value),
+                format!("{}: {what} is not a positive number", e.shown()),
                 format!("give {what} as a positive decimal number"),
             )),
         }
@@ -304,7 +363,7 @@ impl<'a> Draft<'a> {
             self.err(
                 section,
                 Some(e.line),
-                format!("{}={} is not a yes/no value", e.key, e.value),
+                format!("{} is not a yes/no value", e.shown()),
                 "write true or false (yes/no, on/off, 1/0)",
             )
         })
@@ -322,16 +381,17 @@ impl<'a> Draft<'a> {
         };
         let mut out = Vec::with_capacity(s.entries.len());
         for e in &s.entries {
-            let n = match e.key.parse::<usize>() {
-                Ok(n) if n >= 1 => n,
-                _ => {
+            let n = match whole(&e.key) {
+                Ok(n) if (1..=MAX_COUNT).contains(&n) => n,
+                Ok(0) | Err(Whole::No) => {
                     return Err(self.err(
                         section,
                         Some(e.line),
-                        format!("key `{}` is not a {what} number (1, 2, ...)", e.key),
+                        format!("key `{}` is not a {what} number (1, 2, ...)", clip(&e.key)),
                         format!("number each line by its {what}, from 1"),
                     ))
                 }
+                _ => return Err(self.too_large(section, e, &format!("the {what} number"))),
             };
             if let Some((m, source)) = max {
                 if n > m {
@@ -361,14 +421,18 @@ impl<'a> Draft<'a> {
             if tok.is_empty() {
                 continue;
             }
-            let n = tok.parse::<usize>().map_err(|_| {
-                self.err(
-                    section,
-                    Some(e.line),
-                    format!("{}={}: `{tok}` is not a {what} number", e.key, e.value),
-                    format!("list {what} numbers separated by commas, e.g. 1,3"),
-                )
-            })?;
+            let n = match whole(tok) {
+                Ok(n) if n <= MAX_COUNT => n,
+                Err(Whole::No) => {
+                    return Err(self.err(
+                        section,
+                        Some(e.line),
+                        format!("{}: `{}` is not a {what} number", e.shown(), clip(tok)),
+                        format!("list {what} numbers separated by commas, e.g. 1,3"),
+                    ))
+                }
+                _ => return Err(self.too_large(section, e, &format!("a {what} number"))),
+            };
             if n == 0 {
                 continue;
             }
@@ -377,10 +441,7 @@ impl<'a> Draft<'a> {
                     return Err(self.err(
                         section,
                         Some(e.line),
-                        format!(
-                            "{}={}: {what} {n} is beyond the {m} of {source}",
-                            e.key, e.value
-                        ),
+                        format!("{}: {what} {n} is beyond the {m} of {source}", e.shown()),
                         format!("use {what}s 1 to {m} or raise {source}"),
                     ));
                 }
@@ -443,6 +504,48 @@ impl Thread {
     }
 }
 
+/// The drawdown of a whole draft: ends x picks bits, 1 where the warp is over.
+struct Drawdown {
+    picks: usize,
+    bits: Vec<u64>,
+}
+
+/// Row j = pick j + 1, column i = end i + 1: end i is raised at pick j when one of its shafts
+/// is among those moved (`lift[j]`), and over the weft when raised on a rising shed or not
+/// raised on a sinking one. Linear in the cells and the entries of threading and liftplan.
+fn drawdown(threading: &[Vec<usize>], lift: &[Vec<usize>], rising: bool) -> Drawdown {
+    let (ends, picks) = (threading.len(), lift.len());
+    let top = lift.iter().flatten().copied().max().unwrap_or(0);
+    let mut moved = vec![false; top + 1];
+    let mut bits = vec![0u64; (ends * picks).div_ceil(64)];
+    for (j, shafts) in lift.iter().enumerate() {
+        shafts.iter().for_each(|&s| moved[s] = true);
+        for (i, on) in threading.iter().enumerate() {
+            let raised = on.iter().any(|&s| moved.get(s).copied().unwrap_or(false));
+            if raised == rising {
+                let k = i * picks + j;
+                bits[k / 64] |= 1 << (k % 64);
+            }
+        }
+        shafts.iter().for_each(|&s| moved[s] = false);
+    }
+    Drawdown { picks, bits }
+}
+
+impl Drawdown {
+    fn over(&self, i: usize, j: usize) -> bool {
+        let k = i * self.picks + j;
+        self.bits[k / 64] >> (k % 64) & 1 == 1
+    }
+
+    /// FNV-1a of a sequence of cells: a filter before comparing columns or rows cell by cell.
+    fn hash(&self, cells: impl Iterator<Item = bool>) -> u64 {
+        cells.fold(0xcbf2_9ce4_8422_2325, |h, c| {
+            (h ^ u64::from(c)).wrapping_mul(0x0100_0000_01b3)
+        })
+    }
+}
+
 /// The smallest p dividing `n` with `same(i, (i + p) % n)` for every i.
 fn minimal_period(n: usize, same: impl Fn(usize, usize) -> bool) -> usize {
     (1..=n)
@@ -453,9 +556,6 @@ fn minimal_period(n: usize, same: impl Fn(usize, usize) -> bool) -> usize {
 
 /// Reads and validates a WIF draft; `file` names it in errors (and, without a `[TEXT] Title`,
 /// gives the fabric its name).
-///
-/// The number of ends or picks is checked against the period's bound
-/// ([`crate::fabric::MAX_THREADS`]) before anything of that size is allocated.
 pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifError> {
     let d = Draft {
         file,
@@ -494,14 +594,6 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
     }
     let th = d.numbered("THREADING", "end", ends_max)?;
     let ends = ends_given.unwrap_or_else(|| th.iter().map(|(n, _)| *n).max().unwrap_or(0));
-    too_many(
-        &d,
-        ends,
-        ends_given.is_some(),
-        "WARP",
-        "THREADING",
-        "warp ends",
-    )?;
     let mut threading = vec![None; ends];
     for &(n, e) in &th {
         let shafts = d.list("THREADING", e, "shaft", shaft_max)?;
@@ -560,15 +652,18 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
                 "add [TIEUP] with a line treadle=shafts for each treadle, or give a [LIFTPLAN]",
             ));
         }
-        let mut tieup: Vec<(usize, Vec<usize>)> = Vec::new();
-        for &(n, e) in &d.numbered("TIEUP", "treadle", treadle_max)? {
-            tieup.push((n, d.list("TIEUP", e, "shaft", shaft_max)?));
+        // Tie-up by treadle number (each at most MAX_COUNT).
+        let tied = d.numbered("TIEUP", "treadle", treadle_max)?;
+        let mut tieup: Vec<Vec<usize>> =
+            vec![Vec::new(); tied.iter().map(|t| t.0 + 1).max().unwrap_or(0)];
+        for &(n, e) in &tied {
+            tieup[n] = d.list("TIEUP", e, "shaft", shaft_max)?;
         }
         let mut rows = Vec::new();
         for &(n, e) in &d.numbered("TREADLING", "pick", picks_max)? {
             let mut lifted = Vec::new();
             for t in d.list("TREADLING", e, "treadle", treadle_max)? {
-                if let Some((_, s)) = tieup.iter().find(|(k, _)| *k == t) {
+                if let Some(s) = tieup.get(t) {
                     lifted.extend(s);
                 }
             }
@@ -593,14 +688,6 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
             format!("give [{plan_section}] a line for each pick"),
         ));
     }
-    too_many(
-        &d,
-        picks,
-        picks_given.is_some(),
-        "WEFT",
-        plan_section,
-        "picks",
-    )?;
     let mut lift: Vec<Option<Vec<usize>>> = vec![None; picks];
     for (n, s) in plan {
         lift[n - 1] = Some(s);
@@ -623,22 +710,48 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
         })
         .collect::<Result<_, _>>()?;
 
-    // Drawdown: row j = pick j + 1, column i = end i + 1, true where the warp is over.
-    let over = |i: usize, j: usize| {
-        let raised = threading[i].iter().any(|s| lift[j].contains(s));
-        raised == rising
-    };
+    if ends.saturating_mul(picks) > MAX_DRAFT_CELLS {
+        return Err(d.err(
+            "WARP",
+            d.section("WARP").map(|s| s.line),
+            format!(
+                "the draft has {ends} ends x {picks} picks = {} cells, more than the {MAX_DRAFT_CELLS} clothbake reads",
+                ends * picks
+            ),
+            "give one repeat of the weave (docs/limits.md)",
+        ));
+    }
+    let dd = drawdown(&threading, &lift, rising);
+    let over = |i: usize, j: usize| dd.over(i, j);
 
     let warp = threads(&d, "WARP", ends, "end", opts, "WEFT")?;
     let weft = threads(&d, "WEFT", picks, "pick", opts, "WARP")?;
 
-    // The smallest repeat of pattern and threads.
+    // The smallest repeat of pattern and threads: columns (rows) compared by hash first.
+    let column: Vec<u64> = (0..ends)
+        .map(|i| dd.hash((0..picks).map(|j| over(i, j))))
+        .collect();
     let px = minimal_period(ends, |a, b| {
-        warp[a].key() == warp[b].key() && (0..picks).all(|j| over(a, j) == over(b, j))
+        warp[a].key() == warp[b].key()
+            && column[a] == column[b]
+            && (0..picks).all(|j| over(a, j) == over(b, j))
     });
+    let row: Vec<u64> = (0..picks)
+        .map(|j| dd.hash((0..px).map(|i| over(i, j))))
+        .collect();
     let py = minimal_period(picks, |a, b| {
-        weft[a].key() == weft[b].key() && (0..px).all(|i| over(i, a) == over(i, b))
+        weft[a].key() == weft[b].key()
+            && row[a] == row[b]
+            && (0..px).all(|i| over(i, a) == over(i, b))
     });
+    check_period(px, py).map_err(|(problem, fix)| {
+        d.err(
+            "WARP",
+            d.section("WARP").map(|s| s.line),
+            format!("the draft's repeat is {px} ends x {py} picks: {problem}"),
+            fix,
+        )
+    })?;
     let rows: Vec<Vec<bool>> = (0..py)
         .map(|j| (0..px).map(|i| over(i, j)).collect())
         .collect();
@@ -653,12 +766,17 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
                 .file_stem()
                 .map_or("draft".into(), |s| s.to_string_lossy().into_owned())
         });
-    // Sizes in notes: in the draft's units, or in mm where the options set them.
+    // Sizes in notes: in the group's units where it gives its sizes, in mm where the options
+    // set them or they come from the other group or the defaults.
     let unit = |g: &str| {
         if opts.radius.is_some() || opts.spacing.is_some() {
-            Ok((1.0, "mm, from --radius/--spacing".to_string()))
-        } else {
+            return Ok((1.0, "mm, from --radius/--spacing".to_string()));
+        }
+        let own = group_sizes(&d, g)?;
+        if own.spacing.is_some() || own.thickness.is_some() {
             draft_unit(&d, g)
+        } else {
+            Ok((1.0, "mm".to_string()))
         }
     };
     let (warp, warp_note) = group("WARP", &warp[..px], &unit("WARP")?);
@@ -725,10 +843,7 @@ fn threads(
                 d.err(
                     section,
                     Some(e.line),
-                    format!(
-                        "{}={}: colour {idx} is not in the [COLOR TABLE]",
-                        e.key, e.value
-                    ),
+                    format!("{}: colour {idx} is not in the [COLOR TABLE]", e.shown()),
                     "add the colour to [COLOR TABLE] or use one of its entries",
                 )
             })
@@ -740,7 +855,7 @@ fn threads(
                 d.err(
                     g,
                     Some(e.line),
-                    format!("Color={}: `{}` is not a colour number", e.value, v[0]),
+                    format!("{}: `{}` is not a colour number", e.shown(), clip(v[0])),
                     "give the number of a [COLOR TABLE] entry, e.g. Color=1",
                 )
             })?;
@@ -811,7 +926,7 @@ fn group_sizes(d: &Draft<'_>, g: &str) -> Result<GroupSizes, WifError> {
             d.err(
                 g,
                 Some(e.line),
-                format!("Units={} is not a WIF unit", e.value),
+                format!("{} is not a WIF unit", e.shown()),
                 "write Units=Decipoints, Units=Inches or Units=Centimeters",
             )
         })?,
@@ -845,7 +960,7 @@ fn colours(d: &Draft<'_>) -> Result<Vec<(usize, [f64; 3])>, WifError> {
                     return Err(d.err(
                         "COLOR PALETTE",
                         Some(e.line),
-                        format!("Range={} is not a range low,high with low < high", e.value),
+                        format!("{} is not a range low,high with low < high", e.shown()),
                         "write e.g. Range=0,255",
                     ))
                 }
@@ -858,7 +973,7 @@ fn colours(d: &Draft<'_>) -> Result<Vec<(usize, [f64; 3])>, WifError> {
             return Err(d.err(
                 "COLOR PALETTE",
                 Some(e.line),
-                format!("Form={}: only RGB colours are read", e.value),
+                format!("{}: only RGB colours are read", e.shown()),
                 "give the palette as Form=RGB",
             ));
         }
@@ -875,7 +990,7 @@ fn colours(d: &Draft<'_>) -> Result<Vec<(usize, [f64; 3])>, WifError> {
                 return Err(d.err(
                     "COLOR TABLE",
                     Some(e.line),
-                    format!("{}={} is not three numbers r,g,b", e.key, e.value),
+                    format!("{} is not three numbers r,g,b", e.shown()),
                     format!("write the colour as r,g,b, each from {lo} to {hi}"),
                 ))
             }
@@ -885,8 +1000,8 @@ fn colours(d: &Draft<'_>) -> Result<Vec<(usize, [f64; 3])>, WifError> {
                 "COLOR TABLE",
                 Some(e.line),
                 format!(
-                    "{}={}: a component lies outside the [COLOR PALETTE] range {lo},{hi}",
-                    e.key, e.value
+                    "{}: a component lies outside the [COLOR PALETTE] range {lo},{hi}",
+                    e.shown()
                 ),
                 "fix the colour or the palette's Range",
             ));
@@ -984,35 +1099,6 @@ fn draft_unit(d: &Draft<'_>, g: &str) -> Result<(f64, String), WifError> {
 fn mm(x: f64) -> String {
     let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 12) as usize;
     format!("{x:.digits$}")
-}
-
-/// Refuses `n` threads beyond [`crate::fabric::MAX_THREADS`], naming `[group] Threads` when the
-/// draft gave it, else the numbered section whose largest number set it.
-fn too_many(
-    d: &Draft<'_>,
-    n: usize,
-    given: bool,
-    group: &str,
-    numbered: &str,
-    what: &str,
-) -> Result<(), WifError> {
-    let max = crate::fabric::MAX_THREADS;
-    if n <= max {
-        return Ok(());
-    }
-    let (section, field) = if given {
-        (group, format!("[{group}] Threads"))
-    } else {
-        (numbered, format!("the largest number in [{numbered}]"))
-    };
-    Err(d.err(
-        section,
-        d.section(section).map(|s| s.line),
-        format!(
-            "{field} asks for {n} {what}, more than clothbake weaves (at most {max} in one period)"
-        ),
-        format!("give one repeat of the weave (at most {max} {what})"),
-    ))
 }
 
 #[cfg(test)]
@@ -1212,5 +1298,97 @@ mod tests {
         let (r, _) = packed_radii(&[1.0, 1.0, 0.5], &[1.5, 1.0, 2.0]);
         assert!((r[1] - 1.0 / 1.5).abs() < 1e-15, "{r:?}");
         assert!(r[0] + r[1] <= 1.5 * (1.0 + 1e-15) && r[1] + r[2] <= 1.0 * (1.0 + 1e-15));
+    }
+
+    #[test]
+    fn counts_and_numbers_are_bounded_before_anything_is_allocated() {
+        // Threads of a billion, or more than usize holds: "too large", not "not a whole number".
+        for n in ["1000000000", "99999999999999999999999"] {
+            let e = err(&PLAIN.replace("[WARP]\nThreads=2", &format!("[WARP]\nThreads={n}")));
+            assert_eq!((e.section.as_str(), e.line), ("WARP", Some(7)), "{e}");
+            assert!(
+                e.problem.contains(&format!(
+                    "Threads={n}: the number of warp ends is too large, at most 65536"
+                )),
+                "{e}"
+            );
+        }
+        let e = err(&PLAIN.replace("Threads=2", "Threads=two"));
+        assert!(e.problem.contains("is not a whole number"), "{e}");
+        // A threading line numbered past the limit, with no Threads to bound it.
+        let e = err(&PLAIN
+            .replace("[WARP]\nThreads=2\n", "")
+            .replace("[THREADING]\n1=1", "[THREADING]\n70000=1"));
+        assert_eq!(e.section, "THREADING");
+        assert!(
+            e.problem
+                .contains("the end number is too large, at most 65536"),
+            "{e}"
+        );
+        let e = err(&PLAIN.replace("[TREADLING]\n1=1", "[TREADLING]\n1=123456789012345678901"));
+        assert!(e.problem.contains("a treadle number is too large"), "{e}");
+        // 5000 x 5000 ends and picks: refused before the drawdown is made.
+        let mut body = String::from("[WARP]\nThreads=5000\n[WEFT]\nThreads=5000\n[THREADING]\n");
+        for k in 1..=5000 {
+            body += &format!("{k}={}\n", k % 8 + 1);
+        }
+        body += "[LIFTPLAN]\n";
+        for k in 1..=5000 {
+            body += &format!("{k}={}\n", k % 8 + 1);
+        }
+        let e = err(&body);
+        assert!(
+            e.problem
+                .contains("5000 ends x 5000 picks = 25000000 cells, more than the 16777216"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_repeat_beyond_the_period_limit_is_refused() {
+        // 2048 ends on 2048 shafts, a straight draw, and 1024 picks lifting one shaft each: no
+        // smaller repeat, 2^21 cells.
+        let mut body = String::from("[WARP]\nThreads=2048\n[WEFT]\nThreads=1024\n[THREADING]\n");
+        for e in 1..=2048 {
+            body += &format!("{e}={e}\n");
+        }
+        body += "[LIFTPLAN]\n";
+        for p in 1..=1024 {
+            body += &format!("{p}={p}\n");
+        }
+        let e = err(&body);
+        assert!(
+            e.problem
+                .contains("the draft's repeat is 2048 ends x 1024 picks")
+                && e.problem.contains("2097152 cells, more than the 1048576"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn quoted_text_is_clipped() {
+        let long = "x".repeat(500);
+        let e = err(&PLAIN.replace("[TREADLING]\n1=1", &format!("[TREADLING]\n1={long}")));
+        assert!(
+            e.problem.len() < 200 && !e.problem.contains(&"x".repeat(61)),
+            "{e}"
+        );
+        assert!(e.problem.contains("..."), "{e}");
+    }
+
+    #[test]
+    fn the_drawdown_bits_are_the_weaving_rule() {
+        // End i on shafts threading[i], pick j moving lift[j]: over where raised == rising.
+        let threading = vec![vec![1], vec![2, 3], vec![4]];
+        let lift = vec![vec![1, 4], vec![3], vec![], vec![2]];
+        for rising in [true, false] {
+            let dd = drawdown(&threading, &lift, rising);
+            for (i, t) in threading.iter().enumerate() {
+                for (j, l) in lift.iter().enumerate() {
+                    let raised = t.iter().any(|s| l.contains(s));
+                    assert_eq!(dd.over(i, j), raised == rising, "{i} {j}");
+                }
+            }
+        }
     }
 }

@@ -131,3 +131,150 @@ fn a_period_beyond_the_limits_is_refused_in_one_line() {
         ],
     );
 }
+
+/// `eval --weave PATH` with fixed directions.
+fn eval_path(path: &Path) -> Output {
+    clothbake(&[
+        "eval",
+        "--weave",
+        path.to_str().unwrap(),
+        "--wi",
+        "30,0",
+        "--wo",
+        "30,180",
+    ])
+}
+
+const PLAIN: &str = r#"{"pattern": [[1,0],[0,1]], "warp": {"radius": 1, "spacing": 2.5},
+    "weft": {"radius": 1, "spacing": 2.5}}"#;
+
+/// A WIF header and a 2-end plain weave after `warp`, the body of `[WARP]`.
+fn plain_wif(warp: &str) -> String {
+    format!("[WIF]\nVersion=1.1\n[WARP]\n{warp}\n[THREADING]\n1=1\n2=2\n[LIFTPLAN]\n1=1\n2=2\n")
+}
+
+#[test]
+fn special_and_oversized_files_are_refused_before_reading() {
+    // Each within seconds (no endless read, no blocking open), one line, exit 2.
+    #[cfg(unix)]
+    {
+        fails_with(
+            &eval_path(Path::new("/dev/zero")),
+            2,
+            &[
+                "/dev/zero",
+                "is a device, not a regular file",
+                "give a fabric file",
+            ],
+        );
+        // A draft name that is a device: refused the same way.
+        let link = temp("zero.wif");
+        let _ = std::fs::remove_file(&link);
+        std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
+        fails_with(&eval_path(&link), 2, &["inputs-zero.wif", "a device"]);
+        // A FIFO nobody writes to: opening it would block.
+        let fifo = temp("fifo.json");
+        let _ = std::fs::remove_file(&fifo);
+        let made = Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("run mkfifo");
+        assert!(made.success());
+        fails_with(
+            &eval_path(&fifo),
+            2,
+            &["inputs-fifo.json", "a FIFO (named pipe)"],
+        );
+    }
+    // 2 GB (sparse): refused from its size.
+    let big = temp("big.json");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(2 << 30)
+        .unwrap();
+    fails_with(
+        &eval_path(&big),
+        2,
+        &[
+            "inputs-big.json",
+            "2147483648 bytes, more than the 16 MiB",
+            "docs/limits.md",
+        ],
+    );
+    std::fs::remove_file(&big).unwrap();
+    fails_with(
+        &eval_path(Path::new(env!("CARGO_TARGET_TMPDIR"))),
+        2,
+        &["is a directory, not a fabric file"],
+    );
+}
+
+#[test]
+fn draft_counts_too_large_say_so() {
+    for n in ["1000000000", "99999999999999999999999"] {
+        let p = temp(&format!("threads-{}.wif", n.len()));
+        std::fs::write(&p, plain_wif(&format!("Threads={n}"))).unwrap();
+        fails_with(
+            &eval_path(&p),
+            2,
+            &[
+                &format!("inputs-threads-{}.wif", n.len()),
+                "[WARP] line 4",
+                &format!("Threads={n}: the number of warp ends is too large, at most 65536"),
+                "docs/limits.md",
+            ],
+        );
+    }
+}
+
+#[test]
+fn binary_data_is_not_a_text_draft() {
+    // Bytes of a pseudo-random sequence (SplitMix64): not echoed back.
+    let mut x: u64 = 1;
+    let bytes: Vec<u8> = (0..4096)
+        .map(|_| {
+            x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = x;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            (z ^ (z >> 31)) as u8
+        })
+        .collect();
+    for name in ["noise.wif", "noise.json"] {
+        let p = temp(name);
+        std::fs::write(&p, &bytes).unwrap();
+        let line = fails_with(&eval_path(&p), 2, &[name, "is not a", "control character"]);
+        assert!(line.len() < 250, "{line}");
+    }
+    let line = fails_with(&eval_path(&temp("noise.wif")), 2, &["not a text WIF draft"]);
+    assert!(line.contains("docs/wif.md"), "{line}");
+}
+
+#[test]
+fn a_utf8_byte_order_mark_is_accepted() {
+    for (name, text) in [
+        ("bom.json", format!("\u{feff}{PLAIN}")),
+        ("bom.wif", format!("\u{feff}{}", plain_wif("Threads=2"))),
+    ] {
+        let p = temp(name);
+        std::fs::write(&p, text).unwrap();
+        succeeds(&eval_path(&p));
+    }
+}
+
+#[test]
+fn a_json_top_level_that_is_not_an_object_is_named() {
+    for (name, text, what) in [
+        ("array.json", "[1, 2]", "is a JSON array"),
+        ("string.json", "\"twill\"", "is a JSON string"),
+        ("empty.json", "  \n", "is empty"),
+    ] {
+        let p = temp(name);
+        std::fs::write(&p, text).unwrap();
+        fails_with(
+            &eval_path(&p),
+            2,
+            &[name, what, "expected an object", "docs/fabric-format.md"],
+        );
+    }
+}
