@@ -8,7 +8,7 @@ use std::process::{Command, Output, Stdio};
 
 mod common;
 
-use common::{fabric, listing, succeeds, text};
+use common::{cmd, fabric, listing, run_in, succeeds, text};
 
 fn fails_with(out: &Output, needles: &[&str]) -> String {
     common::fails_with(out, 2, needles)
@@ -16,21 +16,6 @@ fn fails_with(out: &Output, needles: &[&str]) -> String {
 
 fn fresh_dir(name: &str) -> PathBuf {
     common::fresh_dir("limits-cli", name)
-}
-
-fn cmd(dir: &Path, args: &[&str]) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_clothbake"));
-    c.args(args)
-        .current_dir(dir)
-        .env_remove("SLURM_ARRAY_TASK_ID")
-        .env_remove("JOB_COMPLETION_INDEX")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    c
-}
-
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    cmd(dir, args).output().expect("run the clothbake binary")
 }
 
 const RES: &str = "2,4,2,4";

@@ -1,12 +1,12 @@
 //! Shards, merge, checkpoint and resume, driving the built binary as separate processes.
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Output};
 use std::time::{Duration, Instant};
 
 mod common;
 
-use common::{fabric, listing, succeeds, text};
+use common::{cmd, fabric, listing, run_in, succeeds, text};
 
 /// Exit status 2, one line `clothbake: ...` on stderr containing every needle.
 fn fails_with(out: &Output, needles: &[&str]) -> String {
@@ -15,21 +15,6 @@ fn fails_with(out: &Output, needles: &[&str]) -> String {
 
 fn fresh_dir(name: &str) -> PathBuf {
     common::fresh_dir("shards", name)
-}
-
-fn cmd(dir: &Path, args: &[&str]) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_clothbake"));
-    c.args(args)
-        .current_dir(dir)
-        .env_remove("SLURM_ARRAY_TASK_ID")
-        .env_remove("JOB_COMPLETION_INDEX")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    c
-}
-
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    cmd(dir, args).output().expect("run the clothbake binary")
 }
 
 /// `clothbake diff A B --tol 0 --abs 0`: exit 0 and no value differs.

@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::process::Output;
+use std::process::{Command, Output, Stdio};
 
 /// The absolute path of the shipped fabric `tables/<name>.json`.
 pub fn fabric(name: &str) -> String {
@@ -65,4 +65,22 @@ pub fn listing(dir: &Path) -> Vec<String> {
         .collect();
     v.sort();
     v
+}
+
+/// The `clothbake` binary run in `dir` with `args`, outside any SLURM or Kubernetes array job,
+/// its output captured.
+pub fn cmd(dir: &Path, args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_clothbake"));
+    c.args(args)
+        .current_dir(dir)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("JOB_COMPLETION_INDEX")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    c
+}
+
+/// Runs [`cmd`] to its end.
+pub fn run_in(dir: &Path, args: &[&str]) -> Output {
+    cmd(dir, args).output().expect("run the clothbake binary")
 }
