@@ -771,8 +771,7 @@ impl AnalyticModel {
             return empty;
         };
         let s_v = t.l_v * t.width;
-        let (px, py) = self.grid.period();
-        let coverage = s_v / (self.grid.area_fraction(cell) * px * py * wo.cos_theta());
+        let coverage = self.cell_coverage(cell, s_v, wo);
         let (i_d, i_s) = match t.lit {
             Some((l_vi, kd, ks)) => {
                 let w = l_vi * u.seg.radius / s_v;
@@ -792,6 +791,23 @@ impl AnalyticModel {
             },
             coverage,
         }
+    }
+
+    /// c(x; wo) of a cell whose unit shows visible projected area `s_v`.
+    fn cell_coverage(&self, cell: Cell, s_v: f64, wo: UnitVec3) -> f64 {
+        let (px, py) = self.grid.period();
+        s_v / (self.grid.area_fraction(cell) * px * py * wo.cos_theta())
+    }
+
+    /// The coverage c(x; wo) of a cell alone, as [`AnalyticModel::intensity_in`] reports it,
+    /// without the facet terms (0 below the horizon).
+    pub fn coverage_in(&self, cell: Cell, wo: UnitVec3) -> f64 {
+        if !wo.above_horizon() {
+            return 0.0;
+        }
+        let (unit, _) = self.cell_units[self.grid.index(cell)];
+        self.visible(&self.units[unit as usize], wo.get())
+            .map_or(0.0, |v| self.cell_coverage(cell, v.l_v * v.width, wo))
     }
 
     /// The directional coverage C(wo): the period mean of the coverage, the visible yarn's

@@ -141,13 +141,7 @@ impl Bsdf for AnalyticBsdf {
         let total: f64 = cells.iter().map(|c| c.1).sum();
         cells
             .iter()
-            .map(|&(cell, share)| {
-                share
-                    * self
-                        .model
-                        .intensity_in(UnitVec3::Z, wo, cell, None)
-                        .coverage
-            })
+            .map(|&(cell, share)| share * self.model.coverage_in(cell, wo))
             .sum::<f64>()
             / total
     }

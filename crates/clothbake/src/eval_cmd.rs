@@ -56,33 +56,26 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
         Method::Analytic => {
             let model = AnalyticModel::with_variant(&fabric, facet, args.model.variant.into());
             let coverage = if horizon { 0.0 } else { model.coverage(wo) };
+            // With --at, the cell's reflection and coverage from one evaluation.
+            let at = args.at.map(|p| (p, model.cells().cell_at(p)));
+            let spot = at
+                .filter(|_| !horizon)
+                .map(|(p, _)| model.intensity_at(wi, wo, p, secondary.as_ref()));
             let r = if horizon {
                 Reflection {
                     secondary: secondary.map(|_| Secondary::default()),
                     ..Reflection::default()
                 }
-            } else if let Some(at) = args.at {
-                model
-                    .intensity_at(wi, wo, at, secondary.as_ref())
-                    .reflection
+            } else if let Some(l) = &spot {
+                l.reflection
             } else {
                 model.intensity_with(wi, wo, secondary.as_ref())
             };
             local = Some(report::Local {
                 directional_coverage: coverage,
-                warp_on_top: args.at.is_some_and(|at| {
-                    let cell = model.cells().cell_at(at);
-                    fabric.weave().warp_over(cell.warp, cell.weft)
-                }),
-                at: args.at.map(|at| {
-                    let cell = model.cells().cell_at(at);
-                    let c = if horizon {
-                        0.0
-                    } else {
-                        model.intensity_at(wi, wo, at, None).coverage
-                    };
-                    (at, cell, c)
-                }),
+                warp_on_top: at
+                    .is_some_and(|(_, cell)| fabric.weave().warp_over(cell.warp, cell.weft)),
+                at: at.map(|(p, cell)| (p, cell, spot.map_or(0.0, |l| l.coverage))),
             });
             (r, None)
         }
