@@ -396,7 +396,11 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
         Err(e) => return Err(bake_error(e)),
     }
     let done = ck.into_rows();
-    let evaluated: usize = done.keys().map(|&r| orbits.row_evaluations(r)).sum();
+    let evaluated: usize = done
+        .keys()
+        .map(|&r| orbits.row_evaluations(r))
+        .sum::<usize>()
+        / orbits.stride();
     let g = job.options.grid;
     let table = match &job.target {
         Target::Shard { path, id } => {

@@ -24,6 +24,7 @@ pub mod merge;
 pub mod output;
 pub mod settings;
 pub mod shard;
+pub mod spatial;
 pub mod sweep;
 
 pub use sweep::*;

@@ -18,6 +18,17 @@ pub fn orbits_of(meta: &Metadata) -> Result<Orbits, String> {
     let fabric = Fabric::from_json_str(&meta.fabric_json, "the stored fabric")
         .map_err(|e| format!("its fabric cannot be read: {e}"))?;
     meta.grid.validate().map_err(|e| e.to_string())?;
+    if let Some(l) = &meta.spatial {
+        // A spatial bake uses no symmetry (`Orbits::spatial`).
+        l.validate(&meta.grid).map_err(|e| e.to_string())?;
+        if meta.symmetry != "none" {
+            return Err(format!(
+                "it is a spatial bake, which uses no symmetry, but names symmetry \"{}\"",
+                meta.symmetry
+            ));
+        }
+        return Ok(Orbits::spatial(&meta.grid, l.classes as usize));
+    }
     let syms = usable_symmetries(&fabric, &meta.grid);
     if symmetry_name(&syms) != meta.symmetry {
         return Err(format!(

@@ -120,6 +120,8 @@ pub struct Settings {
     pub caps: Option<Caps>,
     /// The secondary-reflection settings.
     pub bounces: Bounces,
+    /// A spatially varying table (docs/spatial.md).
+    pub spatial: bool,
 }
 
 /// The bounces and the secondary reflection's settings as given.
@@ -249,6 +251,16 @@ impl Settings {
                 n.word("secondary", "raytrace")
             ));
         }
+        if self.spatial && (self.raytrace || self.bounces.bounces != 1) {
+            return Err(format!(
+                "{} tabulates the analytic model's direct reflection; drop {} or use {} and {} \
+                 (spatial tables with inter-reflection or from the ray tracer are not built yet)",
+                f("spatial"),
+                f("spatial"),
+                n.word("method", "analytic"),
+                n.number("bounces", "1")
+            ));
+        }
         let method = if self.raytrace {
             Method::Raytrace {
                 samples: self.samples.unwrap_or(DEFAULT_SAMPLES),
@@ -266,6 +278,7 @@ impl Settings {
             method,
             bounces: self.bounces.bounces,
             secondary,
+            spatial: self.spatial,
         };
         check_options(&options).map_err(|e| e.to_string())?;
         Ok(options)

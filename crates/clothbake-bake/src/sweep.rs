@@ -13,9 +13,10 @@
 use clothbake_core::interreflection::{Orders, Ranges, Sampling};
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{
-    AnalyticBsdf, AnalyticModel, Bsdf, Caps, Fabric, FacetModel, Kernel, RayTracer,
+    AnalyticBsdf, AnalyticModel, Bsdf, Caps, ClassTerms, Fabric, FacetModel, Kernel, RayTracer,
     SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
 };
+use clothbake_loader::spatial::value_index;
 use clothbake_loader::{Grid, Metadata, Table, FORMAT_VERSION};
 use rayon::prelude::*;
 use serde_json::{json, Value};
@@ -63,6 +64,9 @@ pub struct BakeOptions {
     pub bounces: u32,
     /// How I_2 is computed; used only when `bounces == 2`.
     pub secondary: SecondaryOptions,
+    /// A spatially varying table (docs/spatial.md): the classes of the period's cells beside
+    /// the average. Analytic model, one bounce.
+    pub spatial: bool,
 }
 
 impl Default for BakeOptions {
@@ -75,6 +79,7 @@ impl Default for BakeOptions {
             },
             bounces: 1,
             secondary: SecondaryOptions::default(),
+            spatial: false,
         }
     }
 }
@@ -152,6 +157,9 @@ impl BakeOptions {
             };
             sec["kernel"] = json!(kernel_name(s.kernel));
             v["secondary"] = sec;
+        }
+        if self.spatial {
+            v["spatial"] = json!(true);
         }
         v
     }
@@ -240,6 +248,14 @@ pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
     opts.grid
         .validate()
         .map_err(|e| BakeError::Invalid(e.to_string()))?;
+    if opts.spatial && (opts.bounces != 1 || !matches!(opts.method, Method::Analytic { .. })) {
+        return Err(BakeError::Invalid(
+            "--spatial bakes the analytic model's direct reflection; give --bounces 1 and \
+             --method analytic with --spatial (spatial tables with inter-reflection are not \
+             built yet)"
+                .into(),
+        ));
+    }
     match (opts.bounces, opts.method) {
         (1, _) | (2, Method::Analytic { .. }) => Ok(()),
         (2, Method::Raytrace { .. }) => Err(BakeError::Invalid(
@@ -278,6 +294,10 @@ pub struct Orbits {
     reps: Vec<(usize, usize)>,
     /// Canonical phi_o cells per phi_i cell.
     per_phi_i: Vec<usize>,
+    /// Row entries per evaluated cell: 1, or a spatial bake's [`crate::spatial::stride`].
+    stride: usize,
+    /// A spatial bake's classes (0 otherwise).
+    classes: usize,
 }
 
 impl Orbits {
@@ -299,7 +319,24 @@ impl Orbits {
             grid: *g,
             reps,
             per_phi_i,
+            stride: 1,
+            classes: 0,
         }
+    }
+
+    /// The orbits of a spatial bake of `classes` classes: no symmetry (it would map cells of
+    /// the period onto others), [`crate::spatial::stride`] row entries per cell.
+    pub fn spatial(g: &Grid, classes: usize) -> Orbits {
+        Orbits {
+            stride: crate::spatial::stride(classes),
+            classes,
+            ..Orbits::new(g, &[])
+        }
+    }
+
+    /// Row entries per evaluated cell.
+    pub fn stride(&self) -> usize {
+        self.stride
     }
 
     /// The grid.
@@ -321,10 +358,10 @@ impl Orbits {
         self.rep(pi, po) == (pi, po)
     }
 
-    /// Cells evaluated in `row` (the length of its [`Row`]).
+    /// Entries of `row`'s [`Row`]: the cells it evaluates times [`Orbits::stride`].
     pub fn row_evaluations(&self, row: usize) -> usize {
         let (_, pi) = row_cell(&self.grid, row);
-        self.per_phi_i[pi as usize] * self.grid.n_theta_o as usize
+        self.per_phi_i[pi as usize] * self.grid.n_theta_o as usize * self.stride
     }
 
     /// The cell `(ti, pi, to, po)` of value `k` of `row`'s [`Row`] (its `k`-th canonical
@@ -336,12 +373,13 @@ impl Orbits {
             .filter(|&po| self.canonical(pi as usize, po as usize))
             .collect();
         let per_to = canon.len().max(1);
+        let k = k / self.stride;
         let to = u32::try_from(k / per_to).ok()?;
         let po = *canon.get(k % per_to)?;
         (to < self.grid.n_theta_o).then_some((ti, pi, to, po))
     }
 
-    /// Cells evaluated in the whole grid.
+    /// Row entries of the whole grid (the cells evaluated times [`Orbits::stride`]).
     pub fn evaluations(&self) -> usize {
         (0..self.rows()).map(|r| self.row_evaluations(r)).sum()
     }
@@ -353,16 +391,24 @@ impl Orbits {
         let g = self.grid;
         let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
         assert_eq!(rows.len(), self.rows(), "one Row per grid row");
-        let mut values = vec![f32::NAN; g.len() * 3];
+        let n = g.len();
+        // A spatial table's classes: 2 K values per cell after the averaged RGB (the cell's last
+        // row entry may end in padding).
+        let class_values = 2 * self.classes;
+        let mut values = vec![f32::NAN; n * 3 + n * class_values];
         for (row, vals) in rows.iter().enumerate() {
             assert_eq!(vals.len(), self.row_evaluations(row), "row {row}'s length");
             let (ti, pi) = row_cell(&g, row);
-            let mut it = vals.iter();
+            let mut it = vals.chunks_exact(self.stride);
             for to in 0..nto {
                 for po in 0..npo {
                     if self.canonical(pi as usize, po as usize) {
-                        let v = it.next().expect("one value per canonical cell");
-                        values[3 * g.index(ti, pi, to, po)..][..3].copy_from_slice(v);
+                        let v = it.next().expect("one entry per canonical cell");
+                        let c = g.index(ti, pi, to, po);
+                        values[3 * c..][..3].copy_from_slice(&v[0]);
+                        for (m, x) in v[1..].iter().flatten().take(class_values).enumerate() {
+                            values[value_index(3 + m, c, n)] = *x;
+                        }
                     }
                 }
             }
@@ -400,7 +446,8 @@ pub fn tool_name() -> String {
     format!("clothbake {}", env!("CARGO_PKG_VERSION"))
 }
 
-type CellFn = Box<dyn Fn(usize, UnitVec3, UnitVec3) -> [f64; 3] + Sync + Send>;
+/// Appends a cell's row entries (see [`Orbits::stride`]) for cell index, wi, wo.
+type CellFn = Box<dyn Fn(usize, UnitVec3, UnitVec3, &mut Row) + Sync + Send>;
 
 /// A prepared bake: the cell evaluator, the orbits and the metadata of the table it makes.
 /// Rows are evaluated independently ([`Baker::eval_row`]), by one process ([`bake`]) or by
@@ -417,13 +464,27 @@ impl Baker {
     pub fn new(fabric: &Fabric, opts: &BakeOptions) -> Result<Baker, BakeError> {
         check_options(opts)?;
         let g = opts.grid;
-        let syms = usable_symmetries(fabric, &g);
+        let mut syms = usable_symmetries(fabric, &g);
         let secondary = (opts.bounces == 2).then_some(opts.secondary);
+        let mut spatial = None;
         let eval: CellFn = match opts.method {
+            Method::Analytic { variant } if opts.spatial => {
+                let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
+                let layout = crate::spatial::layout(&m, &g).map_err(BakeError::Invalid)?;
+                syms.clear();
+                let classes = m.classes();
+                spatial = Some(layout);
+                let bsdf = AnalyticBsdf::new(m, None);
+                Box::new(move |_, wi, wo, out| {
+                    out.push(bsdf.f(wi, wo).map(|x| x as f32));
+                    let mut terms = vec![ClassTerms::default(); classes];
+                    crate::spatial::class_values(bsdf.model(), wi, wo, &mut terms, out);
+                })
+            }
             Method::Analytic { variant } => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
                 let bsdf = AnalyticBsdf::new(m, secondary);
-                Box::new(move |_, wi, wo| bsdf.f(wi, wo))
+                Box::new(move |_, wi, wo, out| out.push(bsdf.f(wi, wo).map(|x| x as f32)))
             }
             Method::Raytrace {
                 samples,
@@ -431,10 +492,12 @@ impl Baker {
                 caps,
             } => {
                 let rt = RayTracer::new(fabric, opts.facet).with_caps(caps);
-                Box::new(move |c, wi, wo| {
-                    rt.render(wi, wo, samples, seed.wrapping_add(c as u64))
+                Box::new(move |c, wi, wo, out| {
+                    let f = rt
+                        .render(wi, wo, samples, seed.wrapping_add(c as u64))
                         .reflection
-                        .brdf(wi)
+                        .brdf(wi);
+                    out.push(f.map(|x| x as f32));
                 })
             }
         };
@@ -448,9 +511,15 @@ impl Baker {
             fabric_json: fabric.to_json().to_string(),
             options_json: opts.to_json().to_string(),
             symmetry: symmetry_name(&syms),
+            spatial: None,
         };
+        let orbits = match &spatial {
+            Some(l) => Orbits::spatial(&g, l.classes as usize),
+            None => Orbits::new(&g, &syms),
+        };
+        let meta = Metadata { spatial, ..meta };
         Ok(Baker {
-            orbits: Orbits::new(&g, &syms),
+            orbits,
             syms,
             eval,
             meta,
@@ -490,8 +559,7 @@ impl Baker {
                     continue;
                 }
                 let c = g.index(ti, pi, to, po);
-                let v = (self.eval)(c, wi, direction(to, nto, po, npo));
-                out.push(v.map(|x| x as f32));
+                (self.eval)(c, wi, direction(to, nto, po, npo), &mut out);
             }
         }
         Some(out)

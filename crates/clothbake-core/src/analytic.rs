@@ -26,7 +26,7 @@ use crate::interreflection::{
     Secondary, Setting,
 };
 use crate::quad::integrate;
-use crate::reflect::Reflection;
+use crate::reflect::{intensity_to_brdf, Reflection};
 use crate::shadowing::{
     mean_occluded_length, occluded_arc, occluded_length, ActiveTable, ArcOcclusion, Occluder,
 };
@@ -168,6 +168,24 @@ pub struct AnalyticModel {
     grid: CellGrid,
     /// The unit each cell shows and the unit's neighbour pair there, by [`CellGrid::index`].
     cell_units: Vec<(u32, u32)>,
+    /// The class of each unit: units that differ in their threads' diffuse albedos only.
+    unit_class: Vec<u32>,
+    /// A unit of each class.
+    class_unit: Vec<u32>,
+}
+
+/// A class's direct reflection for one pair of directions, per unit diffuse albedo
+/// (docs/spatial.md): a cell of the class whose thread has albedo rho_d reflects
+/// f_r = rho_d `diffuse` + `specular` (eqs 4.1, 4.11 restricted to the cell's piece).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ClassTerms {
+    /// f_r of the diffuse term with rho_d = 1, in 1/sr.
+    pub diffuse: f64,
+    /// f_r of the specular term, in 1/sr.
+    pub specular: f64,
+    /// The piece's visible projected area seen from `wo` over the period's projected area:
+    /// a cell's coverage is this over the cell's share of the period's area.
+    pub visible: f64,
 }
 
 /// What the model answers at one point of the weave period (docs/spatial.md).
@@ -421,6 +439,10 @@ impl AnalyticModel {
         let mut cell_units = vec![(u32::MAX, 0); nx * ny];
         let mut units: Vec<Unit> = Vec::new();
         let mut index = UnitIndex::new(KEY_TOLERANCE);
+        // Classes: the unit keys without the diffuse albedos.
+        let mut classes = UnitIndex::new(KEY_TOLERANCE);
+        let mut unit_class: Vec<u32> = Vec::new();
+        let mut class_unit: Vec<u32> = Vec::new();
         // Neighbour pairs of each unit: keys [unit, neighbours...] -> (unit, its variant).
         let mut pairs = UnitIndex::new(KEY_TOLERANCE);
         let mut pair_at: Vec<(usize, usize)> = Vec::new();
@@ -527,12 +549,7 @@ impl AnalyticModel {
                     (hi - origin) / unit_len,
                 ];
                 let mat = data.material;
-                key.extend(mat.albedo);
                 key.extend([mat.specular, mat.exponent]);
-                // Per-thread colours: the neighbours' albedos enter the secondary reflection.
-                for nb in &nbs {
-                    key.extend(nb.map_or([-1.0; 3], |n| n.material.albedo));
-                }
                 for t in [
                     &unit.side_plus,
                     &unit.side_minus,
@@ -541,11 +558,25 @@ impl AnalyticModel {
                 ] {
                     table_key(t, unit_len, &mut key);
                 }
+                let class_key = key.clone();
+                key.extend(mat.albedo);
+                // Per-thread colours: the neighbours' albedos enter the secondary reflection.
+                for nb in &nbs {
+                    key.extend(nb.map_or([-1.0; 3], |n| n.material.albedo));
+                }
                 let Some(i) = merge.then(|| index.find_or_insert(key)).flatten() else {
                     if merge {
                         pairs.find_or_insert(neighbour_key(units.len(), &nbs, unit_len));
                         pair_at.push((units.len(), 0));
                     }
+                    let class = match merge.then(|| classes.find_or_insert(class_key)).flatten() {
+                        Some(c) => c as u32,
+                        None => {
+                            class_unit.push(units.len() as u32);
+                            class_unit.len() as u32 - 1
+                        }
+                    };
+                    unit_class.push(class);
                     cell_units[grid.index(grid.crossing(g, seg.thread, k))] =
                         (units.len() as u32, 0);
                     units.push(unit);
@@ -574,6 +605,8 @@ impl AnalyticModel {
             units,
             grid,
             cell_units,
+            unit_class,
+            class_unit,
         }
     }
 
@@ -797,6 +830,50 @@ impl AnalyticModel {
     fn cell_coverage(&self, cell: Cell, s_v: f64, wo: UnitVec3) -> f64 {
         let (px, py) = self.grid.period();
         s_v / (self.grid.area_fraction(cell) * px * py * wo.cos_theta())
+    }
+
+    /// Number of classes of the period's units (see [`ClassTerms`]).
+    pub fn classes(&self) -> usize {
+        self.class_unit.len()
+    }
+
+    /// The class of the unit each cell shows and that unit's thread's diffuse albedo, by
+    /// [`CellGrid::index`].
+    pub fn cell_classes(&self) -> Vec<(u32, [f64; 3])> {
+        self.cell_units
+            .iter()
+            .map(|&(u, _)| {
+                let unit = &self.units[u as usize];
+                (self.unit_class[u as usize], unit.seg.material.albedo)
+            })
+            .collect()
+    }
+
+    /// Each class's direct reflection for light from `wi` seen from `wo`, written to `out`
+    /// (one entry per class; zero below the horizon). For every cell, rho_d `diffuse` +
+    /// `specular` is the f_r of [`AnalyticModel::intensity_in`] without secondary reflection,
+    /// and `visible` over the cell's area share its coverage.
+    pub fn class_terms(&self, wi: UnitVec3, wo: UnitVec3, out: &mut [ClassTerms]) {
+        assert_eq!(out.len(), self.classes(), "one entry per class");
+        for (o, &u) in out.iter_mut().zip(&self.class_unit) {
+            *o = ClassTerms::default();
+            if !(wi.above_horizon() && wo.above_horizon()) {
+                continue;
+            }
+            let u = &self.units[u as usize];
+            let Some(t) = self.unit_terms(u, &[], wi, wo, None) else {
+                continue;
+            };
+            let s_v = t.l_v * t.width;
+            let (px, py) = self.grid.period();
+            o.visible = s_v / (px * py * wo.cos_theta());
+            if let Some((l_vi, kd, ks)) = t.lit {
+                let w = l_vi * u.seg.radius / s_v;
+                let [d, s, _] = intensity_to_brdf([w * kd, w * ks, 0.0], wi);
+                o.diffuse = d;
+                o.specular = s;
+            }
+        }
     }
 
     /// The coverage c(x; wo) of a cell alone, as [`AnalyticModel::intensity_in`] reports it,

@@ -129,6 +129,13 @@ impl CellGrid {
         (self.x.period, self.y.period)
     }
 
+    /// The cell edges in fractions of the period: along u (warp columns, `nx + 1` values) and
+    /// along v (weft rows, `ny + 1`), increasing, the last one more than the first by 1.
+    pub fn edge_fractions(&self) -> (Vec<f64>, Vec<f64>) {
+        let f = |e: &Edges| e.edges.iter().map(|x| x / e.period).collect();
+        (f(&self.x), f(&self.y))
+    }
+
     /// Row-major index (weft row, then warp column) of a cell.
     pub fn index(&self, c: Cell) -> usize {
         c.weft * self.dims().0 + c.warp

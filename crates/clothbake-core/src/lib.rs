@@ -30,7 +30,9 @@ pub mod weave;
 pub mod wif;
 pub mod yarn;
 
-pub use analytic::{AnalyticModel, LocalReflection, SecondaryMethod, SecondaryOptions, Variant};
+pub use analytic::{
+    AnalyticModel, ClassTerms, LocalReflection, SecondaryMethod, SecondaryOptions, Variant,
+};
 pub use brdf::{AnalyticBsdf, Component};
 pub use cells::{Cell, CellGrid, PeriodPoint};
 pub use clothbake_bsdf::{vec3, Bsdf, BsdfSample, Footprint, FromFn, Rgb};

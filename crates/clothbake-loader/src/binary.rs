@@ -137,7 +137,8 @@ mod legacy {
         let meta: Metadata = bincode_options()
             .with_limit(header_len)
             .reject_trailing_bytes()
-            .deserialize(&header)
+            .deserialize::<HeaderV1>(&header)
+            .map(HeaderV1::into_metadata)
             .map_err(|e| TableError::Corrupted {
                 path: path.to_path_buf(),
                 reason: format!(
@@ -154,6 +155,37 @@ mod legacy {
             });
         }
         Table::new(meta, values).map_err(|e| e.in_file(path))
+    }
+
+    /// The metadata of a version-1 header: [`Metadata`]'s fields of that version, in order.
+    #[derive(serde::Deserialize)]
+    struct HeaderV1 {
+        format_version: u32,
+        tool: String,
+        grid: crate::table::Grid,
+        centring: String,
+        quantity: String,
+        units: String,
+        fabric_json: String,
+        options_json: String,
+        symmetry: String,
+    }
+
+    impl HeaderV1 {
+        fn into_metadata(self) -> Metadata {
+            Metadata {
+                format_version: self.format_version,
+                tool: self.tool,
+                grid: self.grid,
+                centring: self.centring,
+                quantity: self.quantity,
+                units: self.units,
+                fabric_json: self.fabric_json,
+                options_json: self.options_json,
+                symmetry: self.symmetry,
+                spatial: None,
+            }
+        }
     }
 
     /// The fields of a version-1 header, in order: `(name, false)` for a u32, `(name, true)`

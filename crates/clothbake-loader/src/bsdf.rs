@@ -3,7 +3,7 @@
 //! table was opened without sampling). Directions are rounded to f32 as the lookup takes them.
 
 use crate::lookup::Brdf;
-use clothbake_bsdf::{Bsdf, BsdfSample, Rgb, UnitVec3, Vec3};
+use clothbake_bsdf::{Bsdf, BsdfSample, Footprint, Rgb, UnitVec3, Vec3};
 
 fn f32s(u: UnitVec3) -> [f32; 3] {
     [u.x as f32, u.y as f32, u.z as f32]
@@ -12,6 +12,15 @@ fn f32s(u: UnitVec3) -> [f32; 3] {
 impl Bsdf for Brdf {
     fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb {
         self.eval(f32s(wi), f32s(wo)).map(f64::from)
+    }
+
+    fn f_at(&self, at: Footprint, wi: UnitVec3, wo: UnitVec3) -> Rgb {
+        self.eval_at(f32s(wi), f32s(wo), at.u, at.v, at.width)
+            .map(f64::from)
+    }
+
+    fn coverage_at(&self, at: Footprint, wo: UnitVec3) -> f64 {
+        f64::from(Brdf::coverage_at(self, f32s(wo), at.u, at.v, at.width))
     }
 
     fn sample(&self, wo: UnitVec3, u: [f64; 2]) -> Option<BsdfSample> {

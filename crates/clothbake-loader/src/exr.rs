@@ -8,6 +8,7 @@ use std::path::Path;
 use crate::atomic::write_atomic_as;
 use crate::bytes::{hex, CHUNK_VALUES};
 use crate::error::TableError;
+use crate::spatial::{channel_names, value_index};
 use crate::stored::{Samples, StoredTable};
 use crate::table::{check_format_version, Grid, Metadata, Precision, Table, FORMAT_VERSION};
 
@@ -64,8 +65,17 @@ pub fn directions_text(g: &Grid) -> String {
 
 /// What the channels hold, in words.
 pub fn values_text(meta: &Metadata) -> String {
+    let classes = match &meta.spatial {
+        Some(s) => format!(
+            "; class<k>.diffuse, class<k>.specular (k < {}): each class's f_r at unit diffuse \
+             albedo and its specular f_r, for the weave period's cells (clothbake.metadata's \
+             \"spatial\" gives each cell's class and albedo)",
+            s.classes
+        ),
+        None => String::new(),
+    };
     format!(
-        "R, G, B: {} in {} at each cell centre (the BRDF, f_r = I / (pi cos theta_i)); the \
+        "R, G, B: {} in {} at each cell centre (the BRDF, f_r = I / (pi cos theta_i)){classes}; the \
          metadata and the bake's fabric and options are in clothbake.metadata",
         meta.quantity, meta.units
     )
@@ -183,21 +193,24 @@ mod exr_io {
         }
         let (width, height) = (width as usize, height as usize);
 
-        // Channel k, row-major over the 2-D layout.
-        let plane = |k: usize| -> Vec<f32> {
+        let names = channel_names(table.meta.spatial.as_ref().map_or(0, |s| s.classes));
+        let n = grid.len();
+        // Channel ch, row-major over the 2-D layout.
+        let plane = |ch: usize| -> Vec<f32> {
             let mut out = Vec::with_capacity(width * height);
             for ti in 0..grid.n_theta_i {
                 for to in 0..grid.n_theta_o {
                     for pi in 0..grid.n_phi_i {
                         for po in 0..grid.n_phi_o {
-                            out.push(table.values[3 * grid.index(ti, pi, to, po) + k]);
+                            let c = grid.index(ti, pi, to, po);
+                            out.push(table.values[value_index(ch, c, n)]);
                         }
                     }
                 }
             }
             out
         };
-        let planes = [plane(0), plane(1), plane(2)];
+        let planes: Vec<Vec<f32>> = (0..names.len()).map(plane).collect();
         if precision == Precision::F16 {
             let max = half::f16::MAX.to_f32();
             if let Some(v) = table.values.iter().find(|v| v.abs() > max) {
@@ -213,24 +226,20 @@ mod exr_io {
             }
         };
         let meta_json = table.meta.to_ascii_json();
-        let kept = [stored(&planes[0]), stored(&planes[1]), stored(&planes[2])];
+        let kept: Vec<Vec<f32>> = planes.iter().map(|p| stored(p)).collect();
         let crc = planes_crc(
             meta_json.as_bytes(),
-            &[
-                Plane::F32(&kept[0]),
-                Plane::F32(&kept[1]),
-                Plane::F32(&kept[2]),
-            ],
+            &kept.iter().map(|p| Plane::F32(p)).collect::<Vec<_>>(),
         );
         let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
-        for (name, p) in ["R", "G", "B"].into_iter().zip(planes) {
+        for (name, p) in names.iter().zip(planes) {
             let samples = match precision {
                 Precision::F32 => FlatSamples::F32(p),
                 Precision::F16 => {
                     FlatSamples::F16(p.into_iter().map(half::f16::from_f32).collect())
                 }
             };
-            channels.push(AnyChannel::new(name, samples));
+            channels.push(AnyChannel::new(name.as_str(), samples));
         }
 
         let mut attributes = LayerAttributes {
@@ -445,16 +454,24 @@ mod exr_io {
                     grid.exr_height()
                 )));
             }
-            let names: Vec<String> = header
+            let expected = channel_names(meta.spatial.as_ref().map_or(0, |s| s.classes));
+            let mut names: Vec<String> = header
                 .channels
                 .list
                 .iter()
                 .map(|c| String::from_utf8_lossy(c.name.bytes()).into_owned())
                 .collect();
-            if names != ["B", "G", "R"] {
-                return Err(foreign(format!(
-                    "the EXR has channels {names:?}, but a table has exactly R, G and B"
-                )));
+            names.sort();
+            let mut sorted = expected.clone();
+            sorted.sort();
+            if names != sorted {
+                return Err(foreign(if meta.spatial.is_some() {
+                    format!(
+                        "the EXR has channels {names:?}, but this spatial table has exactly R, G, B and each class's diffuse and specular"
+                    )
+                } else {
+                    format!("the EXR has channels {names:?}, but a table has exactly R, G and B")
+                }));
             }
 
             let image = exr::prelude::read()
@@ -471,13 +488,11 @@ mod exr_io {
                 .first()
                 .ok_or_else(|| corrupted("the EXR has no layer".to_string()))?;
             let (width, height) = (grid.exr_width() as usize, grid.exr_height() as usize);
-            let mut planes: [Option<Plane<'_>>; 3] = Default::default();
+            let mut planes: Vec<Option<Plane<'_>>> = (0..expected.len()).map(|_| None).collect();
             for channel in &layer.channel_data.list {
-                let k = match channel.name.bytes() {
-                    b"R" => 0,
-                    b"G" => 1,
-                    b"B" => 2,
-                    _ => continue,
+                let name = String::from_utf8_lossy(channel.name.bytes());
+                let Some(k) = expected.iter().position(|e| *e == name) else {
+                    continue;
                 };
                 let plane = match &channel.sample_data {
                     FlatSamples::F16(v) => Plane::F16(v),
@@ -497,12 +512,12 @@ mod exr_io {
                 }
                 planes[k] = Some(plane);
             }
-            let [Some(r), Some(g), Some(b)] = planes else {
-                return Err(foreign(
-                    "the EXR lacks one of the channels R, G and B".to_string(),
-                ));
+            let Some(planes) = planes.into_iter().collect::<Option<Vec<Plane<'_>>>>() else {
+                return Err(foreign(format!(
+                    "the EXR lacks one of the channels {}",
+                    expected.join(", ")
+                )));
             };
-            let planes = [r, g, b];
             if let Some(stored) = attrs.get(&Text::from(ATTR_CRC32)).and_then(attribute_text) {
                 let computed = planes_crc(&meta_json_bytes, &planes);
                 if u32::from_str_radix(stored.trim(), 16).ok() != Some(computed) {
@@ -526,15 +541,26 @@ mod exr_io {
                     })
                 })
             };
-            let samples = match &planes {
-                [Plane::F16(r), Plane::F16(g), Plane::F16(b)] => {
-                    Samples::F16(pixels().flat_map(|x| [r[x], g[x], b[x]]).collect())
-                }
-                _ => Samples::F32(
-                    pixels()
-                        .flat_map(|x| [planes[0].get(x), planes[1].get(x), planes[2].get(x)])
+            // The averaged RGB, interleaved, then each class's (diffuse, specular) pairs.
+            let order = || {
+                let rgb = pixels().flat_map(|x| [(0, x), (1, x), (2, x)]);
+                let classes = (3..planes.len())
+                    .step_by(2)
+                    .flat_map(move |ch| pixels().flat_map(move |x| [(ch, x), (ch + 1, x)]));
+                rgb.chain(classes)
+            };
+            let all_f16 = planes.iter().all(|p| matches!(p, Plane::F16(_)));
+            let samples = if all_f16 {
+                Samples::F16(
+                    order()
+                        .map(|(ch, x)| match planes[ch] {
+                            Plane::F16(v) => v[x],
+                            Plane::F32(_) => unreachable!("every plane is f16"),
+                        })
                         .collect(),
-                ),
+                )
+            } else {
+                Samples::F32(order().map(|(ch, x)| planes[ch].get(x)).collect())
             };
             StoredTable::new(meta.clone(), samples).map_err(|e| e.in_file(path))
         })
@@ -562,12 +588,13 @@ mod exr_io {
         }
     }
 
-    /// The [`ATTR_CRC32`] checksum of a metadata text and three row-major planes, widened to
-    /// f32 chunk by chunk (no full f32 copy).
-    fn planes_crc(meta_json: &[u8], planes: &[Plane<'_>; 3]) -> u32 {
+    /// The [`ATTR_CRC32`] checksum of a metadata text and the row-major planes (in
+    /// [`channel_names`] order), pixel by pixel, widened to f32 chunk by chunk (no full f32
+    /// copy).
+    fn planes_crc(meta_json: &[u8], planes: &[Plane<'_>]) -> u32 {
         let mut hasher = crc32fast::Hasher::new();
         hasher.update(meta_json);
-        let mut bytes = Vec::with_capacity(CHUNK_VALUES * 12);
+        let mut bytes = Vec::with_capacity(CHUNK_VALUES * 4 * planes.len());
         let n = planes[0].len();
         for start in (0..n).step_by(CHUNK_VALUES) {
             bytes.clear();

@@ -23,6 +23,7 @@ pub mod lookup;
 mod nodes;
 mod read;
 pub mod sampling;
+pub mod spatial;
 pub mod stored;
 mod table;
 
@@ -38,5 +39,6 @@ pub use exr::{read_exr, read_exr_stored, write_exr, EXR_MAGIC};
 pub use half::f16;
 pub use lookup::{Brdf, LengthMismatch, Memory, Options, Sample, SimdPath, HORIZON_COS};
 pub use read::{read_table, read_table_stored};
+pub use spatial::{Spatial, SpatialLookup};
 pub use stored::{Samples, StoredTable};
 pub use table::{Grid, Metadata, Precision, Table, FORMAT_VERSION, MAX_CELLS, MAX_VALUE};

@@ -33,6 +33,7 @@ use crate::avx2;
 use crate::error::TableError;
 use crate::nodes::{self, Lane, Nodes, Values};
 use crate::sampling::Sampler;
+use crate::spatial::SpatialLookup;
 use crate::stored::{Samples, StoredTable};
 use crate::table::{Grid, Metadata, Precision, Table};
 
@@ -155,6 +156,8 @@ pub struct Brdf {
     simd: SimdPath,
     reciprocal: bool,
     sampler: Option<Sampler>,
+    /// The classes of a spatially varying table (`crate::spatial`).
+    spatial: Option<SpatialLookup>,
 }
 
 impl Brdf {
@@ -177,8 +180,12 @@ impl Brdf {
 
     /// A lookup of a table in memory, after checking it (see [`StoredTable::new`]).
     pub fn from_stored(table: StoredTable, options: Options) -> Result<Brdf, TableError> {
-        let StoredTable { meta, samples } = StoredTable::new(table.meta, table.samples)?;
+        let StoredTable { meta, mut samples } = StoredTable::new(table.meta, table.samples)?;
         let g = meta.grid;
+        let spatial = meta.spatial.clone().map(|layout| {
+            let classes = samples.split_off(3 * g.len());
+            SpatialLookup::new(layout, g, classes)
+        });
         let value = |ti: u32, pi: u32, to: u32, po: u32| -> [f32; 3] {
             let c = 3 * g.index(ti, pi, to, po);
             [samples.get(c), samples.get(c + 1), samples.get(c + 2)]
@@ -201,7 +208,35 @@ impl Brdf {
             simd,
             reciprocal: options.reciprocal,
             sampler,
+            spatial,
         })
+    }
+
+    /// The spatial part of a spatially varying table, `None` for an averaged table.
+    pub fn spatial(&self) -> Option<&SpatialLookup> {
+        self.spatial.as_ref()
+    }
+
+    /// f_r through a footprint of the weave period (docs/spatial.md): at (u, v) in period
+    /// fractions (wrapped), over a square of side `width` periods. A spatial table answers the
+    /// coverage-weighted mean of its cells' f_r over the square, and its averaged f_r
+    /// ([`Brdf::eval`]) once `width` reaches 1; an averaged table always answers
+    /// [`Brdf::eval`].
+    pub fn eval_at(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64, width: f64) -> [f32; 3] {
+        self.spatial
+            .as_ref()
+            .and_then(|s| s.eval_at(wi, wo, u, v, width))
+            .unwrap_or_else(|| self.eval(wi, wo))
+    }
+
+    /// The share of a footprint's projected area in which the eye meets yarn, seen from `wo`
+    /// (see [`Brdf::eval_at`]); for a footprint of a whole period or more, the directional
+    /// coverage C(wo). An averaged table carries no coverage and answers 1 (opaque).
+    pub fn coverage_at(&self, wo: [f32; 3], u: f64, v: f64, width: f64) -> f32 {
+        self.spatial
+            .as_ref()
+            .and_then(|s| s.coverage_at(wo, u, v, width.min(0.999_999)))
+            .unwrap_or(1.0)
     }
 
     /// The same table looked up by `path`; `None` when this processor cannot run it (or,
@@ -245,7 +280,9 @@ impl Brdf {
             Values::F32(_) => 4,
         };
         let values = lane * self.nodes.len();
-        values + self.sampler.as_ref().map_or(0, Sampler::memory_bytes)
+        values
+            + self.sampler.as_ref().map_or(0, Sampler::memory_bytes)
+            + self.spatial.as_ref().map_or(0, SpatialLookup::memory_bytes)
     }
 
     /// True when the table was opened with importance sampling ([`Options::sampling`]).

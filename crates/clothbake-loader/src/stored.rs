@@ -41,6 +41,14 @@ impl Samples {
         }
     }
 
+    /// Splits off the values from `at` on (as [`Vec::split_off`]).
+    pub fn split_off(&mut self, at: usize) -> Samples {
+        match self {
+            Samples::F16(v) => Samples::F16(v.split_off(at)),
+            Samples::F32(v) => Samples::F32(v.split_off(at)),
+        }
+    }
+
     /// The precision of the values.
     pub fn precision(&self) -> Precision {
         match self {

@@ -6,6 +6,7 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 use crate::error::TableError;
+use crate::spatial::Spatial;
 
 /// Version of the table description: the [`Metadata`] record, the grid layout and the OpenEXR
 /// format (`docs/table-format.md`). Readers reject any other version. The binary container
@@ -176,6 +177,10 @@ pub struct Metadata {
     pub options_json: String,
     /// The symmetry the baker exploited, in words, e.g. `"mirror x, mirror y"` or `"none"`.
     pub symmetry: String,
+    /// For a spatially varying table, the period's cells and classes (`crate::spatial`);
+    /// absent from averaged tables, whose headers are as before.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spatial: Option<Spatial>,
 }
 
 impl Metadata {
@@ -197,7 +202,18 @@ impl Metadata {
             fabric_json: fabric_json.into(),
             options_json: options_json.into(),
             symmetry: symmetry.into(),
+            spatial: None,
         }
+    }
+
+    /// Number of values of a table with this metadata: 3 per grid cell (the averaged RGB), and
+    /// for a spatial table 2 per grid cell and class after them. Saturates.
+    pub fn values_len(&self) -> usize {
+        let extra = self
+            .spatial
+            .as_ref()
+            .map_or(0, |s| s.values_len(&self.grid));
+        self.grid.len().saturating_mul(3).saturating_add(extra)
     }
 
     /// Checks the format version, the grid and the centring.
@@ -211,6 +227,9 @@ impl Metadata {
             });
         }
         self.grid.validate()?;
+        if let Some(s) = &self.spatial {
+            s.validate(&self.grid)?;
+        }
         if self.centring != "cell" {
             return Err(TableError::InvalidTable {
                 reason: format!(
@@ -253,7 +272,9 @@ fn escape_non_ascii(json: &str) -> String {
 /// A baked table: metadata and RGB values, interleaved, one triple per grid cell.
 ///
 /// The value of cell `c` (see [`Grid::index`]) and channel `k` (0 = R, 1 = G, 2 = B) is
-/// `values[3 * c + k]`.
+/// `values[3 * c + k]`. A spatially varying table ([`Metadata::spatial`]) continues with class
+/// `k`'s diffuse and specular values of cell `c` at `3 N + 2 (k N + c)` and `+ 1`, `N` the
+/// number of grid cells (`crate::spatial`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Table {
     /// What the table holds.
@@ -306,11 +327,16 @@ pub(crate) fn check_values(
     unphysical: Option<(usize, f32)>,
 ) -> Result<(), TableError> {
     meta.validate()?;
-    let expected = meta.grid.len() * 3;
+    let expected = meta.values_len();
     if len != expected {
+        let what = if meta.spatial.is_some() {
+            "RGB and the classes' values"
+        } else {
+            "RGB"
+        };
         return Err(TableError::InvalidTable {
             reason: format!(
-                "grid {} has {} cells and needs {expected} values (RGB), but there are {len}",
+                "grid {} has {} cells and needs {expected} values ({what}), but there are {len}",
                 meta.grid,
                 meta.grid.len(),
             ),
@@ -328,13 +354,17 @@ pub(crate) fn check_values(
             )
         };
         return Err(TableError::InvalidTable {
-            reason: format!(
-                "value {} of cell {} (channel {}) is {:e}; {rule}",
-                i,
-                i / 3,
-                ['R', 'G', 'B'][i % 3],
-                v
-            ),
+            reason: if i < 3 * meta.grid.len() {
+                format!(
+                    "value {} of cell {} (channel {}) is {:e}; {rule}",
+                    i,
+                    i / 3,
+                    ['R', 'G', 'B'][i % 3],
+                    v
+                )
+            } else {
+                format!("value {i} (a class's value) is {v:e}; {rule}")
+            },
         });
     }
     Ok(())

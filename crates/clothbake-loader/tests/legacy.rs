@@ -60,6 +60,7 @@ fn parse_v1(b: &[u8]) -> Table {
         fabric_json: c.text(),
         options_json: c.text(),
         symmetry: c.text(),
+        spatial: None,
     };
     assert_eq!(c.1, 20 + h, "the header is exactly H bytes");
     let n = c.u64() as usize;

@@ -97,13 +97,14 @@ fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) ->
 /// method: "analytic" (default; variant "refined" or "thesis") or "raytrace" (samples, seed,
 /// caps "excluded" or "shaded"). With bounces=2: secondary "analytic" (orders: "default",
 /// "fast" or "T,B,A") or "raytrace" (sampling: "N,STEP,L0,exact|area"); kernel
-/// "radiometric" (default) or "thesis".
+/// "radiometric" (default) or "thesis". spatial: True tabulates the weave up close beside the
+/// average (docs/spatial.md; analytic model, bounces=1); look it up with Table.eval(uv=...).
 /// Returns the Table (None for a shard).
 #[pyfunction]
 #[pyo3(signature = (fabric, res=(32, 64, 32, 64), bounces=1, facet="huo", progress=None, *,
     output=None, overwrite=false, resume=false, shard=None, format=None, precision=None,
     method="analytic", variant=None, samples=None, seed=None, caps=None, secondary=None,
-    kernel=None, orders=None, sampling=None, checkpoint_every=None))]
+    kernel=None, orders=None, sampling=None, checkpoint_every=None, spatial=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn bake(
     py: Python<'_>,
@@ -128,6 +129,7 @@ pub fn bake(
     orders: Option<&str>,
     sampling: Option<&str>,
     checkpoint_every: Option<f64>,
+    spatial: bool,
 ) -> PyResult<Option<PyTable>> {
     check_bounces(bounces)?;
     let grid = Grid {
@@ -186,6 +188,7 @@ pub fn bake(
                 .transpose()
                 .map_err(|e| bad("sampling", e))?,
         },
+        spatial,
     };
     let options = settings
         .options(Naming::Python)

@@ -117,6 +117,7 @@ pub fn plan_with_env(
         seed: o.seed,
         caps: o.caps.map(Caps::from),
         bounces: o.bounces.settings(),
+        spatial: o.spatial,
     };
     let options = settings.options(Naming::Cli).map_err(CliError::line)?;
     let shard = match (o.shard, o.shards) {

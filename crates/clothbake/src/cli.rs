@@ -183,6 +183,12 @@ pub struct BakeOpts {
     #[command(flatten)]
     pub bounces: BounceArgs,
 
+    /// Also tabulate the weave up close (docs/spatial.md): each class of the period's crossing
+    /// cells beside the average, so that renderers show the weave below one period per pixel
+    /// (render --periods, Brdf::eval_at). Analytic model, --bounces 1.
+    #[arg(long)]
+    pub spatial: bool,
+
     /// Material overrides, applied to both yarn groups.
     #[command(flatten)]
     pub material: MaterialArgs,

@@ -23,12 +23,13 @@ fn format_name(path: &Path) -> &'static str {
     }
 }
 
-/// Minimum, maximum and mean of each channel.
+/// Minimum, maximum and mean of each channel of the averaged RGB.
 pub fn channel_stats(t: &Table) -> [[f64; 3]; 3] {
     let mut min = [f64::INFINITY; 3];
     let mut max = [f64::NEG_INFINITY; 3];
     let mut sum = [0.0; 3];
-    for c in t.values.chunks_exact(3) {
+    let rgb = &t.values[..3 * t.meta.grid.len()];
+    for c in rgb.chunks_exact(3) {
         for k in 0..3 {
             let v = f64::from(c[k]);
             min[k] = min[k].min(v);
@@ -36,8 +37,31 @@ pub fn channel_stats(t: &Table) -> [[f64; 3]; 3] {
             sum[k] += v;
         }
     }
-    let n = (t.values.len() / 3).max(1) as f64;
+    let n = (rgb.len() / 3).max(1) as f64;
     [min, max, sum.map(|s| s / n)]
+}
+
+/// The layout of a spatial table: its classes and, for periods up to 32 threads wide, the
+/// class of each crossing cell (weft rows from v = 0 upward, warp columns from u = 0).
+fn spatial_lines(s: &mut String, sp: &clothbake_loader::Spatial) {
+    let (nx, ny) = sp.dims();
+    let _ = writeln!(
+        s,
+        "spatial    {} classes over {nx} x {ny} crossing cells (warp x weft; docs/spatial.md); \
+         each cell shows its class's f_r at its thread's albedo",
+        sp.classes
+    );
+    if nx <= 32 {
+        for j in 0..ny.min(32) {
+            let row: Vec<String> = (0..nx)
+                .map(|i| format!("{:>3}", sp.cell_class[j * nx + i]))
+                .collect();
+            let _ = writeln!(s, "  weft {j:<3}{}", row.join(""));
+        }
+        if ny > 32 {
+            let _ = writeln!(s, "  ... ({} more weft rows)", ny - 32);
+        }
+    }
 }
 
 /// Runs `clothbake info` and returns the text to print.
@@ -85,6 +109,9 @@ pub fn run(args: &InfoArgs) -> Result<String, CliError> {
     let _ = writeln!(s, "quantity   {} in {}", m.quantity, m.units);
     let _ = writeln!(s, "symmetry   {}", m.symmetry);
     let _ = writeln!(s, "options    {}", m.options_json);
+    if let Some(sp) = &m.spatial {
+        spatial_lines(&mut s, sp);
+    }
     let [min, max, mean] = channel_stats(&t);
     let _ = writeln!(s, "values     {:>12} {:>12} {:>12}", "R", "G", "B");
     for (name, v) in [("min", min), ("max", max), ("mean", mean)] {

@@ -151,6 +151,57 @@ fn four_shards_two_at_a_time_merge_to_the_single_bake() {
 }
 
 #[test]
+fn spatial_bakes_are_the_same_for_any_thread_count_and_shard_split() {
+    let d = fresh_dir("spatial");
+    let twill = fabric("twill");
+    let base = ["bake", "--weave", twill.as_str(), "--res", RES, "--spatial"];
+    succeeds(&run_in(
+        &d,
+        &[&base[..], &["--threads", "1", "-o", "one.exr"]].concat(),
+    ));
+    succeeds(&run_in(
+        &d,
+        &[&base[..], &["--threads", "2", "-o", "two.exr"]].concat(),
+    ));
+    identical(&d, "one.exr", "two.exr");
+    for k in 0..3 {
+        let s = format!("{k}/3");
+        succeeds(&run_in(&d, &[&base[..], &["--shard", &s]].concat()));
+    }
+    let out = succeeds(&run_in(
+        &d,
+        &[
+            "merge",
+            "-o",
+            "merged.exr",
+            "twill-2-of-3.shard",
+            "twill-0-of-3.shard",
+            "twill-1-of-3.shard",
+        ],
+    ));
+    assert!(out.contains("3 shards merged"), "{out}");
+    identical(&d, "one.exr", "merged.exr");
+    let info = succeeds(&run_in(&d, &["info", "merged.exr"]));
+    assert!(info.contains("spatial    3 classes over 3 x 3"), "{info}");
+    // What a spatial table cannot hold yet is refused before anything is written.
+    fails_with(
+        &run_in(
+            &d,
+            &[&base[..], &["--bounces", "2", "-o", "b2.exr"]].concat(),
+        ),
+        &["--spatial", "--bounces 1"],
+    );
+    fails_with(
+        &run_in(
+            &d,
+            &[&base[..], &["--method", "raytrace", "-o", "rt.exr"]].concat(),
+        ),
+        &["--spatial", "--method analytic"],
+    );
+    assert!(!d.join("b2.exr").exists() && !d.join("rt.exr").exists());
+}
+
+#[test]
 fn shard_auto_reads_slurm_and_kubernetes() {
     let d = fresh_dir("auto");
     let twill = fabric("twill");

@@ -1,0 +1,459 @@
+//! Spatially varying tables: the weave period's crossing cells, the class of reflection each
+//! cell shows and its thread's colour ([`Spatial`], stored in the [`crate::Metadata`]), and
+//! the render-time lookup at a point of the period through a footprint ([`SpatialLookup`]).
+//!
+//! A spatial table holds, beside the averaged RGB table, two values per grid cell and class:
+//! f_r of the class's diffuse term at unit albedo (D) and of its specular term (S), after the
+//! averaged values, class by class, cell by cell, D then S (`docs/table-format.md`). A cell of
+//! the period whose class is `k` and whose thread has diffuse albedo rho_d reflects
+//! `rho_d D_k + S_k`; its coverage c(x; wo) is the class's visible share of the period
+//! ([`Spatial::visible`], tabulated over the outgoing directions) over the cell's share of the
+//! period's area. The coverage-weighted mean of the cells' f_r is the averaged table
+//! (docs/spatial.md).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::TableError;
+use crate::stored::Samples;
+use crate::table::Grid;
+
+/// Most crossing cells a spatial table's period may have (2^16): the layout is stored as JSON
+/// in the header.
+pub const MAX_SPATIAL_CELLS: usize = 1 << 16;
+
+/// Most classes a spatial table may have (2^12).
+pub const MAX_CLASSES: u32 = 1 << 12;
+
+/// The layout of a spatially varying table: the period's crossing cells and what each shows.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct Spatial {
+    /// Number of classes K: the table holds 2 K values per grid cell beside the average.
+    pub classes: u32,
+    /// Cell edges along u (the weft direction, +X) in fractions of the period: one more than
+    /// the warp threads, increasing, the last exactly 1 more than the first.
+    pub u_edges: Vec<f64>,
+    /// Cell edges along v (the warp direction, +Y), likewise, one more than the weft threads.
+    pub v_edges: Vec<f64>,
+    /// The class of each cell, row-major (weft row, then warp column).
+    pub cell_class: Vec<u32>,
+    /// The diffuse albedo (RGB) of the thread on top in each cell, row-major.
+    pub cell_albedo: Vec<[f32; 3]>,
+    /// Each class's visible projected area over the period's projected area, at the grid's
+    /// outgoing cell centres: `visible[(k * n_theta_o + to) * n_phi_o + po]`.
+    pub visible: Vec<f32>,
+}
+
+/// The names of a table's channels in an OpenEXR file: `R`, `G`, `B` and, for a spatial table
+/// of `classes` classes, `class<k>.diffuse` and `class<k>.specular` for each class `k`.
+pub fn channel_names(classes: u32) -> Vec<String> {
+    let mut names: Vec<String> = ["R", "G", "B"].map(String::from).to_vec();
+    for k in 0..classes {
+        names.push(format!("class{k}.diffuse"));
+        names.push(format!("class{k}.specular"));
+    }
+    names
+}
+
+/// Index in a table's values of channel `ch` (in [`channel_names`] order) of grid cell `cell`,
+/// for a grid of `n` cells.
+pub fn value_index(ch: usize, cell: usize, n: usize) -> usize {
+    if ch < 3 {
+        3 * cell + ch
+    } else {
+        let (k, j) = ((ch - 3) / 2, (ch - 3) % 2);
+        3 * n + 2 * (k * n + cell) + j
+    }
+}
+
+impl Spatial {
+    /// Number of warp columns and weft rows of cells.
+    pub fn dims(&self) -> (usize, usize) {
+        (
+            self.u_edges.len().saturating_sub(1),
+            self.v_edges.len().saturating_sub(1),
+        )
+    }
+
+    /// Number of values the classes add to a table on `grid` (2 K per grid cell), saturating.
+    pub fn values_len(&self, grid: &Grid) -> usize {
+        grid.len()
+            .saturating_mul(2)
+            .saturating_mul(self.classes as usize)
+    }
+
+    /// Checks the layout against the table's grid.
+    pub fn validate(&self, grid: &Grid) -> Result<(), TableError> {
+        let bad = |reason: String| Err(TableError::InvalidTable { reason });
+        if self.classes == 0 || self.classes > MAX_CLASSES {
+            return bad(format!(
+                "a spatial table has 1 to {MAX_CLASSES} classes, not {}",
+                self.classes
+            ));
+        }
+        for (name, e) in [("u_edges", &self.u_edges), ("v_edges", &self.v_edges)] {
+            let ok = e.len() >= 2
+                && e.iter().all(|x| x.is_finite())
+                && e.windows(2).all(|w| w[1] > w[0])
+                && (e[e.len() - 1] - e[0] - 1.0).abs() < 1e-9;
+            if !ok {
+                return bad(format!(
+                    "spatial {name} must be at least 2 increasing fractions spanning one period"
+                ));
+            }
+        }
+        let (nx, ny) = self.dims();
+        let cells = nx.saturating_mul(ny);
+        if cells > MAX_SPATIAL_CELLS {
+            return bad(format!(
+                "the period has {cells} cells, more than the limit of {MAX_SPATIAL_CELLS}"
+            ));
+        }
+        if self.cell_class.len() != cells || self.cell_albedo.len() != cells {
+            return bad(format!(
+                "{nx} x {ny} cells need {cells} classes and albedos, but there are {} and {}",
+                self.cell_class.len(),
+                self.cell_albedo.len()
+            ));
+        }
+        if let Some(c) = self.cell_class.iter().find(|&&c| c >= self.classes) {
+            return bad(format!(
+                "a cell has class {c}, but there are {} classes",
+                self.classes
+            ));
+        }
+        let albedo_ok = |a: &[f32; 3]| a.iter().all(|x| (0.0..=1.0).contains(x));
+        if !self.cell_albedo.iter().all(albedo_ok) {
+            return bad("every albedo of a spatial table lies in [0, 1]".to_string());
+        }
+        let n_vis = (self.classes as usize)
+            .saturating_mul(grid.n_theta_o as usize)
+            .saturating_mul(grid.n_phi_o as usize);
+        if self.visible.len() != n_vis {
+            return bad(format!(
+                "{} classes on grid {grid} need {n_vis} visible areas, but there are {}",
+                self.classes,
+                self.visible.len()
+            ));
+        }
+        if !self.visible.iter().all(|v| v.is_finite() && *v >= 0.0) {
+            return bad("every visible area of a spatial table is finite and >= 0".to_string());
+        }
+        Ok(())
+    }
+
+    /// The cell column (or row) of `edges` holding fraction `t` of the period, wrapped.
+    fn locate(edges: &[f64], t: f64) -> usize {
+        let e0 = edges[0];
+        let t = if t.is_finite() { t } else { 0.0 };
+        let x = e0 + (t - e0).rem_euclid(1.0);
+        let n = edges.len() - 1;
+        edges
+            .partition_point(|&e| e <= x)
+            .saturating_sub(1)
+            .min(n - 1)
+    }
+
+    /// Cells overlapping `[t0, t1]` (fractions, `t1 - t0 < 1`) with the share of each cell's
+    /// width the interval covers.
+    fn overlaps(edges: &[f64], t0: f64, t1: f64, out: &mut Vec<(usize, f64)>) {
+        out.clear();
+        let n = edges.len() - 1;
+        let mut k = Spatial::locate(edges, t0);
+        // The unwrapped start of cell k at or before t0.
+        let mut start = edges[k] + ((t0 - edges[k]).div_euclid(1.0));
+        while start < t1 && out.len() <= n {
+            let w = edges[k + 1] - edges[k];
+            let end = start + w;
+            let covered = end.min(t1) - start.max(t0);
+            if covered > 0.0 {
+                out.push((k, covered / w));
+            }
+            start = end;
+            k = (k + 1) % n;
+        }
+    }
+}
+
+/// Interpolation weights of one axis: low and high node and the high node's weight.
+#[derive(Clone, Copy)]
+struct Axis {
+    lo: usize,
+    hi: usize,
+    t: f32,
+}
+
+impl Axis {
+    /// A polar axis of `n` cell-centred nodes over [0, 90] degrees, clamped at both ends.
+    fn polar(theta_deg: f32, n: u32) -> Axis {
+        let x = theta_deg * n as f32 / 90.0 - 0.5;
+        let x = if x.is_finite() { x } else { 0.0 };
+        let lo = x.floor().clamp(0.0, (n - 1) as f32);
+        Axis {
+            lo: lo as usize,
+            hi: (lo as usize + 1).min(n as usize - 1),
+            t: (x - lo).clamp(0.0, 1.0),
+        }
+    }
+
+    /// An azimuth axis of `n` cell-centred nodes over [0, 360) degrees, wrapped.
+    fn azimuth(phi_deg: f32, n: u32) -> Axis {
+        let x = phi_deg * n as f32 / 360.0 - 0.5;
+        let x = if x.is_finite() { x } else { 0.0 };
+        let f = x.floor();
+        let lo = (f as i64).rem_euclid(i64::from(n)) as usize;
+        Axis {
+            lo,
+            hi: (lo + 1) % n as usize,
+            t: (x - f).clamp(0.0, 1.0),
+        }
+    }
+
+    fn taps(self) -> [(usize, f32); 2] {
+        [(self.lo, 1.0 - self.t), (self.hi, self.t)]
+    }
+}
+
+/// A direction as (theta, phi) in degrees, `None` at or below the horizon or not a number.
+fn angles(w: [f32; 3]) -> Option<(f32, f32)> {
+    let n = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+    if !(n > 0.0 && w[2] / n > crate::HORIZON_COS) {
+        return None;
+    }
+    let theta = (w[2] / n).clamp(-1.0, 1.0).acos().to_degrees();
+    let phi = w[1].atan2(w[0]).to_degrees();
+    Some((theta, if phi < 0.0 { phi + 360.0 } else { phi }))
+}
+
+/// The classes' values of a spatial table and its layout, for lookups at a point of the period.
+#[derive(Clone, Debug)]
+pub struct SpatialLookup {
+    layout: Spatial,
+    grid: Grid,
+    /// The classes' (D, S) values: `2 (k N + c) + j`, `N` grid cells.
+    values: Samples,
+}
+
+/// What a footprint of the period sees of each class.
+struct Seen {
+    /// Per class: the summed share of its cells the footprint covers.
+    share: Vec<f32>,
+    /// Per class: that share times each cell's albedo, summed (RGB).
+    albedo: Vec<[f32; 3]>,
+}
+
+impl SpatialLookup {
+    /// The lookup of a table's class values (`values`, as [`Spatial::values_len`] counts them).
+    pub(crate) fn new(layout: Spatial, grid: Grid, values: Samples) -> SpatialLookup {
+        debug_assert_eq!(values.len(), layout.values_len(&grid));
+        SpatialLookup {
+            layout,
+            grid,
+            values,
+        }
+    }
+
+    /// The layout.
+    pub fn layout(&self) -> &Spatial {
+        &self.layout
+    }
+
+    /// Bytes held by the class values.
+    pub fn memory_bytes(&self) -> usize {
+        let lane = match self.values {
+            Samples::F16(_) => 2,
+            Samples::F32(_) => 4,
+        };
+        lane * self.values.len()
+    }
+
+    /// Class `k`'s (D, S) at the directions, interpolated over the 16 grid nodes around them.
+    fn class_f(&self, k: usize, i: (f32, f32), o: (f32, f32)) -> [f32; 2] {
+        let g = self.grid;
+        let (a, b) = (Axis::polar(i.0, g.n_theta_i), Axis::azimuth(i.1, g.n_phi_i));
+        let (c, d) = (Axis::polar(o.0, g.n_theta_o), Axis::azimuth(o.1, g.n_phi_o));
+        let base = k * g.len();
+        let mut out = [0.0f32; 2];
+        for (ti, wa) in a.taps() {
+            for (pi, wb) in b.taps() {
+                for (to, wc) in c.taps() {
+                    for (po, wd) in d.taps() {
+                        let w = wa * wb * wc * wd;
+                        let n = base + g.index(ti as u32, pi as u32, to as u32, po as u32);
+                        out[0] += w * self.values.get(2 * n);
+                        out[1] += w * self.values.get(2 * n + 1);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Class `k`'s visible share of the period at outgoing angles `o`, interpolated.
+    fn visible(&self, k: usize, o: (f32, f32)) -> f32 {
+        let g = self.grid;
+        let (c, d) = (Axis::polar(o.0, g.n_theta_o), Axis::azimuth(o.1, g.n_phi_o));
+        let mut v = 0.0;
+        for (to, wc) in c.taps() {
+            for (po, wd) in d.taps() {
+                let n = (k * g.n_theta_o as usize + to) * g.n_phi_o as usize + po;
+                v += wc * wd * self.layout.visible[n];
+            }
+        }
+        v
+    }
+
+    /// What a footprint of side `width` (0 for a point, else in (0, 1)) centred on (u, v)
+    /// covers of each class.
+    fn seen(&self, u: f64, v: f64, width: f64) -> Seen {
+        let l = &self.layout;
+        let k = l.classes as usize;
+        let mut seen = Seen {
+            share: vec![0.0; k],
+            albedo: vec![[0.0; 3]; k],
+        };
+        for (c, share, _) in self.covered(u, v, width) {
+            let class = l.cell_class[c] as usize;
+            seen.share[class] += share as f32;
+            for (acc, a) in seen.albedo[class].iter_mut().zip(l.cell_albedo[c]) {
+                *acc += share as f32 * a;
+            }
+        }
+        seen
+    }
+
+    /// f_r through the footprint: the mean of the covered cells' f_r, each weighted by its
+    /// covered share times its coverage. `None` for a footprint of a whole period or more
+    /// (the averaged table answers), `Some(0)` below the horizon.
+    pub fn eval_at(
+        &self,
+        wi: [f32; 3],
+        wo: [f32; 3],
+        u: f64,
+        v: f64,
+        width: f64,
+    ) -> Option<[f32; 3]> {
+        if width >= 1.0 || !(u.is_finite() && v.is_finite()) {
+            return None;
+        }
+        let (Some(i), Some(o)) = (angles(wi), angles(wo)) else {
+            return Some([0.0; 3]);
+        };
+        let seen = self.seen(u, v, width.max(0.0));
+        let (mut num, mut den) = ([0.0f32; 3], 0.0f32);
+        for (k, (&share, a)) in seen.share.iter().zip(&seen.albedo).enumerate() {
+            if share <= 0.0 {
+                continue;
+            }
+            let vis = self.visible(k, o);
+            if vis <= 0.0 {
+                continue;
+            }
+            let [d, s] = self.class_f(k, i, o);
+            for (n, a) in num.iter_mut().zip(a) {
+                *n += vis * (a * d + share * s);
+            }
+            den += vis * share;
+        }
+        Some(if den > 0.0 {
+            num.map(|n| (n / den).max(0.0))
+        } else {
+            [0.0; 3]
+        })
+    }
+
+    /// The footprint's coverage: the share of its projected area in which the eye meets yarn
+    /// seen from `wo`. `None` for a footprint of a whole period or more.
+    pub fn coverage_at(&self, wo: [f32; 3], u: f64, v: f64, width: f64) -> Option<f32> {
+        if width >= 1.0 || !(u.is_finite() && v.is_finite()) {
+            return None;
+        }
+        let Some(o) = angles(wo) else {
+            return Some(0.0);
+        };
+        // Each covered cell's area times its coverage (visible share / cell's area share),
+        // over the covered area.
+        let (mut covered, mut area) = (0.0f64, 0.0f64);
+        for (c, share, cell_area) in self.covered(u, v, width.max(0.0)) {
+            let k = self.layout.cell_class[c] as usize;
+            covered += share * f64::from(self.visible(k, o));
+            area += share * cell_area;
+        }
+        Some(if area > 0.0 {
+            (covered / area) as f32
+        } else {
+            0.0
+        })
+    }
+
+    /// The cells a footprint of side `width` (0 for a point, else in (0, 1)) centred on (u, v)
+    /// covers: row-major index, the share of the cell covered, the cell's share of the period.
+    fn covered(&self, u: f64, v: f64, width: f64) -> Vec<(usize, f64, f64)> {
+        let l = &self.layout;
+        let (nx, _) = l.dims();
+        let cell_area = |i: usize, j: usize| {
+            (l.u_edges[i + 1] - l.u_edges[i]) * (l.v_edges[j + 1] - l.v_edges[j])
+        };
+        if width > 0.0 {
+            let h = 0.5 * width;
+            let (mut xs, mut ys) = (Vec::new(), Vec::new());
+            Spatial::overlaps(&l.u_edges, u - h, u + h, &mut xs);
+            Spatial::overlaps(&l.v_edges, v - h, v + h, &mut ys);
+            let mut out = Vec::with_capacity(xs.len() * ys.len());
+            for &(j, wy) in &ys {
+                for &(i, wx) in &xs {
+                    out.push((j * nx + i, wx * wy, cell_area(i, j)));
+                }
+            }
+            out
+        } else {
+            let (i, j) = (
+                Spatial::locate(&l.u_edges, u),
+                Spatial::locate(&l.v_edges, v),
+            );
+            vec![(j * nx + i, 1.0, cell_area(i, j))]
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overlaps_cover_the_interval_once() {
+        // Edges -0.25, 0.25, 0.75 (two cells of half a period, the first across 0).
+        let e = [-0.25, 0.25, 0.75];
+        assert_eq!(Spatial::locate(&e, 0.0), 0);
+        assert_eq!(Spatial::locate(&e, 0.5), 1);
+        assert_eq!(Spatial::locate(&e, 0.8), 0);
+        assert_eq!(Spatial::locate(&e, -3.6), 1);
+        let mut out = Vec::new();
+        Spatial::overlaps(&e, 0.0, 0.5, &mut out);
+        // Half of cell 0 (0..0.25) and half of cell 1 (0.25..0.5).
+        assert_eq!(out.len(), 2);
+        assert_eq!(out[0].0, 0);
+        assert!((out[0].1 - 0.5).abs() < 1e-12 && (out[1].1 - 0.5).abs() < 1e-12);
+        // Wrapping past the end.
+        Spatial::overlaps(&e, 0.6, 1.1, &mut out);
+        let total: f64 = out.iter().map(|(_, s)| s * 0.5).sum();
+        assert!((total - 0.5).abs() < 1e-12, "{out:?}");
+    }
+
+    #[test]
+    fn axes_interpolate_between_cell_centres() {
+        let a = Axis::polar(0.0, 4);
+        assert_eq!((a.lo, a.hi, a.t), (0, 1, 0.0));
+        // Past the last centre (78.75) the last node holds.
+        let a = Axis::polar(90.0, 4);
+        assert_eq!((a.lo, a.hi), (3, 3));
+        // 22.5 degrees is halfway between the centres 11.25 and 33.75.
+        let a = Axis::polar(22.5, 4);
+        assert_eq!((a.lo, a.hi), (0, 1));
+        assert!((a.t - 0.5).abs() < 1e-6);
+        // Azimuth wraps: 359 degrees lies between the last centre (315) and the first (45).
+        let a = Axis::azimuth(359.0, 4);
+        assert_eq!((a.lo, a.hi), (3, 0));
+        let a = Axis::azimuth(1.0, 4);
+        assert_eq!((a.lo, a.hi), (3, 0));
+    }
+}

@@ -1,0 +1,223 @@
+//! Spatially varying tables (`bake --spatial`, docs/spatial.md): the baked classes and the
+//! loader's lookup at a point of the period against the model's own reflection per crossing
+//! cell, the averaged part against the averaged bake, footprints against the average, and the
+//! table through both file formats.
+
+use clothbake_bake::{bake, BakeOptions};
+use clothbake_core::{AnalyticModel, Cell, Fabric, FacetModel, UnitVec3};
+use clothbake_loader::{Brdf, Grid, Options, Table};
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+const GRID: Grid = Grid {
+    n_theta_i: 6,
+    n_phi_i: 12,
+    n_theta_o: 6,
+    n_phi_o: 12,
+};
+
+fn fabric(file: &str) -> Fabric {
+    Fabric::from_path(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../tables")
+            .join(file),
+    )
+    .unwrap()
+}
+
+fn baked(f: &Fabric, spatial: bool) -> Table {
+    let opts = BakeOptions {
+        grid: GRID,
+        spatial,
+        ..BakeOptions::default()
+    };
+    bake(f, &opts, &|_| {}, &AtomicBool::new(false))
+        .unwrap()
+        .table
+}
+
+fn f32s(u: UnitVec3) -> [f32; 3] {
+    [u.x as f32, u.y as f32, u.z as f32]
+}
+
+/// The centre of each crossing cell in period fractions, with the cell.
+fn cell_centres(model: &AnalyticModel) -> Vec<(Cell, f64, f64)> {
+    let (u, v) = model.cells().edge_fractions();
+    let mut out = Vec::new();
+    for j in 0..v.len() - 1 {
+        for i in 0..u.len() - 1 {
+            let c = Cell { warp: i, weft: j };
+            out.push((c, 0.5 * (u[i] + u[i + 1]), 0.5 * (v[j] + v[j + 1])));
+        }
+    }
+    out
+}
+
+/// Grid nodes (cell centres of the direction grid) to test at: a spread of both hemispheres.
+fn node_pairs() -> Vec<(UnitVec3, UnitVec3)> {
+    let dir = |t: u32, nt: u32, p: u32, np: u32| clothbake_bake::direction(t, nt, p, np);
+    let g = GRID;
+    let mut out = Vec::new();
+    for (ti, pi, to, po) in [
+        (0, 0, 0, 0),
+        (1, 3, 2, 9),
+        (3, 1, 1, 7),
+        (4, 6, 4, 0),
+        (5, 11, 3, 5),
+        (2, 8, 5, 2),
+    ] {
+        out.push((
+            dir(ti, g.n_theta_i, pi, g.n_phi_i),
+            dir(to, g.n_theta_o, po, g.n_phi_o),
+        ));
+    }
+    out
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()) + 1e-6
+}
+
+#[test]
+fn each_cell_of_the_table_is_the_models_reflection_there() {
+    // The loader's point lookup (width 0) at a grid node, in every crossing cell, against the
+    // model's own per-cell reflection and coverage (AnalyticModel::intensity_in): the classes'
+    // albedo factoring, the row packing, the file layout and the cell location all in one.
+    for file in ["twill.json", "satin5.json", "gingham.wif"] {
+        let f = fabric(file);
+        let model = AnalyticModel::new(&f, FacetModel::Huo);
+        let brdf = Brdf::from_table(baked(&f, true), Options::default()).unwrap();
+        assert!(brdf.spatial().is_some());
+        for (wi, wo) in node_pairs() {
+            for (cell, u, v) in cell_centres(&model) {
+                let local = model.intensity_in(wi, wo, cell, None);
+                let want = local.reflection.brdf(wi);
+                let got = brdf.eval_at(f32s(wi), f32s(wo), u, v, 0.0);
+                for k in 0..3 {
+                    assert!(
+                        close(f64::from(got[k]), want[k], 1e-5),
+                        "{file} cell {cell:?} channel {k}: table {} model {}",
+                        got[k],
+                        want[k]
+                    );
+                }
+                let cov = brdf.coverage_at(f32s(wo), u, v, 0.0);
+                assert!(
+                    close(f64::from(cov), local.coverage, 1e-5),
+                    "{file} cell {cell:?}: coverage {cov} vs {}",
+                    local.coverage
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_averaged_part_is_the_averaged_bake() {
+    // The spatial bake evaluates every cell (no symmetry copies); the average it stores is the
+    // averaged bake's to rounding.
+    for file in ["twill.json", "gingham.wif"] {
+        let f = fabric(file);
+        let (s, a) = (baked(&f, true), baked(&f, false));
+        let n = 3 * GRID.len();
+        assert_eq!(a.values.len(), n);
+        let classes = s.meta.spatial.as_ref().unwrap().classes as usize;
+        assert_eq!(s.values.len(), n + 2 * classes * GRID.len());
+        for (k, (x, y)) in s.values[..n].iter().zip(&a.values).enumerate() {
+            assert!(
+                close(f64::from(*x), f64::from(*y), 1e-6),
+                "{file} value {k}: {x} vs {y}"
+            );
+        }
+    }
+}
+
+#[test]
+fn footprints_move_from_the_cell_to_the_average() {
+    let f = fabric("twill.json");
+    let model = AnalyticModel::new(&f, FacetModel::Huo);
+    let brdf = Brdf::from_table(baked(&f, true), Options::default()).unwrap();
+    for (wi, wo) in node_pairs() {
+        let (wi, wo) = (f32s(wi), f32s(wo));
+        let avg = brdf.eval(wi, wo);
+        // A footprint of a period or more is the averaged table.
+        assert_eq!(brdf.eval_at(wi, wo, 0.3, 0.7, 1.0), avg);
+        assert_eq!(brdf.eval_at(wi, wo, 0.3, 0.7, 5.0), avg);
+        // Just under a period: the box filter over all cells, which is the average.
+        let near = brdf.eval_at(wi, wo, 0.3, 0.7, 0.999_999);
+        // The coverage-weighted mean of the point lookups over a fine grid of points.
+        const N: usize = 120;
+        let (mut num, mut den) = ([0.0f64; 3], 0.0f64);
+        for j in 0..N {
+            for i in 0..N {
+                let (u, v) = ((i as f64 + 0.5) / N as f64, (j as f64 + 0.5) / N as f64);
+                let c = f64::from(brdf.coverage_at(wo, u, v, 0.0));
+                let fr = brdf.eval_at(wi, wo, u, v, 0.0);
+                for k in 0..3 {
+                    num[k] += c * f64::from(fr[k]);
+                }
+                den += c;
+            }
+        }
+        for k in 0..3 {
+            let mean = if den > 0.0 { num[k] / den } else { 0.0 };
+            assert!(
+                close(mean, f64::from(avg[k]), 5e-3),
+                "grid mean {mean} vs average {}",
+                avg[k]
+            );
+            assert!(
+                close(f64::from(near[k]), f64::from(avg[k]), 1e-4),
+                "footprint 0.999999 gives {} vs average {}",
+                near[k],
+                avg[k]
+            );
+        }
+        // The directional coverage, against the model's C(wo).
+        let wo_v = UnitVec3::new(clothbake_core::Vec3::new(
+            f64::from(wo[0]),
+            f64::from(wo[1]),
+            f64::from(wo[2]),
+        ))
+        .unwrap();
+        let c = brdf.coverage_at(wo, 0.1, 0.2, 1.0);
+        assert!(
+            close(f64::from(c), model.coverage(wo_v), 1e-4),
+            "{c} vs {}",
+            model.coverage(wo_v)
+        );
+    }
+    // The twill's cells differ: warp floats against weft floats.
+    let (wi, wo) = (
+        f32s(UnitVec3::from_degrees(52.5, 15.0)),
+        f32s(UnitVec3::from_degrees(22.5, 195.0)),
+    );
+    let vals: Vec<f32> = cell_centres(&model)
+        .iter()
+        .map(|&(_, u, v)| brdf.eval_at(wi, wo, u, v, 0.0)[0])
+        .collect();
+    let (lo, hi) = vals
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+    assert!(hi > 1.1 * lo, "the twill's cells are alike: {vals:?}");
+}
+
+#[test]
+fn spatial_tables_survive_both_file_formats() {
+    let dir = std::env::temp_dir().join(format!("clothbake-spatial-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let t = baked(&fabric("gingham.wif"), true);
+    let bin = dir.join("g.bin");
+    clothbake_loader::write_binary(&bin, &t, false).unwrap();
+    assert_eq!(clothbake_loader::read_binary(&bin).unwrap(), t);
+    let exr = dir.join("g.exr");
+    clothbake_loader::write_exr(&exr, &t, clothbake_loader::Precision::F32, false).unwrap();
+    assert_eq!(clothbake_loader::read_exr(&exr).unwrap(), t);
+    // A layout that names a class the table does not have is refused on reading.
+    let mut bad = t.clone();
+    bad.meta.spatial.as_mut().unwrap().cell_class[0] = 99;
+    assert!(Table::new(bad.meta.clone(), bad.values.clone()).is_err());
+    // A table whose values miss the classes is refused.
+    assert!(Table::new(t.meta.clone(), t.values[..3 * GRID.len()].to_vec()).is_err());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
