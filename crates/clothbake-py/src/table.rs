@@ -151,6 +151,57 @@ impl PyTable {
         to_array(py, &out, a.single && b.single)
     }
 
+    /// f_r at points of the weave period through a footprint (docs/spatial.md): `uv` (N, 2)
+    /// or (2,) in period fractions (u along the weft, v along the warp, wrapped), `width` the
+    /// side of the square each lookup covers, in periods (0: the crossing cell at uv; 1 or
+    /// more: the averaged table). A table baked with `spatial=True` shows the weave; an
+    /// averaged table answers `eval`. Returns (f_r (N, 3), coverage (N,)), float32.
+    #[pyo3(signature = (wi, wo, uv, width=0.0))]
+    fn eval_at<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        uv: &Bound<'py, PyAny>,
+        width: f64,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let a = unit_rows("wi", wi)?;
+        let b = unit_rows("wo", wo)?;
+        let p = rows::<2>("uv", uv)?;
+        same_len(("wi", a.rows.len()), ("wo", b.rows.len()))?;
+        same_len(("wi", a.rows.len()), ("uv", p.rows.len()))?;
+        if let Some((i, [u, v])) = p
+            .rows
+            .iter()
+            .enumerate()
+            .find(|(_, r)| !(r[0].is_finite() && r[1].is_finite()))
+        {
+            return Err(PyValueError::new_err(format!(
+                "uv: row {i} is ({u}, {v}); give finite period fractions"
+            )));
+        }
+        if !(width.is_finite() && width >= 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "width: {width} is not a footprint; give the square's side in periods, >= 0"
+            )));
+        }
+        let (wi32, wo32) = (narrow(&a.rows), narrow(&b.rows));
+        let (f, c): (Vec<[f32; 3]>, Vec<f32>) = py.detach(|| {
+            wi32.iter()
+                .zip(&wo32)
+                .zip(&p.rows)
+                .map(|((&i, &o), &[u, v])| {
+                    (
+                        self.brdf.eval_at(i, o, u, v, width),
+                        self.brdf.coverage_at(o, u, v, width),
+                    )
+                })
+                .unzip()
+        });
+        let single = a.single && b.single && p.single;
+        Ok((to_array(py, &f, single)?, to_array1(py, c, single)?))
+    }
+
     /// Importance-samples incident directions for unit vectors `wo` (N, 3) with uniform
     /// numbers `u` (N, 2) in [0, 1): density proportional to f_r cos(theta_i) per table cell.
     /// Returns (wi (N, 3), weight (N, 3) = f_r cos(theta_i) / pdf, pdf (N,) per steradian),

@@ -74,6 +74,29 @@ def test_points_of_the_period_average_to_the_period(twill_path):
         fab.eval(wi[:1], wo[:1], uv=np.array([[0.0, 0.0]]), method="raytrace")
 
 
+def test_a_spatial_table_shows_the_model_per_cell(twill_path):
+    """bake(spatial=True) and Table.eval_at: at grid nodes each crossing cell is the model's
+    own f_r there (the independent path: Fabric.eval(uv=...)), and a whole period is the
+    averaged table."""
+    fab = clothbake.Fabric(twill_path)
+    t = clothbake.bake(fab, res=(6, 12, 6, 12), spatial=True)
+    # Grid nodes: theta centres (k + 0.5) * 15, phi centres (k + 0.5) * 30.
+    wi = np.repeat(dirs([52.5], [15.0]), 9, axis=0)
+    wo = np.repeat(dirs([22.5], [195.0]), 9, axis=0)
+    uv = np.array([[(i + 0.5) / 3, (j + 0.5) / 3] for j in range(3) for i in range(3)])
+    f, c = t.eval_at(wi, wo, uv)
+    s = fab.eval(wi, wo, uv=uv, split=True)
+    np.testing.assert_allclose(f, s["brdf"], rtol=1e-5)
+    np.testing.assert_allclose(c, s["coverage"], rtol=1e-5)
+    assert f[:, 0].max() > 1.1 * f[:, 0].min()
+    whole, _ = t.eval_at(wi, wo, uv, width=1.0)
+    np.testing.assert_array_equal(whole, t.eval(wi, wo))
+    with pytest.raises(ValueError, match="uv"):
+        t.eval_at(wi[:1], wo[:1], np.array([[np.inf, 0.0]]))
+    with pytest.raises(ValueError, match="width"):
+        t.eval_at(wi[:1], wo[:1], uv[:1], width=-1.0)
+
+
 def test_brdf_is_linear_in_the_albedo(twill_path):
     """With Lewis facets and no specular part f_r is linear in each channel's albedo:
     f(rho) = rho f(1), channel by channel."""

@@ -13,9 +13,10 @@ pub mod shade;
 pub mod tonemap;
 
 use camera::Camera;
+use clothbake_core::Footprint;
 use rayon::prelude::*;
 use scene::Scene;
-use shade::{radiance, Lighting, Shader};
+use shade::{radiance_at, Lighting, Shader};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use tonemap::Image;
 
@@ -31,7 +32,29 @@ pub fn render(
     progress: &(dyn Fn(u64) + Sync),
     cancel: &AtomicBool,
 ) -> Option<Image> {
+    render_weave(scene, camera, lighting, shader, aa, None, progress, cancel)
+}
+
+/// As [`render`], with `periods` weave periods across the scene's width ([`Scene::width`]):
+/// each sample looks f_r up at its point of the period through its footprint
+/// ([`Weave::footprint`]).
+#[allow(clippy::too_many_arguments)]
+pub fn render_weave(
+    scene: &Scene,
+    camera: &Camera,
+    lighting: &Lighting,
+    shader: &Shader,
+    aa: u32,
+    periods: Option<f64>,
+    progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
+) -> Option<Image> {
     let aa = aa.max(1);
+    let weave = periods.map(|n| Weave {
+        per_length: n / scene.width(),
+        // The angle one sample subtends: the image plane's width over its pixels and samples.
+        sample_angle: 2.0 * camera.tan_half / f64::from(camera.width.max(1) * aa),
+    });
     let done = AtomicU64::new(0);
     let rows: Vec<Option<Vec<[f32; 3]>>> = (0..camera.height)
         .into_par_iter()
@@ -40,7 +63,7 @@ pub fn render(
                 return None;
             }
             let row = (0..camera.width)
-                .map(|i| pixel(scene, camera, lighting, shader, aa, i, j))
+                .map(|i| pixel(scene, camera, lighting, shader, aa, weave, i, j))
                 .collect();
             progress(done.fetch_add(1, Ordering::Relaxed) + 1);
             Some(row)
@@ -57,13 +80,38 @@ pub fn render(
     })
 }
 
+/// How a render maps surface points to the weave period (`render --periods`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weave {
+    /// Periods per scene length.
+    pub per_length: f64,
+    /// The angle one sample subtends at the eye, radians.
+    pub sample_angle: f64,
+}
+
+impl Weave {
+    /// The footprint of a sample that meets the surface at `hit`, at distance `t` from the eye,
+    /// seen at cos(theta_o) `cos_o`: the point in period fractions and the side of the square
+    /// of equal area to the sample's footprint on the surface (t angle / sqrt(cos theta_o)).
+    pub fn footprint(&self, hit: &scene::Hit, t: f64, cos_o: f64) -> Footprint {
+        let side = t * self.sample_angle / cos_o.max(1e-3).sqrt();
+        Footprint {
+            u: hit.surface.0 * self.per_length,
+            v: hit.surface.1 * self.per_length,
+            width: side * self.per_length,
+        }
+    }
+}
+
 /// The value of pixel (i, j): the mean of its samples.
+#[allow(clippy::too_many_arguments)]
 fn pixel(
     scene: &Scene,
     camera: &Camera,
     lighting: &Lighting,
     shader: &Shader,
     aa: u32,
+    weave: Option<Weave>,
     i: u32,
     j: u32,
 ) -> [f32; 3] {
@@ -78,7 +126,11 @@ fn pixel(
             if let Some(hit) = scene.intersect(&ray) {
                 let wi = hit.to_local(lighting.light);
                 let wo = hit.to_local(-ray.dir);
-                let v = radiance(shader, lighting, wi, wo);
+                let at = weave.map(|w| {
+                    let t = (hit.point - ray.origin).length();
+                    w.footprint(&hit, t, wo.z)
+                });
+                let v = radiance_at(shader, lighting, wi, wo, at);
                 for k in 0..3 {
                     sum[k] += v[k];
                 }

@@ -44,6 +44,9 @@ pub struct Hit {
     pub weft: Vec3,
     /// Unit warp direction, `normal x weft`: the fabric's local +Y.
     pub warp: Vec3,
+    /// Surface coordinates along the weft and the warp, in scene lengths: (x, y) on the flat
+    /// scenes and the drape (its slopes ignored), (r longitude, r latitude) on the sphere.
+    pub surface: (f64, f64),
 }
 
 impl Hit {
@@ -94,6 +97,13 @@ impl Scene {
         })
     }
 
+    /// The scene's width along x, in scene lengths: what `render --periods N` divides into N
+    /// weave periods.
+    pub fn width(&self) -> f64 {
+        let (lo, hi) = self.bounds();
+        hi.x - lo.x
+    }
+
     /// The corners (low, high) of a box enclosing the scene, for framing the camera.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         let sq = |h: f64, zlo: f64, zhi: f64| (Vec3::new(-h, -h, zlo), Vec3::new(h, h, zhi));
@@ -116,6 +126,7 @@ impl Scene {
             normal: up,
             weft: Vec3::new(1.0, 0.0, 0.0),
             warp: Vec3::new(0.0, 1.0, 0.0),
+            surface: (p.x, p.y),
         };
         match self {
             Scene::Swatch { half } => {
@@ -140,7 +151,11 @@ impl Scene {
                 }
                 let p = ray.at(t);
                 let n = unit(p);
-                Some(frame(p, n, up.cross(n), Vec3::new(1.0, 0.0, 0.0)))
+                let surface = (
+                    radius * p.y.atan2(p.x),
+                    radius * n.z.clamp(-1.0, 1.0).asin(),
+                );
+                Some(frame(p, n, up.cross(n), Vec3::new(1.0, 0.0, 0.0), surface))
             }
             Scene::Drape(d) => d.intersect(ray),
         }
@@ -152,8 +167,8 @@ fn unit(v: Vec3) -> Vec3 {
 }
 
 /// The frame at `p` with normal `n` and weft along `t` projected into the tangent plane
-/// (`fallback` where `t` has no tangential part).
-fn frame(p: Vec3, n: Vec3, t: Vec3, fallback: Vec3) -> Hit {
+/// (`fallback` where `t` has no tangential part), at surface coordinates `surface`.
+fn frame(p: Vec3, n: Vec3, t: Vec3, fallback: Vec3, surface: (f64, f64)) -> Hit {
     let proj = |v: Vec3| v - n * v.dot(n);
     let mut w = proj(t);
     if w.length() < 1e-9 {
@@ -165,6 +180,7 @@ fn frame(p: Vec3, n: Vec3, t: Vec3, fallback: Vec3) -> Hit {
         normal: n,
         weft,
         warp: n.cross(weft),
+        surface,
     }
 }
 
@@ -298,6 +314,7 @@ impl Drape {
             n,
             Vec3::new(1.0, 0.0, hx),
             Vec3::new(0.0, 1.0, 0.0),
+            (x, y),
         )
     }
 

@@ -16,10 +16,15 @@
 //!   for grey cloth);
 //! * where `wo` is at or below the local horizon (the back of the surface) V = 0; where `wi`
 //!   is, only the ambient term remains. There are no cast shadows between parts of the scene.
+//! * with `render --periods N`, f_r is looked up through the pixel's footprint of the weave
+//!   period (`Bsdf::f_at`, docs/spatial.md): a spatial table or the model shows the weave where
+//!   a pixel covers less than a period, and the average beyond. The cloth is drawn opaque (the
+//!   coverage of the gaps is not applied), so a distant render equals the averaged one.
 
 pub use clothbake_core::Component;
 use clothbake_core::{
-    AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FacetModel, SecondaryOptions, UnitVec3, Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FacetModel, Footprint, SecondaryOptions, UnitVec3,
+    Variant,
 };
 
 /// What a picture shades with: a [`Bsdf`] (the analytic model or a baked table, through the
@@ -73,6 +78,11 @@ impl Shader {
         self.bsdf.f(wi, wo).map(|x| x as f32)
     }
 
+    /// f_r through a footprint of the weave period ([`Bsdf::f_at`]).
+    pub fn f_r_at(&self, at: Footprint, wi: UnitVec3, wo: UnitVec3) -> [f32; 3] {
+        self.bsdf.f_at(at, wi, wo).map(|x| x as f32)
+    }
+
     /// The cloth's colour for the ambient term: the diffuse colour over its largest channel.
     pub fn tint(&self) -> [f32; 3] {
         self.tint
@@ -115,13 +125,28 @@ pub fn radiance(
     wi: clothbake_core::Vec3,
     wo: clothbake_core::Vec3,
 ) -> [f64; 3] {
+    radiance_at(shader, lighting, wi, wo, None)
+}
+
+/// As [`radiance`], with f_r seen through footprint `at` of the weave period where one is
+/// given ([`Bsdf::f_at`]; `render --periods`).
+pub fn radiance_at(
+    shader: &Shader,
+    lighting: &Lighting,
+    wi: clothbake_core::Vec3,
+    wo: clothbake_core::Vec3,
+    at: Option<Footprint>,
+) -> [f64; 3] {
     let Some(wo) = UnitVec3::new(wo).filter(|w| w.above_horizon()) else {
         return [0.0; 3];
     };
     let tint = shader.tint();
     let mut v: [f64; 3] = std::array::from_fn(|k| lighting.ambient * f64::from(tint[k]));
     if let Some(wi) = UnitVec3::new(wi).filter(|w| w.above_horizon()) {
-        let f = shader.f_r(wi, wo);
+        let f = match at {
+            Some(at) => shader.f_r_at(at, wi, wo),
+            None => shader.f_r(wi, wo),
+        };
         let ce = wi.cos_theta() * lighting.irradiance;
         for k in 0..3 {
             v[k] += f64::from(f[k]) * ce;

@@ -1091,6 +1091,12 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", value_parser = parse_aa, default_value = "2")]
     pub aa: u32,
 
+    /// Show the weave: N weave periods across the scene's width, f_r looked up at each point of
+    /// the period through the pixel's footprint (a table baked with --spatial, or the model;
+    /// an averaged table looks the same at any N). Without it: the averaged BRDF everywhere.
+    #[arg(long, value_name = "N", value_parser = parse_periods)]
+    pub periods: Option<f64>,
+
     /// Ambient coefficient rho_a (thesis sec. 4.3 uses 0.3).
     #[arg(long, value_name = "RHO_A", value_parser = parse_ambient, default_value = "0.3")]
     pub ambient: f64,
@@ -1232,6 +1238,18 @@ pub fn parse_aa(s: &str) -> Result<u32, String> {
         Ok(n) if (1..=16).contains(&n) => Ok(n),
         _ => Err(format!(
             "`{}` is not a whole number from 1 to 16; give the samples per pixel side, e.g. --aa 2",
+            s.trim()
+        )),
+    }
+}
+
+/// Parses `--periods`: a number of weave periods, more than 0 and at most 10^6.
+pub fn parse_periods(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(n) if n > 0.0 && n <= 1e6 => Ok(n),
+        _ => Err(format!(
+            "`{}` is not a number of weave periods from just above 0 to 1000000; give e.g. \
+             --periods 12",
             s.trim()
         )),
     }

@@ -47,9 +47,10 @@ fn spatial_lines(s: &mut String, sp: &clothbake_loader::Spatial) {
     let (nx, ny) = sp.dims();
     let _ = writeln!(
         s,
-        "spatial    {} classes over {nx} x {ny} crossing cells (warp x weft; docs/spatial.md); \
+        "spatial    {} class{} over {nx} x {ny} crossing cells (warp x weft; docs/spatial.md); \
          each cell shows its class's f_r at its thread's albedo",
-        sp.classes
+        sp.classes,
+        if sp.classes == 1 { "" } else { "es" }
     );
     if nx <= 32 {
         for j in 0..ny.min(32) {

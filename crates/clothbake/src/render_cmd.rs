@@ -192,7 +192,11 @@ pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
     };
     let never = AtomicBool::new(false);
     let img = pool
-        .install(|| renderer::render(&scene, &camera, &lighting, &shader, a.aa, &progress, &never))
+        .install(|| {
+            renderer::render_weave(
+                &scene, &camera, &lighting, &shader, a.aa, a.periods, &progress, &never,
+            )
+        })
         .expect("never cancelled");
     if let Some(b) = &bar {
         b.finish_and_clear();

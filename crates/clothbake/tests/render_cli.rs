@@ -204,3 +204,98 @@ fn plot_writes_png_and_svg() {
     assert!(std::fs::read_to_string(&s).unwrap().contains("theta_i 30"));
     assert!(std::fs::metadata(&p).unwrap().len() > 1000);
 }
+
+/// Renders `table` on the swatch (64 x 48, one sample a pixel), with `--periods` when given,
+/// and returns the linear pixels of its `--exr` output.
+fn swatch_pixels(table: &Path, periods: Option<&str>, name: &str) -> Vec<[f32; 3]> {
+    let (png_path, exr_path) = (temp(&format!("{name}.png")), temp(&format!("{name}.exr")));
+    let mut args = vec![
+        "render",
+        "--table",
+        table.to_str().unwrap(),
+        "--scene",
+        "swatch",
+        "--eye",
+        "0,-30,40",
+        "--res",
+        "64,48",
+        "--aa",
+        "1",
+        "--quiet",
+        "-o",
+        png_path.to_str().unwrap(),
+        "--exr",
+        exr_path.to_str().unwrap(),
+    ];
+    if let Some(n) = periods {
+        args.extend(["--periods", n]);
+    }
+    let out = clothbake(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        &exr_path,
+        |res, _| vec![[0f32; 3]; res.width() * res.height()],
+        |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * 64 + pos.x()] = [r, g, b];
+        },
+    )
+    .unwrap();
+    img.layer_data.channel_data.pixels
+}
+
+#[test]
+fn periods_show_the_weave_up_close_and_the_average_from_afar() {
+    let table = temp("gingham-spatial.exr");
+    let draft = tables().join("gingham.wif");
+    let out = clothbake(&[
+        "bake",
+        "--weave",
+        draft.to_str().unwrap(),
+        "--spatial",
+        "--res",
+        "8,16,8,16",
+        "--quiet",
+        "-o",
+        table.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let avg = swatch_pixels(&table, None, "avg");
+    // Far away every footprint spans a period or more: the averaged table, value for value.
+    assert_eq!(swatch_pixels(&table, Some("100000"), "far"), avg);
+    // Up close the gingham's checks: red-thread and white-thread colours side by side, where
+    // the averaged table shows one colour everywhere.
+    let close = swatch_pixels(&table, Some("12"), "close");
+    let hue = |p: &[f32; 3]| p[1] / p[0];
+    let cloth =
+        |px: &[[f32; 3]]| -> Vec<f32> { px.iter().filter(|p| p[0] > 0.05).map(hue).collect() };
+    let (a, c) = (cloth(&avg), cloth(&close));
+    assert!(a.len() > 500 && c.len() > 500, "{} {}", a.len(), c.len());
+    let spread = |h: &[f32]| {
+        let (lo, hi) = h
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(l, u), &x| (l.min(x), u.max(x)));
+        hi - lo
+    };
+    // The average's hue varies only with the specular share of each pixel.
+    assert!(
+        spread(&c) > 5.0 * spread(&a),
+        "hue spread up close {} against {} on average",
+        spread(&c),
+        spread(&a)
+    );
+    let red = c.iter().filter(|&&h| h < 0.8).count();
+    let white = c.iter().filter(|&&h| h > 0.95).count();
+    assert!(
+        red * 10 > c.len() && white * 10 > c.len(),
+        "checks: {red} red-ish and {white} white-ish of {} cloth pixels",
+        c.len()
+    );
+}
