@@ -7,6 +7,7 @@
  *   D ti pi to po r g b                    clothbake_eval_deg
  *   S wox woy woz u1 u2 wix wiy wiz r g b pdf   clothbake_sample
  *   P wox woy woz wix wiy wiz pdf          clothbake_pdf
+ *   A wix wiy wiz wox woy woz u v width r g b coverage   clothbake_eval_at
  * Floats are printed with 9 significant digits, so they round-trip exactly: the C results
  * must equal the Rust ones bit for bit. Exit status 0 when every check passes.
  */
@@ -65,7 +66,7 @@ int main(int argc, char **argv) {
     }
     static float wis[3 * MAX_EVAL], wos[3 * MAX_EVAL], want[3 * MAX_EVAL], got[3 * MAX_EVAL];
     size_t n_eval = 0;
-    int counts[5] = {0, 0, 0, 0, 0};
+    int counts[6] = {0, 0, 0, 0, 0, 0};
     char tag;
     int line = 0;
     while (fscanf(f, " %c", &tag) == 1) {
@@ -112,6 +113,18 @@ int main(int argc, char **argv) {
             check(clothbake_pdf(b, wo, wi, &pdf) == 0, "pdf returns 0", line);
             check(pdf == w_pdf, "pdf equals the Rust loader", line);
             counts[4]++;
+        } else if (tag == 'A') {
+            float wi[3], wo[3], w[3], w_cov, cov;
+            double u, v, width;
+            if (fscanf(f, "%f %f %f %f %f %f %lf %lf %lf %f %f %f %f", &wi[0], &wi[1], &wi[2],
+                       &wo[0], &wo[1], &wo[2], &u, &v, &width, &w[0], &w[1], &w[2], &w_cov) != 13)
+                break;
+            check(clothbake_eval_at(b, wi, wo, u, v, width, out, &cov) == 0, "eval_at returns 0",
+                  line);
+            check(same3(out, w) && cov == w_cov, "eval_at equals the Rust loader", line);
+            check(clothbake_eval_at(b, wi, wo, u, v, -1.0, out, NULL) == -1,
+                  "eval_at with a negative width fails", line);
+            counts[5]++;
         } else {
             fprintf(stderr, "bad tag %c on line %d\n", tag, line);
             return 2;
@@ -126,7 +139,8 @@ int main(int argc, char **argv) {
     check(clothbake_eval_batch(b, NULL, wos, n_eval, got) == -1, "eval_batch with NULL fails", 0);
     clothbake_close(b);
 
-    printf("checked %d grid, %d eval (and batch), %d eval_deg, %d sample, %d pdf cases: %d failures\n",
-           counts[0], counts[1], counts[2], counts[3], counts[4], failures);
+    printf("checked %d grid, %d eval (and batch), %d eval_deg, %d sample, %d pdf, %d eval_at cases: "
+           "%d failures\n",
+           counts[0], counts[1], counts[2], counts[3], counts[4], counts[5], failures);
     return failures == 0 ? 0 : 1;
 }

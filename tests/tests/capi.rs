@@ -47,8 +47,10 @@ fn the_c_program_agrees_with_the_rust_loader() {
         n_phi_o: 16,
     };
     let fabric = Fabric::from_path(&root().join("tables/twill.json")).unwrap();
+    // A spatial table: the averaged lookups as any table's, and `clothbake_eval_at`'s weave.
     let opts = BakeOptions {
         grid,
+        spatial: true,
         ..BakeOptions::default()
     };
     let table = bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false))
@@ -93,6 +95,21 @@ fn the_c_program_agrees_with_the_rust_loader() {
         )
         .unwrap();
         writeln!(cases, "P {} {} {}", v3(wo), v3(wi), f(b.pdf(wo, wi))).unwrap();
+        // Points of the period (any real numbers) through footprints from a point to beyond a
+        // period; doubles printed to round-trip.
+        let (u, v) = (x as f64 * 0.37 - 20.0, x as f64 * 0.23);
+        let width = [0.0, 0.05, 0.3, 0.9, 1.5][k % 5];
+        let fa = b.eval_at(wi, wo, u, v, width);
+        let ca = b.coverage_at(wo, u, v, width);
+        writeln!(
+            cases,
+            "A {} {} {u:e} {v:e} {width:e} {} {}",
+            v3(wi),
+            v3(wo),
+            v3(fa),
+            f(ca)
+        )
+        .unwrap();
     }
     let cases_path = dir.join("cases.txt");
     std::fs::write(&cases_path, cases).unwrap();
@@ -125,7 +142,7 @@ fn the_c_program_agrees_with_the_rust_loader() {
     );
     assert!(
         stdout.contains(
-            "1 grid, 200 eval (and batch), 200 eval_deg, 200 sample, 200 pdf cases: 0 failures"
+            "1 grid, 200 eval (and batch), 200 eval_deg, 200 sample, 200 pdf, 200 eval_at cases: 0 failures"
         ),
         "{stdout}"
     );

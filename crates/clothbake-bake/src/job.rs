@@ -472,7 +472,21 @@ pub fn check_memory(
         Target::Memory => (rows, Kept::Table(None), None, 0),
     };
     let cells = baked * per_row;
-    let need = memory::peak_bytes(&g, baked, kept).saturating_add(extra);
+    // A spatial bake holds 3 + 2 K values a cell where an averaged one holds 3.
+    let scale = if job.options.spatial {
+        let variant = match job.options.method {
+            crate::sweep::Method::Analytic { variant } => variant,
+            crate::sweep::Method::Raytrace { .. } => Default::default(),
+        };
+        let k = clothbake_core::AnalyticModel::with_variant(job.fabric, job.options.facet, variant)
+            .classes() as u64;
+        3 + 2 * k
+    } else {
+        3
+    };
+    let need = (memory::peak_bytes(&g, baked, kept) / 3)
+        .saturating_mul(scale)
+        .saturating_add(extra);
     match available {
         Some(have) if need > have => Err(invalid(
             format!(
@@ -539,5 +553,51 @@ fn bake_error(e: BakeError) -> JobError {
     match e {
         BakeError::Invalid(m) => JobError::Invalid(m),
         BakeError::Cancelled => JobError::Invalid("the bake was cancelled".into()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clothbake_loader::Grid;
+
+    /// The memory a job asks for: the `need` of [`check_memory`]'s refusal with 1 byte free.
+    fn need(job: &Job<'_>) -> f64 {
+        let e = check_memory(job, None, Some(1)).unwrap_err().to_string();
+        let at = e.find("needs about ").expect("the refusal states the need") + 12;
+        let words: Vec<&str> = e[at..].split_whitespace().take(2).collect();
+        let x: f64 = words[0].parse().unwrap();
+        x * match words[1] {
+            "MB" => 1e6,
+            "GB" => 1e9,
+            u => panic!("unit {u}"),
+        }
+    }
+
+    #[test]
+    fn a_spatial_bake_needs_the_memory_of_its_classes() {
+        // The basket weave has 8 classes: 3 + 16 values a cell against 3.
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables");
+        let f = Fabric::from_path(&dir.join("basket.json")).unwrap();
+        let grid = Grid {
+            n_theta_i: 32,
+            n_phi_i: 64,
+            n_theta_o: 32,
+            n_phi_o: 64,
+        };
+        let avg = BakeOptions {
+            grid,
+            ..BakeOptions::default()
+        };
+        let spatial = BakeOptions {
+            spatial: true,
+            ..avg
+        };
+        let ratio = need(&Job::new(&f, spatial)) / need(&Job::new(&f, avg));
+        // Rounded to MB, and the fixed allowance is scaled too (conservative).
+        assert!(
+            (19.0 / 3.0 - 0.1..19.0 / 3.0 + 0.4).contains(&ratio),
+            "ratio {ratio}"
+        );
     }
 }

@@ -42,6 +42,13 @@ int clothbake_grid(const clothbake_brdf *brdf, uint32_t *out);
 /* f_r(wi, wo) into out[3] (RGB, 1/sr). 0, or -1 on error. */
 int clothbake_eval(const clothbake_brdf *brdf, const float *wi, const float *wo, float *out);
 
+/* f_r at point (u, v) of the weave period (fractions, wrapped) through a footprint of side
+ * `width` periods (0: the crossing cell; >= 1: clothbake_eval) into out[3], and the share of
+ * the footprint in which the eye meets yarn into *coverage (unless NULL). A table baked with
+ * --spatial shows the weave; another answers clothbake_eval and coverage 1. 0, or -1 on error. */
+int clothbake_eval_at(const clothbake_brdf *brdf, const float *wi, const float *wo, double u,
+                      double v, double width, float *out, float *coverage);
+
 /* f_r at angles in degrees (theta from +Z, phi from +X toward +Y) into out[3]. */
 int clothbake_eval_deg(const clothbake_brdf *brdf, float theta_i, float phi_i, float theta_o,
                        float phi_o, float *out);

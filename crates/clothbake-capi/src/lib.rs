@@ -161,6 +161,49 @@ pub unsafe extern "C" fn clothbake_eval(
     })
 }
 
+/// `f_r` at point (`u`, `v`) of the weave period (fractions, wrapped) through a footprint of
+/// side `width` periods (0: the crossing cell; 1 or more: [`clothbake_eval`]), into `out`
+/// (RGB, 1/sr); the share of the footprint in which the eye meets yarn into `coverage` when it
+/// is not NULL. A table baked with `--spatial` shows the weave; another answers
+/// [`clothbake_eval`] and coverage 1. 0, or -1 on error (a NaN or infinite `u`, `v` or `width`,
+/// or a negative `width`).
+///
+/// # Safety
+/// `h` is NULL or an open handle; `wi`, `wo`, `out` are NULL or point to 3 floats;
+/// `coverage` is NULL or points to a float.
+#[no_mangle]
+pub unsafe extern "C" fn clothbake_eval_at(
+    h: *const ClothbakeBrdf,
+    wi: *const f32,
+    wo: *const f32,
+    u: f64,
+    v: f64,
+    width: f64,
+    out: *mut f32,
+    coverage: *mut f32,
+) -> c_int {
+    const F: &str = "clothbake_eval_at";
+    guard(-1, || {
+        let b = brdf(h, F)?;
+        if !(u.is_finite() && v.is_finite()) {
+            return Err(format!(
+                "{F}: the point ({u}, {v}) is not finite; give period fractions"
+            ));
+        }
+        if !(width.is_finite() && width >= 0.0) {
+            return Err(format!(
+                "{F}: width {width} is not a footprint; give its side in periods, >= 0"
+            ));
+        }
+        let (wi, wo) = (vec3(wi, F, "wi")?, vec3(wo, F, "wo")?);
+        put3(out, b.eval_at(wi, wo, u, v, width), F, "out")?;
+        if !coverage.is_null() {
+            *coverage = b.coverage_at(wo, u, v, width);
+        }
+        Ok(0)
+    })
+}
+
 /// `f_r` at polar angles and azimuths in degrees into `out`; 0, or -1 on error.
 ///
 /// # Safety
