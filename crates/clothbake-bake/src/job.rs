@@ -577,7 +577,7 @@ mod tests {
     #[test]
     fn a_spatial_bake_needs_the_memory_of_its_classes() {
         // The basket weave has 8 classes: 3 + 16 values a cell against 3.
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables");
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables");
         let f = Fabric::from_path(&dir.join("basket.json")).unwrap();
         let grid = Grid {
             n_theta_i: 32,
