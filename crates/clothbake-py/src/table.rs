@@ -273,6 +273,22 @@ impl PyTable {
         Ok((f[0], f[1], f[2]))
     }
 
+    /// f_r at point (u, v) of the weave period through a footprint of side `width` periods,
+    /// for one pair of unit vectors (see `eval_at`): the scalar path of the Mitsuba plugin.
+    fn eval1_at(&self, wi: [f64; 3], wo: [f64; 3], u: f64, v: f64, width: f64) -> PyResult<Triple> {
+        check_unit("wi", 0, wi)?;
+        check_unit("wo", 0, wo)?;
+        if !(u.is_finite() && v.is_finite() && width.is_finite() && width >= 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "({u}, {v}) with width {width}: give finite period fractions and a width >= 0"
+            )));
+        }
+        let f = self
+            .brdf
+            .eval_at(wi.map(|x| x as f32), wo.map(|x| x as f32), u, v, width);
+        Ok((f[0], f[1], f[2]))
+    }
+
     /// One importance sample for `wo` (3 floats, unit) and `u1, u2` in [0, 1):
     /// (wi, weight, pdf) as tuples and a float (see `sample`).
     fn sample1(&self, wo: [f64; 3], u1: f64, u2: f64) -> PyResult<(Triple, Triple, f32)> {

@@ -143,14 +143,11 @@ def test_white_furnace_lewis(twill_path, tmp_path, figures_dir):
     assert lum[seen].mean() > 0.3
 
 
-def test_plugin_matches_clothbake_render(twill_path, tmp_path):
-    """The same swatch scene through the plugin and through the project's own renderer.
-
-    `clothbake render --scene swatch` (side 60 on z = 0, weft +X) seen by a pinhole camera
-    that the swatch fills, against a Mitsuba rectangle of the same size (its dp_du is +X) seen
-    by a perspective camera with the same eye, target, +Z up and vertical field of view; the
-    table is the same file for both. No ambient term: each pixel is E f_r cos(theta_i).
-    """
+def swatch_pair(table, tmp_path, periods=None):
+    """The swatch scene of `test_plugin_matches_clothbake_render` through the project's own
+    renderer and through the plugin, on the same table file: (ours, plugin) linear images.
+    With `periods`, both look f_r up at points of the weave period (`render --periods N`
+    across the side 60; the plugin's `periods` per UV unit, the rectangle's UV spanning it)."""
     import os
     import subprocess
 
@@ -160,14 +157,13 @@ def test_plugin_matches_clothbake_render(twill_path, tmp_path):
     import OpenEXR
 
     res, fov, eye, light = 40, 30.0, [0.0, -40.0, 40.0], [0.3, 0.6, 0.74]
-    table = tmp_path / "twill.exr"
-    clothbake.bake(clothbake.Fabric(twill_path), res=(32, 64, 32, 64)).save(table, precision="f32")
     ours = tmp_path / "ours.exr"
+    weave = ["--periods", str(periods)] if periods else []
     subprocess.run(
         [exe, "render", "--table", str(table), "--scene", "swatch", "--eye", ",".join(map(str, eye)),
          "--look-at", "0,0,0", "--light", ",".join(map(str, light)), "--fov", str(fov),
          "--res", str(res), "--aa", "4", "--ambient", "0", "--irradiance", str(E),
-         "-o", str(tmp_path / "ours.png"), "--exr", str(ours), "-q", "--force"],
+         "-o", str(tmp_path / "ours.png"), "--exr", str(ours), "-q", "--force", *weave],
         check=True,
     )
     with OpenEXR.File(str(ours)) as f:
@@ -177,6 +173,9 @@ def test_plugin_matches_clothbake_render(twill_path, tmp_path):
         else:
             img_ours = np.stack([np.asarray(ch[c].pixels, dtype=np.float64) for c in "RGB"], axis=-1)
     to = np.array(light) / np.linalg.norm(light)
+    bsdf = {"type": "clothbake", "table": str(table)}
+    if periods:
+        bsdf["periods"] = float(periods)
     sc = mi.load_dict({
         "type": "scene",
         "integrator": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 0},
@@ -185,15 +184,29 @@ def test_plugin_matches_clothbake_render(twill_path, tmp_path):
             "to_world": mi.ScalarTransform4f().look_at(origin=eye, target=[0, 0, 0], up=[0, 0, 1]),
             "film": {"type": "hdrfilm", "width": res, "height": res, "rfilter": {"type": "box"},
                      "pixel_format": "rgb"},
-            "sampler": {"type": "independent", "sample_count": 16},
+            "sampler": {"type": "independent", "sample_count": 64 if periods else 16},
         },
         "shape": {"type": "rectangle", "to_world": mi.ScalarTransform4f().scale([30, 30, 1]),
-                  "bsdf": {"type": "clothbake", "table": str(table)}},
+                  "bsdf": bsdf},
         "light": {"type": "directional", "direction": (-to).tolist(),
                   "irradiance": {"type": "rgb", "value": [E, E, E]}},
     })
-    img_mi = render(sc, 16)
+    img_mi = render(sc, 64 if periods else 16)
     assert img_ours.shape == img_mi.shape
+    return img_ours, img_mi
+
+
+def test_plugin_matches_clothbake_render(twill_path, tmp_path):
+    """The same swatch scene through the plugin and through the project's own renderer.
+
+    `clothbake render --scene swatch` (side 60 on z = 0, weft +X) seen by a pinhole camera
+    that the swatch fills, against a Mitsuba rectangle of the same size (its dp_du is +X) seen
+    by a perspective camera with the same eye, target, +Z up and vertical field of view; the
+    table is the same file for both. No ambient term: each pixel is E f_r cos(theta_i).
+    """
+    table = tmp_path / "twill.exr"
+    clothbake.bake(clothbake.Fabric(twill_path), res=(32, 64, 32, 64)).save(table, precision="f32")
+    img_ours, img_mi = swatch_pair(table, tmp_path)
     mask = np.ones(img_mi.shape[:2], dtype=bool)
     e = rel_rmse(img_mi, img_ours, mask)
     mirrored = rel_rmse(img_mi[:, ::-1], img_ours, mask)
@@ -201,3 +214,22 @@ def test_plugin_matches_clothbake_render(twill_path, tmp_path):
     assert e < 0.05
     # The comparison sees the cloth's anisotropy: the mirrored image is much farther off.
     assert mirrored > 10 * e
+
+
+def test_plugin_shows_the_weave_of_a_spatial_table(twill_path, tmp_path, figures_dir):
+    """periods=: the plugin's close-up of a spatial gingham against `render --periods`, the
+    same table, the same points of the weave period (an even number of periods: the
+    rectangle's UV origin is the swatch's corner, ours its centre)."""
+    table = tmp_path / "gingham.exr"
+    gingham = clothbake.Fabric(str(twill_path.parent / "gingham.wif"))
+    clothbake.bake(gingham, res=(8, 16, 8, 16), spatial=True).save(table, precision="f32")
+    img_ours, img_mi = swatch_pair(table, tmp_path, periods=6)
+    save_png(np.concatenate([img_mi, img_ours], axis=1), figures_dir / "mitsuba-gingham-close.png")
+    mask = np.ones(img_mi.shape[:2], dtype=bool)
+    e = rel_rmse(img_mi, img_ours, mask)
+    # Against the averaged table (no periods) the close-up is far off: the weave is shown.
+    flat, _ = swatch_pair(table, tmp_path)
+    e_flat = rel_rmse(img_mi, flat, mask)
+    print(f"relative RMSE plugin vs render --periods: {e:.4f} (vs the averaged picture {e_flat:.4f})")
+    assert e < 0.08
+    assert e_flat > 2 * e

@@ -4,7 +4,12 @@ After ``register()``, scenes can use ``{"type": "clothbake", "table": "twill.exr
 baked table: interpolated lookup and the loader's importance sampling) or
 ``{"type": "clothbake", "weave": "tables/twill.json"}`` (the analytic model evaluated
 directly; cosine-weighted sampling). Optional parameters: ``facet`` ("huo" | "lewis", weave
-only), ``two_sided`` (bool, default True).
+only), ``two_sided`` (bool, default True), ``periods`` (float, table only: weave periods per
+unit of the surface's UV; each lookup is then at the point (u, v) * periods of the weave period,
+so a table baked with ``spatial=True`` / ``--spatial`` shows the weave up close,
+docs/spatial.md; the pixel filter and the samples per pixel do the footprint's averaging, so
+use it where a pixel covers about a period or less; farther away leave it out and the
+averaged table answers).
 
 Frame: the cloth's +X (the weft) follows the surface's ``dp_du`` (the U texture direction),
 made orthogonal to the shading normal; +Y (the warp) is ``n x s``, along V on a regular
@@ -59,6 +64,12 @@ def register():
             self._fabric = Fabric(str(props["weave"])) if has_weave else None
             self._facet = str(props.get("facet", "huo"))
             self._two_sided = bool(props.get("two_sided", True))
+            self._periods = float(props["periods"]) if "periods" in props else None
+            if self._periods is not None and (self._table is None or not self._periods > 0.0):
+                raise ValueError(
+                    "clothbake BSDF: periods= (weave periods per UV unit, > 0) goes with table= "
+                    "(a table baked with spatial=True shows the weave)"
+                )
             self._source = str(props["table"] if has_table else props["weave"])
             flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
             if self._two_sided:
@@ -102,7 +113,10 @@ def register():
                 return None
             return light, _unit(eye), frame, flip
 
-        def _f(self, light, eye):
+        def _f(self, light, eye, si=None):
+            if self._table is not None and self._periods is not None and si is not None:
+                u, v = float(si.uv[0]) * self._periods, float(si.uv[1]) * self._periods
+                return self._table.eval1_at(light, eye, u, v, 0.0)
             if self._table is not None:
                 return self._table.eval1(light, eye)
             return self._fabric.eval1(light, eye, self._facet)
@@ -119,7 +133,7 @@ def register():
                 return mi.Color3f(0.0)
             light, eye, _, _ = d
             light = _unit(light)
-            f = self._f(light, eye)
+            f = self._f(light, eye, si)
             return mi.Color3f(f[0], f[1], f[2]) * light[2]
 
         def pdf(self, ctx, si, wo, active=True):
@@ -141,6 +155,10 @@ def register():
             if self._table is not None:
                 light, weight, pdf = self._table.sample1(eye, sample2[0], sample2[1])
                 light = list(light)
+                if self._periods is not None and pdf > 0.0:
+                    # Sampled from the averaged table; weighted by the point's own f_r.
+                    f = self._f(_unit(light), eye, si)
+                    weight = tuple(x * light[2] / pdf for x in f)
             else:
                 w = mi.warp.square_to_cosine_hemisphere(sample2)
                 light = [float(w[0]), float(w[1]), float(w[2])]
@@ -162,7 +180,8 @@ def register():
             pass
 
         def to_string(self):
-            return f"ClothBSDF[source={self._source!r}, two_sided={self._two_sided}]"
+            return (f"ClothBSDF[source={self._source!r}, two_sided={self._two_sided}, "
+                    f"periods={self._periods}]")
 
     if not _REGISTERED:
         mi.register_bsdf("clothbake", lambda props: ClothBSDF(props))
