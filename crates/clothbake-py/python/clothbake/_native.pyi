@@ -63,6 +63,9 @@ class Table:
     def pdf(self, wo: npt.ArrayLike, wi: npt.ArrayLike) -> npt.NDArray[np.float32]:
         """Density (per sr) of sample() drawing wi for wo, (N,)."""
     def eval1(self, wi: Vec3, wo: Vec3) -> Vec3: ...
+    def eval_at(self, wi: npt.ArrayLike, wo: npt.ArrayLike, uv: npt.ArrayLike,
+                width: float = 0.0) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+    def eval1_at(self, wi: Vec3, wo: Vec3, u: float, v: float, width: float) -> Vec3: ...
     def sample1(self, wo: Vec3, u1: float, u2: float) -> Tuple[Vec3, Vec3, float]: ...
     def pdf1(self, wo: Vec3, wi: Vec3) -> float: ...
     def save(self, path: Union[str, "os.PathLike[str]"], precision: str = "f16",
@@ -80,7 +83,7 @@ def bake(fabric: Fabric, res: Tuple[int, int, int, int] = (32, 64, 32, 64), boun
          samples: Optional[int] = None, seed: Optional[int] = None, caps: Optional[str] = None,
          secondary: Optional[str] = None, kernel: Optional[str] = None,
          orders: Optional[str] = None, sampling: Optional[str] = None,
-         checkpoint_every: Optional[float] = None) -> Optional[Table]:
+         checkpoint_every: Optional[float] = None, spatial: bool = False) -> Optional[Table]:
     """Bakes fabric (the `clothbake bake` job): returns the Table (f32), also written to
     `output` if given (atomically, with checkpoints and resume); a shard (`shard="K/N"`) is
     written only and None returned. GIL released, deterministic."""
