@@ -13,7 +13,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::angles::{above_horizon, theta_phi};
 use crate::error::TableError;
+use crate::nodes::Lane;
 use crate::stored::Samples;
 use crate::table::Grid;
 
@@ -213,15 +215,18 @@ impl Axis {
     }
 }
 
-/// A direction as (theta, phi) in degrees, `None` at or below the horizon or not a number.
+/// A unit direction as (theta, phi) in degrees, by the averaged lookup's rules: `None` at or
+/// below the horizon (z <= [`crate::HORIZON_COS`]) or not a number.
 fn angles(w: [f32; 3]) -> Option<(f32, f32)> {
-    let n = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
-    if !(n > 0.0 && w[2] / n > crate::HORIZON_COS) {
+    if w.iter().any(|x| x.is_nan()) || !above_horizon(w) {
         return None;
     }
-    let theta = (w[2] / n).clamp(-1.0, 1.0).acos().to_degrees();
-    let phi = w[1].atan2(w[0]).to_degrees();
-    Some((theta, if phi < 0.0 { phi + 360.0 } else { phi }))
+    let (theta, phi) = theta_phi(w);
+    let phi = phi.to_degrees();
+    Some((
+        theta.to_degrees(),
+        if phi < 0.0 { phi + 360.0 } else { phi },
+    ))
 }
 
 /// The classes' values of a spatial table and its layout, for lookups at a point of the period.
@@ -268,6 +273,19 @@ impl SpatialLookup {
 
     /// Class `k`'s (D, S) at the directions, interpolated over the 16 grid nodes around them.
     fn class_f(&self, k: usize, i: (f32, f32), o: (f32, f32)) -> [f32; 2] {
+        match &self.values {
+            Samples::F16(v) => self.class_f_in(v, k, i, o),
+            Samples::F32(v) => self.class_f_in(v, k, i, o),
+        }
+    }
+
+    fn class_f_in<V: Lane>(
+        &self,
+        values: &[V],
+        k: usize,
+        i: (f32, f32),
+        o: (f32, f32),
+    ) -> [f32; 2] {
         let g = self.grid;
         let (a, b) = (Axis::polar(i.0, g.n_theta_i), Axis::azimuth(i.1, g.n_phi_i));
         let (c, d) = (Axis::polar(o.0, g.n_theta_o), Axis::azimuth(o.1, g.n_phi_o));
@@ -279,8 +297,8 @@ impl SpatialLookup {
                     for (po, wd) in d.taps() {
                         let w = wa * wb * wc * wd;
                         let n = base + g.index(ti as u32, pi as u32, to as u32, po as u32);
-                        out[0] += w * self.values.get(2 * n);
-                        out[1] += w * self.values.get(2 * n + 1);
+                        out[0] += w * values[2 * n].widen();
+                        out[1] += w * values[2 * n + 1].widen();
                     }
                 }
             }
@@ -338,7 +356,19 @@ impl SpatialLookup {
         let (Some(i), Some(o)) = (angles(wi), angles(wo)) else {
             return Some([0.0; 3]);
         };
-        let seen = self.seen(u, v, width.max(0.0));
+        if width.is_nan() || width <= 0.0 {
+            // A point: its cell's f_r, rho_d D + S (its coverage cancels).
+            let l = &self.layout;
+            let (nx, _) = l.dims();
+            let c = Spatial::locate(&l.v_edges, v) * nx + Spatial::locate(&l.u_edges, u);
+            let k = l.cell_class[c] as usize;
+            if self.visible(k, o) <= 0.0 {
+                return Some([0.0; 3]);
+            }
+            let [d, s] = self.class_f(k, i, o);
+            return Some(l.cell_albedo[c].map(|a| (a * d + s).max(0.0)));
+        }
+        let seen = self.seen(u, v, width);
         let (mut num, mut den) = ([0.0f32; 3], 0.0f32);
         for (k, (&share, a)) in seen.share.iter().zip(&seen.albedo).enumerate() {
             if share <= 0.0 {

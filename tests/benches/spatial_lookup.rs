@@ -1,0 +1,73 @@
+//! Spatial lookups (issue 19, docs/spatial.md) beside the averaged lookup, in one run: the
+//! twill baked with `--spatial` on the default grid, held in f16 as a default EXR holds it;
+//! 2^16 distinct random direction pairs and points of the period (not a small cycled set: the
+//! table is 86 MB, far larger than the caches, so each lookup pays for its memory reads).
+//! Medians in docs/spatial.md.
+
+use clothbake_bake::{bake, BakeOptions, DEFAULT_GRID};
+use clothbake_core::Fabric;
+use clothbake_loader::{Brdf, Options, Precision, StoredTable};
+use clothbake_tests::accuracy::{random_pairs, to_f32};
+use criterion::{criterion_group, criterion_main, Criterion};
+use std::hint::black_box;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+/// The pool of inputs, a power of two (the index wraps with a mask).
+const N: usize = 1 << 16;
+
+fn spatial_lookup(c: &mut Criterion) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/twill.json");
+    let fabric = Fabric::from_path(&path).expect("tables/twill.json");
+    let opts = BakeOptions {
+        grid: DEFAULT_GRID,
+        spatial: true,
+        ..BakeOptions::default()
+    };
+    let table = bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false))
+        .expect("bake")
+        .table;
+    let stored = StoredTable::from_table(table, Precision::F16).expect("half-float range");
+    let options = Options {
+        sampling: false,
+        ..Options::default()
+    };
+    let brdf = Brdf::from_stored(stored, options).expect("valid table");
+    let (wi, wo): (Vec<[f32; 3]>, Vec<[f32; 3]>) = random_pairs(N, 7)
+        .iter()
+        .map(|&(a, b)| (to_f32(a), to_f32(b)))
+        .unzip();
+    let mut rng = clothbake_core::rng::Rng::new(11);
+    let uv: Vec<(f64, f64)> = (0..N).map(|_| (rng.next_f64(), rng.next_f64())).collect();
+
+    let mut g = c.benchmark_group("twill_spatial_default_grid_f16");
+    g.bench_function("averaged/eval", |b| {
+        let mut k = 0;
+        b.iter(|| {
+            k = (k + 1) & (N - 1);
+            black_box(brdf.eval(black_box(wi[k]), black_box(wo[k])))
+        })
+    });
+    for (name, width) in [("point", 0.0), ("footprint_0.25", 0.25)] {
+        g.bench_function(format!("spatial/eval_at_{name}"), |b| {
+            let mut k = 0;
+            b.iter(|| {
+                k = (k + 1) & (N - 1);
+                let (u, v) = uv[k];
+                black_box(brdf.eval_at(black_box(wi[k]), black_box(wo[k]), u, v, width))
+            })
+        });
+    }
+    g.bench_function("spatial/coverage_at_point", |b| {
+        let mut k = 0;
+        b.iter(|| {
+            k = (k + 1) & (N - 1);
+            let (u, v) = uv[k];
+            black_box(brdf.coverage_at(black_box(wo[k]), u, v, 0.0))
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, spatial_lookup);
+criterion_main!(benches);
