@@ -50,16 +50,10 @@ pub fn layout(model: &AnalyticModel, g: &Grid) -> Result<Spatial, String> {
     })
 }
 
-/// The classes' values for one pair of directions, appended to `out` three to an entry
-/// (diffuse and specular of class 0, diffuse of class 1, ...; the last entry padded with 0).
-pub fn class_values(
-    model: &AnalyticModel,
-    wi: UnitVec3,
-    wo: UnitVec3,
-    terms: &mut [ClassTerms],
-    out: &mut Vec<[f32; 3]>,
-) {
-    model.class_terms(wi, wo, terms);
+/// The classes' values (from [`AnalyticModel::class_terms`]) appended to `out` three to an
+/// entry (diffuse and specular of class 0, diffuse of class 1, ...; the last entry padded with
+/// 0).
+pub fn class_values(terms: &[ClassTerms], out: &mut Vec<[f32; 3]>) {
     let mut flat = terms.iter().flat_map(|t| [t.diffuse, t.specular]);
     while let Some(a) = flat.next() {
         let b = flat.next().unwrap_or(0.0);

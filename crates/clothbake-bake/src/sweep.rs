@@ -474,11 +474,12 @@ impl Baker {
                 syms.clear();
                 let classes = m.classes();
                 spatial = Some(layout);
-                let bsdf = AnalyticBsdf::new(m, None);
                 Box::new(move |_, wi, wo, out| {
-                    out.push(bsdf.f(wi, wo).map(|x| x as f32));
+                    // The average from the classes: each unit is evaluated once.
                     let mut terms = vec![ClassTerms::default(); classes];
-                    crate::spatial::class_values(bsdf.model(), wi, wo, &mut terms, out);
+                    m.class_terms(wi, wo, &mut terms);
+                    out.push(m.average_of_classes(&terms).map(|x| x as f32));
+                    crate::spatial::class_values(&terms, out);
                 })
             }
             Method::Analytic { variant } => {

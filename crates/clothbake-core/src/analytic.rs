@@ -876,6 +876,28 @@ impl AnalyticModel {
         }
     }
 
+    /// The period's averaged f_r (RGB, 1/sr) from [`AnalyticModel::class_terms`]' `terms`:
+    /// each unit's rho_d D + S weighted by its multiplicity times its class's visible area
+    /// (eq. 4.11). Equal to the f_r of [`AnalyticModel::intensity`] to rounding, without
+    /// evaluating any unit again.
+    pub fn average_of_classes(&self, terms: &[ClassTerms]) -> [f64; 3] {
+        assert_eq!(terms.len(), self.classes(), "one entry per class");
+        let (mut num, mut den) = ([0.0; 3], 0.0);
+        for (u, &c) in self.units.iter().zip(&self.unit_class) {
+            let t = &terms[c as usize];
+            let w = f64::from(u.count) * t.visible;
+            for (n, a) in num.iter_mut().zip(u.seg.material.albedo) {
+                *n += w * (a * t.diffuse + t.specular);
+            }
+            den += w;
+        }
+        if den > 0.0 {
+            num.map(|n| n / den)
+        } else {
+            [0.0; 3]
+        }
+    }
+
     /// The coverage c(x; wo) of a cell alone, as [`AnalyticModel::intensity_in`] reports it,
     /// without the facet terms (0 below the horizon).
     pub fn coverage_in(&self, cell: Cell, wo: UnitVec3) -> f64 {
