@@ -285,6 +285,7 @@ fn convergence(out: &mut String, root: &std::path::Path) {
                         max_bounces: 6,
                         kernel: Kernel::Radiometric,
                         roulette_from: 7,
+                        first_order: 1,
                     },
                 );
                 for (o, r) in ratio.iter_mut().enumerate() {

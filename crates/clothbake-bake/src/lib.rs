@@ -25,5 +25,6 @@ pub mod output;
 pub mod settings;
 pub mod shard;
 pub mod sweep;
+pub mod transport;
 
 pub use sweep::*;
