@@ -5,7 +5,9 @@
 //! * The part varies slowly with direction, so it is estimated on a coarse cell-centred grid
 //!   ([`coarse_grid`], at most [`COARSE`]) and interpolated quadrilinearly in (theta_i, phi_i,
 //!   theta_o, phi_o) (azimuths periodic, polar angles clamped to the outer centres). What is
-//!   interpolated is I / cos(theta_i) (pi f_r), which stays finite toward grazing light.
+//!   interpolated is the residual relative to the analytic direct term I_1 (per channel), which
+//!   a cell multiplies by its own I_1: its noise stays a fixed fraction of I_1 toward the
+//!   horizon, where I_1 falls faster than between two nodes.
 //! * Each node is a pure function of its indices: [`Transport::multiple`] seeded by the node's
 //!   direction pair (`clothbake_core::transport::pair_seed`). Nodes related by a symmetry of
 //!   the fabric take the value of their orbit's representative. The nodes a set of rows needs
@@ -32,8 +34,19 @@ pub const COARSE: Grid = Grid {
     n_phi_o: 16,
 };
 
-/// Primary rays per coarse node.
+/// Primary rays per coarse node and round.
 pub const PATHS: usize = 65_536;
+
+/// A node adds rounds of [`PATHS`] fresh paths until the standard error of its multiple-bounce
+/// part is at most this fraction of the analytic I_1 there ...
+pub const TARGET: f64 = 0.004;
+
+/// ... or it has run this many rounds.
+pub const MAX_ROUNDS: u64 = 8;
+
+fn mean(v: [f64; 3]) -> f64 {
+    (v[0] + v[1] + v[2]) / 3.0
+}
 
 /// Base seed of the node's pair seeds.
 pub const SEED: u64 = 1;
@@ -58,8 +71,10 @@ pub fn describe(table: &Grid, bounces: u32) -> Value {
                    stratified primary rays, uniform hemisphere continuation, roulette from order 4)",
         "coarse_grid": g,
         "paths_per_node": PATHS,
+        "rounds": format!("up to {MAX_ROUNDS}, until the standard error is at most {TARGET} of the analytic I_1"),
+        "control_variate": "the analytic second bounce (ch. 5, radiometric kernel, full ranges, default orders), added per cell",
         "seed": SEED,
-        "interpolation": "quadrilinear in I / cos(theta_i), azimuths periodic, polar angles clamped",
+        "interpolation": "quadrilinear in the residual over the analytic I_1, times the cell's I_1; azimuths periodic, polar angles clamped",
     })
 }
 
@@ -68,10 +83,12 @@ pub struct Multiple {
     transport: Transport,
     /// The control variate: the analytic second bounce (thesis ch. 5, radiometric kernel),
     /// evaluated per cell; the nodes hold the path-traced part minus it.
-    control: Option<(AnalyticModel, SecondaryOptions)>,
+    control: Option<SecondaryOptions>,
+    /// The analytic model: the control variate and the I_1 the nodes' noise is held to.
+    model: AnalyticModel,
     grid: Grid,
     syms: Vec<Symmetry>,
-    /// Per node: I / cos(theta_i) of orders 2 to N, RGB, and the channel mean's standard error.
+    /// Per node: the residual over I_1, RGB, and its channel mean's standard error over I_1.
     nodes: Vec<OnceLock<[f64; 4]>>,
 }
 
@@ -105,16 +122,14 @@ impl Multiple {
         let grid = coarse_grid(table);
         let syms = usable_symmetries(fabric, &grid);
         let transport = Transport::new(RayTracer::new(fabric, facet), bounces, PATHS, SEED);
-        let control = Some((
-            AnalyticModel::new(fabric, facet),
-            SecondaryOptions {
-                kernel: Kernel::Radiometric,
-                ..SecondaryOptions::default()
-            },
-        ));
+        let control = Some(SecondaryOptions {
+            kernel: Kernel::Radiometric,
+            ..SecondaryOptions::default()
+        });
         Multiple {
             transport,
             control,
+            model: AnalyticModel::new(fabric, facet),
             grid,
             syms,
             nodes: (0..grid.len()).map(|_| OnceLock::new()).collect(),
@@ -141,13 +156,14 @@ impl Multiple {
     /// The control variate's options, which the bake's analytic model adds per cell (the
     /// second bounce); `None`: no control variate.
     pub fn control(&self) -> Option<SecondaryOptions> {
-        self.control.as_ref().map(|c| c.1)
+        self.control
     }
 
     /// The analytic second bounce I_2 of the control variate at the pair (zero without one).
     fn control_at(&self, wi: UnitVec3, wo: UnitVec3) -> [f64; 3] {
         match &self.control {
-            Some((m, o)) if wi.above_horizon() && wo.above_horizon() => m
+            Some(o) if wi.above_horizon() && wo.above_horizon() => self
+                .model
                 .intensity_with(wi, wo, Some(o))
                 .secondary
                 .map_or([0.0; 3], |s| s.total()),
@@ -166,8 +182,9 @@ impl Multiple {
         self.grid.index(ti, ri as u32, to, ro as u32)
     }
 
-    /// The estimate at a canonical node: I of orders 2 to N over cos(theta_i), and the standard
-    /// error of its channel mean.
+    /// The estimate at a canonical node: the residual intensity of orders 2 to N over the
+    /// analytic I_1 there, per channel, and the standard error of its channel mean over the
+    /// channel mean of I_1.
     fn compute(&self, node: usize) -> [f64; 4] {
         let g = self.grid;
         let (npo, nto, npi) = (g.n_phi_o as usize, g.n_theta_o as usize, g.n_phi_i as usize);
@@ -177,11 +194,29 @@ impl Multiple {
         let ti = node / (npo * nto * npi);
         let wi = direction(ti as u32, g.n_theta_i, pi as u32, g.n_phi_i);
         let wo = direction(to as u32, g.n_theta_o, po as u32, g.n_phi_o);
-        let p = self.transport.multiple(wi, wo);
-        let e = (p.multiple_err[0] + p.multiple_err[1] + p.multiple_err[2]) / 3.0;
+        // Rounds of `paths` fresh paths until the standard error is at most TARGET of the
+        // analytic I_1 there (or MAX_ROUNDS rounds): the mean of the rounds, equally weighted.
+        let i1v = self.model.intensity(wi, wo).direct();
+        let i1 = mean(i1v);
+        let (mut sum, mut var) = ([0.0; 3], 0.0);
+        let mut rounds = 0;
+        while rounds < MAX_ROUNDS {
+            let p = self.transport.multiple_round(wi, wo, rounds);
+            rounds += 1;
+            for (s, m) in sum.iter_mut().zip(p.multiple) {
+                *s += m;
+            }
+            var += mean(p.multiple_err).powi(2);
+            if var.sqrt() / rounds as f64 <= TARGET * i1 {
+                break;
+            }
+        }
+        let r = rounds as f64;
         let c = self.control_at(wi, wo);
-        let m: [f64; 3] = std::array::from_fn(|k| p.multiple[k] - c[k]);
-        [m[0], m[1], m[2], e].map(|x| x / wi.z)
+        // Relative to the direct term, per channel (zero where there is none).
+        let ratio = |x: f64, i: f64| if i > 0.0 { x / i } else { 0.0 };
+        let m: [f64; 3] = std::array::from_fn(|k| ratio(sum[k] / r - c[k], i1v[k]));
+        [m[0], m[1], m[2], ratio(var.sqrt() / r, i1)]
     }
 
     fn node(&self, node: usize) -> [f64; 4] {
@@ -266,8 +301,13 @@ impl Multiple {
                 }
             }
         }
-        let pi = std::f64::consts::PI;
-        (v.map(|x| x / pi), var.sqrt() / pi)
+        // Back to f_r: times the cell's own I_1, over pi cos(theta_i).
+        let i1 = self.model.intensity(wi, wo).direct();
+        let to_f = std::f64::consts::PI * wi.z;
+        (
+            std::array::from_fn(|k| v[k] * i1[k] / to_f),
+            var.sqrt() * mean(i1) / to_f,
+        )
     }
 }
 

@@ -123,6 +123,23 @@ impl Transport {
         )
     }
 
+    /// As [`Transport::multiple`] with the independent paths of round `round` (round 0 is
+    /// [`Transport::multiple`] itself): more samples for the same pair, still seeded by it.
+    pub fn multiple_round(&self, wi: UnitVec3, wo: UnitVec3, round: u64) -> PathEstimate {
+        let seed = pair_seed(self.seed, wi, wo);
+        self.tracer.render_paths(
+            wi,
+            wo,
+            self.paths,
+            if round == 0 {
+                seed
+            } else {
+                mix64(seed ^ round)
+            },
+            self.options(false),
+        )
+    }
+
     /// Every order 1 to N by the path tracer alone (the ground truth of the whole sum).
     pub fn all_orders(&self, wi: UnitVec3, wo: UnitVec3) -> PathEstimate {
         self.tracer.render_paths(

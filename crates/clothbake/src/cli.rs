@@ -501,7 +501,9 @@ pub struct EvalArgs {
     /// I_ds, I_dd and I_2 (I is then I_1 + I_2); raytrace adds std_err ([r, g, b], null when
     /// too few samples to estimate it) and samples; the analytic model adds
     /// directional_coverage, and with --at also at ([u, v]), cell ([warp, weft]), on_top ("warp"
-    /// or "weft") and coverage.
+    /// or "weft") and coverage. With --bounces N > 2 or all: orders (I_1, I_2, ...) and
+    /// orders_std_err, I_2_parallel, I_2_perpendicular, I_2_split_std_err, I_multiple,
+    /// I_multiple_std_err, paths, seed and converged (docs/transport.md).
     #[arg(long)]
     pub json: bool,
 }
@@ -721,14 +723,15 @@ impl BounceArgs {
         })
     }
 
-    /// An error for a command that evaluates the model per direction (`render`, `export`):
+    /// An error for the commands that evaluate the model per direction (`render`, `plot`,
+    /// `export`; `command` names them):
     /// full transport (--bounces N > 2, all) is path-traced and is made there from a table.
     pub fn model_only(&self, command: &str) -> Result<(), CliError> {
         if self.bounces > 2 {
             return Err(CliError::new(
                 format!(
-                    "{command} --weave evaluates the model per direction and takes --bounces 1 or \
-                     2; --bounces {} path-traces every bounce past the first",
+                    "with --weave, {command} evaluates the model per direction and takes \
+                     --bounces 1 or 2; --bounces {} path-traces every bounce past the first",
                     clothbake_core::transport::bounces_name(self.bounces)
                 ),
                 format!(
