@@ -141,3 +141,49 @@ fn the_multiple_part_is_the_same_for_any_thread_count_and_row_split() {
     assert_eq!(values(2, &[b, a]), one, "two threads, rows in two parts");
     assert_eq!(values(3, &[&rows[5..9]]), one, "nodes computed on demand");
 }
+
+#[test]
+fn a_full_transport_bake_is_bit_identical_for_any_thread_count_and_row_split() {
+    use clothbake_bake::{bake, BakeOptions, Baker};
+    let f = fabric("twill");
+    let o = BakeOptions {
+        grid: Grid {
+            n_theta_i: 2,
+            n_phi_i: 4,
+            n_theta_o: 2,
+            n_phi_o: 4,
+        },
+        bounces: ALL_BOUNCES,
+        ..BakeOptions::default()
+    };
+    let none = AtomicBool::new(false);
+    let with_threads = |n: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .unwrap();
+        pool.install(|| bake(&f, &o, &|_| {}, &none).unwrap().table)
+    };
+    let one = with_threads(1);
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&with_threads(2).values), bits(&one.values));
+    // Two processes (fresh bakers), one row each in turn, as shards or a resumed bake do.
+    let rows: Vec<_> = (0..8)
+        .map(|r| {
+            let b = Baker::new(&f, &o).unwrap();
+            let slot = std::sync::Mutex::new(None);
+            b.sweep(&[r], &|_| {}, &none, &|_, v| {
+                *slot.lock().unwrap() = Some(v)
+            })
+            .unwrap();
+            slot.into_inner().unwrap().unwrap()
+        })
+        .collect();
+    let split = Baker::new(&f, &o).unwrap().table(&rows).unwrap();
+    assert_eq!(bits(&split.values), bits(&one.values));
+    let opts = &one.meta.options_json;
+    assert!(
+        opts.contains("\"bounces\":\"all\"") && opts.contains("coarse_grid"),
+        "{opts}"
+    );
+}
