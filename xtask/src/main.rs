@@ -6,6 +6,9 @@
 //!   `install_capi.rs`).
 //! * `ch5`: the comparisons of thesis sec. 5.4 (sphere, disk, convergence) into
 //!   `docs/interreflection-results.md`.
+//! * `transport`: full light transport (every bounce, path-traced on the micro-geometry): the
+//!   perpendicular share of I_2 and the orders past the second per shipped fabric, the furnace
+//!   test and the orders at n = 1, into `docs/transport.md` (between its `transport` markers).
 //! * `figures`: the thesis's rendered scenes (Figs 4.5, 5.10, 5.11, 5.17) into `docs/figures/`.
 //! * `validate-spatial`: the model per crossing cell against the truth sorted into the same
 //!   cells, written to `docs/validation-spatial.md`.
@@ -30,6 +33,7 @@ mod install_capi;
 mod ir_accuracy;
 mod spatial;
 mod test;
+mod transport;
 
 use clothbake_core::validate::{compare_with, direction_set, Report};
 use clothbake_core::{Caps, Fabric, FacetModel, Variant};
@@ -54,6 +58,7 @@ fn main() {
         "validate" => validate(),
         "validate-spatial" => spatial::run(&root()),
         "ch5" => ch5::run(&root()),
+        "transport" => transport::run(&root(), std::env::args().nth(2).as_deref()),
         "figures" => figures::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
         "golden" => golden(),
         "bench-bake" => bench_bake(std::env::args().skip(2).any(|a| a == "--bounces-2")),
@@ -187,6 +192,17 @@ fn validate() {
         .unwrap();
     }
     let path = root().join("docs/validation.md");
+    // Keep the full-transport section `cargo xtask transport` writes between its markers.
+    let old = std::fs::read_to_string(&path).unwrap_or_default();
+    let keep = old
+        .find("<!-- transport-validation:begin -->")
+        .zip(old.find("<!-- transport-validation:end -->"))
+        .map(|(a, b)| &old[a..b + "<!-- transport-validation:end -->".len()]);
+    out.push('\n');
+    out.push_str(
+        keep.unwrap_or("<!-- transport-validation:begin -->\n<!-- transport-validation:end -->"),
+    );
+    out.push('\n');
     std::fs::write(&path, out).unwrap();
     eprintln!("wrote {}", path.display());
 }

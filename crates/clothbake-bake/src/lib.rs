@@ -26,5 +26,6 @@ pub mod settings;
 pub mod shard;
 pub mod spatial;
 pub mod sweep;
+pub mod transport;
 
 pub use sweep::*;

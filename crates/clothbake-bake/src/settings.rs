@@ -127,7 +127,7 @@ pub struct Settings {
 /// The bounces and the secondary reflection's settings as given.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounces {
-    /// 1 or 2.
+    /// 1, 2, N > 2 or `clothbake_core::ALL_BOUNCES` (docs/transport.md).
     pub bounces: u32,
     /// `Some(true)`: the two-level sampling; `Some(false)`: the analytic solution [default].
     pub sampled: Option<bool>,
@@ -179,6 +179,22 @@ impl Bounces {
                 f("sampling"),
                 n.number("bounces", "2")
             ));
+        }
+        if self.bounces > 2 {
+            if let Some(name) = self.secondary_given() {
+                return Err(format!(
+                    "{} sets the thesis's analytic second bounce, which {} does not use: there \
+                     every order from the second on is path-traced on the micro-geometry \
+                     (radiometric kernel); drop {} or use {}",
+                    f(name),
+                    n.number(
+                        "bounces",
+                        &clothbake_core::transport::bounces_name(self.bounces)
+                    ),
+                    f(name),
+                    n.number("bounces", "2")
+                ));
+            }
         }
         let method = match (self.sampled, self.orders, self.sampling) {
             (None | Some(false), orders, None) => SecondaryMethod::Analytic {

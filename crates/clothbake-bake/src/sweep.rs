@@ -2,7 +2,8 @@
 //!
 //! * Cell-centred grid (see `clothbake_loader::Grid`); values are f_r = I / (pi cos theta_i) in
 //!   1/sr, RGB, from the analytic model (or the ray tracer, for small ground-truth tables). With
-//!   `bounces: 2` the analytic model adds the secondary reflection I_2 (thesis ch. 5).
+//!   `bounces: 2` the analytic model adds the secondary reflection I_2 (thesis ch. 5); with more
+//!   (or all) it adds the path-traced orders 2 to N on a coarse grid ([`crate::transport`]).
 //! * Symmetry: where the fabric's micro-geometry is invariant under mirror x, mirror y or a
 //!   rotation by 180 degrees ([`clothbake_core::symmetry`]), so is its BRDF, exactly. Only one
 //!   cell of each orbit of the symmetry group on the (phi_i, phi_o) indices is evaluated; the
@@ -10,6 +11,7 @@
 //! * Deterministic: every cell is a pure function of the inputs; the parallel sweep collects in
 //!   cell order, so the table is bit-identical for any number of threads.
 
+use crate::transport::Multiple;
 use clothbake_core::interreflection::{Orders, Ranges, Sampling};
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{
@@ -21,7 +23,7 @@ use clothbake_loader::{Grid, Metadata, Table, FORMAT_VERSION};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 /// The default grid: 32 x 64 x 32 x 64 cells (2.8 degrees in theta, 5.6 in phi).
 pub const DEFAULT_GRID: Grid = Grid {
@@ -60,7 +62,9 @@ pub struct BakeOptions {
     pub facet: FacetModel,
     /// Evaluation method.
     pub method: Method,
-    /// Bounces: 1 (direct reflection I_1 only) or 2 (I_1 + the secondary reflection I_2).
+    /// Bounces: 1 (direct reflection I_1 only), 2 (I_1 + the secondary reflection I_2), or more
+    /// (`clothbake_core::ALL_BOUNCES` for all): I_1 plus the path-traced orders 2 to N
+    /// ([`crate::transport`]).
     pub bounces: u32,
     /// How I_2 is computed; used only when `bounces == 2`.
     pub secondary: SecondaryOptions,
@@ -142,6 +146,10 @@ impl BakeOptions {
             }
         }
         v["bounces"] = json!(self.bounces);
+        if self.bounces > 2 {
+            v["bounces"] = json!(clothbake_core::transport::bounces_name(self.bounces));
+            v["transport"] = crate::transport::describe(&self.grid, self.bounces);
+        }
         if self.bounces == 2 {
             let s = self.secondary;
             let mut sec = match s.method {
@@ -242,8 +250,8 @@ pub fn representative(pi: usize, po: usize, syms: &[Symmetry], g: &Grid) -> (usi
     orbit[..len].iter().copied().min().expect("non-empty orbit")
 }
 
-/// Checks that `opts` can be baked: a valid grid, one or two bounces, two bounces only with the
-/// analytic model.
+/// Checks that `opts` can be baked: a valid grid, at least one bounce, more than one only with
+/// the analytic model.
 pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
     opts.grid
         .validate()
@@ -257,15 +265,15 @@ pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
         ));
     }
     match (opts.bounces, opts.method) {
-        (1, _) | (2, Method::Analytic { .. }) => Ok(()),
-        (2, Method::Raytrace { .. }) => Err(BakeError::Invalid(
+        (1, _) | (2.., Method::Analytic { .. }) => Ok(()),
+        (2.., Method::Raytrace { .. }) => Err(BakeError::Invalid(
             "the ray tracer bakes the direct reflection only; use --bounces 1 with --method \
-             raytrace, or --method analytic with --bounces 2"
+             raytrace, or --method analytic with --bounces 2 or all"
                 .into(),
         )),
         (n, _) => Err(BakeError::Invalid(format!(
-            "{n} bounces is not supported; use --bounces 1 (direct reflection) or 2 (direct and \
-             secondary reflection, thesis ch. 5)"
+            "{n} bounces is not supported; use --bounces 1 (direct reflection), 2 (direct and \
+             secondary reflection, thesis ch. 5) or all (every bounce, docs/transport.md)"
         ))),
     }
 }
@@ -457,6 +465,8 @@ pub struct Baker {
     syms: Vec<Symmetry>,
     eval: CellFn,
     meta: Metadata,
+    /// With more than two bounces: the path-traced part's coarse nodes.
+    multiple: Option<Arc<Multiple>>,
 }
 
 impl Baker {
@@ -467,8 +477,10 @@ impl Baker {
         let mut syms = usable_symmetries(fabric, &g);
         let secondary = (opts.bounces == 2).then_some(opts.secondary);
         let mut spatial = None;
-        let eval: CellFn = match opts.method {
-            Method::Analytic { variant } if opts.spatial => {
+        let multiple = (opts.bounces > 2)
+            .then(|| Arc::new(Multiple::new(fabric, opts.facet, &g, opts.bounces)));
+        let eval: CellFn = match (opts.method, multiple.clone()) {
+            (Method::Analytic { variant }, None) if opts.spatial => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
                 let layout = crate::spatial::layout(&m, &g).map_err(BakeError::Invalid)?;
                 syms.clear();
@@ -482,16 +494,29 @@ impl Baker {
                     crate::spatial::class_values(&terms, out);
                 })
             }
-            Method::Analytic { variant } => {
+            (Method::Analytic { variant }, Some(mb)) => {
+                // The analytic direct term and second bounce (the control variate) plus the
+                // interpolated path-traced rest of the orders >= 2.
+                let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
+                let bsdf = AnalyticBsdf::new(m, mb.control());
+                Box::new(move |_, wi, wo, out| {
+                    let (d, r) = (bsdf.f(wi, wo), mb.f(wi, wo));
+                    out.push(std::array::from_fn(|k| (d[k] + r[k]) as f32));
+                })
+            }
+            (Method::Analytic { variant }, None) => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
                 let bsdf = AnalyticBsdf::new(m, secondary);
                 Box::new(move |_, wi, wo, out| out.push(bsdf.f(wi, wo).map(|x| x as f32)))
             }
-            Method::Raytrace {
-                samples,
-                seed,
-                caps,
-            } => {
+            (
+                Method::Raytrace {
+                    samples,
+                    seed,
+                    caps,
+                },
+                _,
+            ) => {
                 let rt = RayTracer::new(fabric, opts.facet).with_caps(caps);
                 Box::new(move |c, wi, wo, out| {
                     let f = rt
@@ -524,6 +549,7 @@ impl Baker {
             syms,
             eval,
             meta,
+            multiple,
         })
     }
 
@@ -577,6 +603,11 @@ impl Baker {
         cancel: &AtomicBool,
         sink: &(dyn Fn(usize, Row) + Sync),
     ) -> Result<(), BakeError> {
+        if let Some(m) = &self.multiple {
+            if !m.prepare(&self.orbits.grid, rows, cancel) {
+                return Err(BakeError::Cancelled);
+            }
+        }
         let done = AtomicU64::new(0);
         rows.par_iter().for_each(|&row| {
             if let Some(vals) = self.eval_row(row, cancel) {
@@ -692,7 +723,7 @@ mod tests {
         for (o, needle) in [
             (
                 BakeOptions {
-                    bounces: 3,
+                    bounces: 0,
                     ..BakeOptions::default()
                 },
                 "--bounces 1",

@@ -22,6 +22,7 @@ pub mod rng;
 pub mod shadowing;
 pub mod source;
 pub mod symmetry;
+pub mod transport;
 pub mod trig;
 pub mod truth;
 mod unit_index;
@@ -41,6 +42,7 @@ pub use facet::{Facet, FacetIntensity, FacetModel};
 pub use geometry::Geometry;
 pub use interreflection::{Kernel, Secondary};
 pub use reflect::{intensity_to_brdf, Reflection};
+pub use transport::{Transport, ALL_BOUNCES};
 /// The path tracer under its former module name.
 pub use truth::pathtracer as pathtrace;
 pub use truth::{Caps, Estimate, PathEstimate, PathOptions, RayTracer};

@@ -108,6 +108,7 @@ fn path_i2(rt: &RayTracer, wi: UnitVec3, wo: UnitVec3, seed: u64, kernel: Kernel
             max_bounces: 2,
             kernel,
             roulette_from: 9,
+            first_order: 1,
         },
     );
     (p.orders[1][0], p.std_err[1][0])

@@ -507,7 +507,9 @@ pub struct EvalArgs {
     /// I_ds, I_dd and I_2 (I is then I_1 + I_2); raytrace adds std_err ([r, g, b], null when
     /// too few samples to estimate it) and samples; the analytic model adds
     /// directional_coverage, and with --at also at ([u, v]), cell ([warp, weft]), on_top ("warp"
-    /// or "weft") and coverage.
+    /// or "weft") and coverage. With --bounces N > 2 or all: orders (I_1, I_2, ...) and
+    /// orders_std_err, I_2_parallel, I_2_perpendicular, I_2_split_std_err, I_multiple,
+    /// I_multiple_std_err, paths, seed and converged (docs/transport.md).
     #[arg(long)]
     pub json: bool,
 }
@@ -673,9 +675,10 @@ pub enum PrecisionArg {
 #[derive(Args, Debug, Clone, Copy, PartialEq)]
 pub struct BounceArgs {
     /// 1: direct reflection; 2: adds the secondary reflection I_2 between neighbouring parallel
-    /// threads (thesis ch. 5; much slower). With `eval --method raytrace` the path tracer
-    /// estimates I_2 (ground truth).
-    #[arg(long, value_name = "1|2", value_parser = parse_bounces, default_value = "1")]
+    /// threads (thesis ch. 5; much slower); N (3 to 64) or all: the direct term plus every
+    /// bounce from the second to N path-traced on the micro-geometry, every yarn
+    /// (docs/transport.md). With `eval --method raytrace` the path tracer estimates every order.
+    #[arg(long, value_name = "1|2|N|all", value_parser = parse_bounces, default_value = "1")]
     pub bounces: u32,
 
     /// With --bounces 2: the secondary reflection's analytic solution (sec. 5.3) or the
@@ -724,6 +727,26 @@ impl BounceArgs {
             "orders" => "--orders",
             _ => "--sampling",
         })
+    }
+
+    /// An error for the commands that evaluate the model per direction (`render`, `plot`,
+    /// `export`; `command` names them):
+    /// full transport (--bounces N > 2, all) is path-traced and is made there from a table.
+    pub fn model_only(&self, command: &str) -> Result<(), CliError> {
+        if self.bounces > 2 {
+            return Err(CliError::new(
+                format!(
+                    "with --weave, {command} evaluates the model per direction and takes \
+                     --bounces 1 or 2; --bounces {} path-traces every bounce past the first",
+                    clothbake_core::transport::bounces_name(self.bounces)
+                ),
+                format!(
+                    "bake a table with `clothbake bake --bounces {}` and give it as --table",
+                    clothbake_core::transport::bounces_name(self.bounces)
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// The secondary-reflection options (also for --bounces 1, where they are unused); the
@@ -950,15 +973,18 @@ pub fn parse_threads(s: &str) -> Result<usize, String> {
     clothbake_bake::settings::parse_threads(s, "--threads")
 }
 
-/// Parses `--bounces 1|2`.
+/// Parses `--bounces 1|2|N|all`: 1 the direct reflection, 2 the thesis's analytic second
+/// bounce, N > 2 or `all` the direct term plus the path-traced orders 2 to N (docs/transport.md).
 pub fn parse_bounces(s: &str) -> Result<u32, String> {
+    const FIX: &str = "give 1 (direct reflection), 2 (direct and the thesis's secondary \
+                       reflection, ch. 5), a whole number N from 3 to 64 or `all` (every \
+                       bounce, path-traced from the second on; docs/transport.md)";
     match s.trim() {
-        "1" => Ok(1),
-        "2" => Ok(2),
-        t => Err(format!(
-            "`{t}` bounces is not supported; give 1 (direct reflection) or 2 (direct and \
-             secondary reflection, thesis ch. 5)"
-        )),
+        "all" => Ok(clothbake_core::ALL_BOUNCES),
+        t => match t.parse::<u32>() {
+            Ok(n @ 1..=64) => Ok(n),
+            _ => Err(format!("`{t}` bounces is not supported; {FIX}")),
+        },
     }
 }
 
@@ -1409,7 +1435,10 @@ mod tests {
         }
         assert!(parse_threads("0").is_err());
         assert_eq!(parse_threads("3").unwrap(), 3);
-        assert!(parse_bounces("3").unwrap_err().contains("give 1"));
+        assert!(parse_bounces("0").unwrap_err().contains("give 1"));
+        assert!(parse_bounces("65").unwrap_err().contains("give 1"));
+        assert_eq!(parse_bounces("3").unwrap(), 3);
+        assert_eq!(parse_bounces(" all").unwrap(), clothbake_core::ALL_BOUNCES);
         assert_eq!(parse_bounces("2").unwrap(), 2);
         assert!(parse_tolerance("-1").is_err());
         assert!(parse_tolerance("inf").is_err());

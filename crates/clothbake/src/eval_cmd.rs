@@ -7,16 +7,24 @@ use clothbake_core::interreflection::Ranges;
 use clothbake_core::pathtrace::PathOptions;
 use clothbake_core::{
     AnalyticModel, Caps, Fabric, FabricError, FacetModel, Kernel, PlainNaming, RayTracer,
-    Reflection, Secondary, SecondaryMethod, SecondaryOptions, Variant,
+    Reflection, Secondary, SecondaryMethod, SecondaryOptions, Transport, Variant,
 };
 use std::path::Path;
 
 /// Runs `clothbake eval` and returns the text to print on stdout.
 pub fn run(args: &EvalArgs) -> Result<String, CliError> {
-    if args.method == Method::Analytic && (args.samples.is_some() || args.seed.is_some()) {
+    let full = args.bounces.bounces > 2;
+    if args.method == Method::Analytic && !full && (args.samples.is_some() || args.seed.is_some()) {
         return Err(CliError::new(
-            "--samples and --seed apply only to the ray tracer",
-            "add --method raytrace or drop them",
+            "--samples and --seed apply only to the ray tracer and the path-traced bounces",
+            "add --method raytrace or --bounces all, or drop them",
+        ));
+    }
+    if full && args.at.is_some() {
+        return Err(CliError::new(
+            "--at resolves the direct reflection per crossing cell; the path-traced bounces of \
+             --bounces N > 2 or all are the period's average",
+            "drop --at or use --bounces 1 or 2",
         ));
     }
     let opts = args.bounces.options()?;
@@ -52,6 +60,12 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     let horizon = !(args.wi.above_horizon() && args.wo.above_horizon());
 
     let mut local = None;
+    let transport = full.then(|| {
+        let samples = args.samples.unwrap_or(DEFAULT_SAMPLES);
+        let seed = args.seed.unwrap_or(DEFAULT_SEED);
+        let tracer = RayTracer::new(&fabric, facet).with_caps(args.caps.into());
+        Transport::new(tracer, args.bounces.bounces, samples, seed)
+    });
     let (reflection, raytrace) = match args.method {
         Method::Analytic => {
             let model = AnalyticModel::with_variant(&fabric, facet, args.model.variant.into());
@@ -91,12 +105,17 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
                     },
                     [0.0; 3],
                 )
+            } else if full {
+                // The direct reflection by the ray tracer; the later orders below.
+                let est = tracer.render(wi, wo, samples, seed);
+                (est.reflection, est.std_err)
             } else if args.bounces.bounces == 2 {
                 // The path tracer: orders 1 and 2, I_2 split into its four components.
                 let opts = PathOptions {
                     max_bounces: 2,
                     kernel,
                     roulette_from: 9,
+                    first_order: 1,
                 };
                 let p = tracer.render_paths(wi, wo, samples, seed, opts);
                 let direct = tracer.render(wi, wo, samples, seed);
@@ -111,13 +130,45 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
             (r, Some(report::Raytrace { std_err, samples }))
         }
     };
+    let transport = transport.map(|t| {
+        let p = t.multiple(wi, wo);
+        let direct = reflection.direct();
+        let direct_err = raytrace.map_or([0.0; 3], |r| r.std_err);
+        // Orders past the last one any path reached carry nothing: leave them out.
+        let last = p
+            .orders
+            .iter()
+            .rposition(|o| o.iter().any(|&x| x != 0.0))
+            .unwrap_or(0)
+            .max(1);
+        let mut orders = vec![direct];
+        orders.extend_from_slice(&p.orders[1..=last.min(p.orders.len() - 1)]);
+        let mut std_err = vec![direct_err];
+        std_err.extend_from_slice(&p.std_err[1..orders.len()]);
+        report::Transport {
+            total: std::array::from_fn(|c| direct[c] + p.multiple[c]),
+            orders,
+            std_err,
+            i2_split: p.i2_split,
+            i2_split_err: p.i2_split_err,
+            multiple: (p.multiple, p.multiple_err),
+            paths: t.paths(),
+            seed: t.seed(),
+        }
+    });
     let brdf = if horizon {
         [0.0; 3]
+    } else if let Some(t) = &transport {
+        clothbake_core::intensity_to_brdf(t.total, wi)
     } else {
         reflection.brdf(wi)
     };
     let bounces = match args.bounces.bounces {
         1 => "1 bounce".to_string(),
+        n if n > 2 => format!(
+            "{} bounces (orders 2 and up path-traced, radiometric kernel)",
+            clothbake_core::transport::bounces_name(n)
+        ),
         n => format!("{n} bounces"),
     };
     let settings = match args.method {
@@ -146,6 +197,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
         brdf,
         raytrace,
         local,
+        transport,
     };
     Ok(if args.json { rep.json() } else { rep.table() })
 }

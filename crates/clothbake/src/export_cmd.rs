@@ -46,6 +46,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
              table)",
         )),
         (Some(weave), None) => {
+            args.bounces.model_only("export")?;
             let secondary = args.bounces.options()?;
             let secondary = (args.bounces.bounces == 2).then_some(secondary);
             let fabric = apply_material(

@@ -20,6 +20,7 @@ use std::time::Instant;
 
 /// The model shader of `--weave`, with its options checked.
 fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
+    b.bounces.model_only("render (and plot)")?;
     let opts = b.bounces.options()?;
     let secondary = (b.bounces.bounces == 2).then_some(opts);
     let component = match b.component {

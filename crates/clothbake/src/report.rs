@@ -27,6 +27,38 @@ pub struct Local {
     pub warp_on_top: bool,
 }
 
+/// Full transport (`--bounces N > 2`, `all`): the energy of every order and the split of I_2.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transport {
+    /// I_1, I_2, ... (I_1 the direct term of the method, the rest path-traced), RGB.
+    pub orders: Vec<[f64; 3]>,
+    /// Their standard errors (I_1's: zero for the analytic model).
+    pub std_err: Vec<[f64; 3]>,
+    /// I_2 by the yarn the light met first: parallel, perpendicular to the visible one.
+    pub i2_split: [[f64; 3]; 2],
+    /// Standard errors of `i2_split`.
+    pub i2_split_err: [[f64; 3]; 2],
+    /// The multiple-bounce part, orders 2 to N, and its standard error.
+    pub multiple: ([f64; 3], [f64; 3]),
+    /// The total I = I_1 + the multiple-bounce part.
+    pub total: [f64; 3],
+    /// Paths per direction pair and the base seed.
+    pub paths: usize,
+    /// Base seed (the pair's seed is hashed from it and the directions).
+    pub seed: u64,
+}
+
+impl Transport {
+    /// Whether the orders die out: orders 16 and up carry at most 0.1% of I_1 (channel means).
+    /// Facets that reflect more than they receive (the thesis's sec. 5.4 material at n = 1,
+    /// docs/transport.md) make the series diverge, and the truncated sum means little.
+    pub fn converged(&self) -> bool {
+        let m = |v: &[f64; 3]| (v[0] + v[1] + v[2]) / 3.0;
+        let tail: f64 = self.orders.iter().skip(15).map(m).sum();
+        tail <= 1e-3 * m(&self.orders[0])
+    }
+}
+
 /// Everything one evaluation prints.
 #[derive(Debug)]
 pub struct Report<'a> {
@@ -59,6 +91,8 @@ pub struct Report<'a> {
     pub raytrace: Option<Raytrace>,
     /// Present for the analytic model.
     pub local: Option<Local>,
+    /// Present with --bounces N > 2 or all.
+    pub transport: Option<Transport>,
 }
 
 impl Report<'_> {
@@ -81,6 +115,20 @@ impl Report<'_> {
         if let Some(rt) = &self.raytrace {
             v["std_err"] = json!(rt.std_err);
             v["samples"] = json!(rt.samples);
+        }
+        if let Some(t) = &self.transport {
+            v["I"] = json!(t.total);
+            v["orders"] = json!(t.orders);
+            v["orders_std_err"] = json!(t.std_err);
+            v["I_2"] = json!(t.orders.get(1).copied().unwrap_or_default());
+            v["I_2_parallel"] = json!(t.i2_split[0]);
+            v["I_2_perpendicular"] = json!(t.i2_split[1]);
+            v["I_2_split_std_err"] = json!(t.i2_split_err);
+            v["I_multiple"] = json!(t.multiple.0);
+            v["I_multiple_std_err"] = json!(t.multiple.1);
+            v["paths"] = json!(t.paths);
+            v["seed"] = json!(t.seed);
+            v["converged"] = json!(t.converged());
         }
         if let Some(l) = &self.local {
             v["directional_coverage"] = json!(l.directional_coverage);
@@ -148,6 +196,13 @@ impl Report<'_> {
                 "note    a direction lies at the horizon: nothing is reflected"
             );
         }
+        if self.transport.as_ref().is_some_and(|t| !t.converged()) {
+            let _ = writeln!(
+                s,
+                "note    the orders do not die out (orders 16 and up carry over 0.1% of I_1): these \
+                 facets reflect more than they receive, the sum is truncated (docs/transport.md)"
+            );
+        }
         let _ = writeln!(s, "{:8}{:>12} {:>12} {:>12}", "", "R", "G", "B");
         let row = |s: &mut String, name: &str, v: [f64; 3], unit: &str| {
             let _ = writeln!(
@@ -165,7 +220,19 @@ impl Report<'_> {
             row(&mut s, "I_dd", s2.dd, "");
             row(&mut s, "I_2", s2.total(), "");
         }
-        row(&mut s, "I", self.reflection.total(), "");
+        if let Some(t) = &self.transport {
+            for (k, (o, e)) in t.orders.iter().zip(&t.std_err).enumerate() {
+                let err = format!("  +- {:.6} {:.6} {:.6}", e[0], e[1], e[2]);
+                row(&mut s, &format!("I_{}", k + 1), *o, &err);
+            }
+            let err = |e: [f64; 3]| format!("  +- {:.6} {:.6} {:.6}", e[0], e[1], e[2]);
+            row(&mut s, "I_2 par", t.i2_split[0], &err(t.i2_split_err[0]));
+            row(&mut s, "I_2 perp", t.i2_split[1], &err(t.i2_split_err[1]));
+            row(&mut s, "I_2..", t.multiple.0, &err(t.multiple.1));
+            row(&mut s, "I", t.total, "");
+        } else {
+            row(&mut s, "I", self.reflection.total(), "");
+        }
         row(&mut s, "brdf", self.brdf, "  1/sr");
         if let Some(l) = &self.local {
             if let Some((_, _, c)) = l.at {

@@ -284,7 +284,7 @@ fn bad_options_are_one_line_errors() {
         (&["--res", "a,b,c,d"], &["not a whole number"]),
         (&["--res", "4096,4096,4096,4096"], &["2^31"]),
         (&["--threads", "0"], &["--threads", "at least 1"]),
-        (&["--bounces", "3"], &["--bounces", "give 1"]),
+        (&["--bounces", "0"], &["--bounces", "give 1"]),
         (&["--format", "png"], &["--format", "exr", "bin"]),
         (
             &["--format", "bin", "--precision", "f32"],

@@ -29,6 +29,9 @@ pub struct PathOptions {
     pub kernel: Kernel,
     /// First order at which Russian roulette may end a path.
     pub roulette_from: usize,
+    /// First order whose light is gathered (orders below it report zero): 2 leaves out the
+    /// direct reflection when another method supplies it and saves its shadow rays.
+    pub first_order: usize,
 }
 
 impl Default for PathOptions {
@@ -37,6 +40,7 @@ impl Default for PathOptions {
             max_bounces: 8,
             kernel: Kernel::Radiometric,
             roulette_from: 4,
+            first_order: 1,
         }
     }
 }
@@ -50,6 +54,16 @@ pub struct PathEstimate {
     pub std_err: Vec<[f64; 3]>,
     /// I_2 split into I_ss, I_sd, I_ds, I_dd.
     pub secondary: Secondary,
+    /// I_2 split by the yarn the light met first (the first bounce seen from the eye's side):
+    /// `[parallel, perpendicular]` to the visible segment (same group, or the crossing group).
+    pub i2_split: [[f64; 3]; 2],
+    /// Standard errors of `i2_split`.
+    pub i2_split_err: [[f64; 3]; 2],
+    /// The sum of every order from 2 to `max_bounces` (the multiple-bounce part), estimated
+    /// jointly, so that its standard error accounts for the orders' correlation.
+    pub multiple: [f64; 3],
+    /// Standard error of `multiple`.
+    pub multiple_err: [f64; 3],
     /// Primary rays that hit (counted) yarn.
     pub yarn_hits: usize,
     /// Primary rays traced.
@@ -62,6 +76,8 @@ struct Acc {
     rays: u64,
     orders: Vec<[f64; 3]>,
     split: [[f64; 3]; 4],
+    pp: [[f64; 3]; 2],
+    multi: [f64; 3],
 }
 
 /// A direction uniform over the hemisphere around `n`.
@@ -137,17 +153,31 @@ impl RayTracer {
         let mut out = wo.get();
         let mut thr = [1.0; 3];
         let mut first: ([f64; 3], f64) = ([0.0; 3], 0.0);
+        let visible = self.cylinder(&at).group;
         for k in 1..=k_max {
             let n = at.normal;
-            let mat = self.cylinder(&at).finish;
+            let cyl = self.cylinder(&at);
+            let mat = cyl.finish;
             // Next-event estimation toward the light.
-            let f = self.terms.shade(&mat, n, wi.get(), out);
+            let f = if k >= opts.first_order {
+                self.terms.shade(&mat, n, wi.get(), out)
+            } else {
+                Default::default()
+            };
             if (f.diffuse > 0.0 || f.specular > 0.0) && self.lit(&at, wi) {
                 let fd: [f64; 3] = std::array::from_fn(|c| f.diffuse * mat.albedo[c]);
                 for c in 0..3 {
-                    acc.orders[k - 1][c] += thr[c] * (fd[c] + f.specular);
+                    let x = thr[c] * (fd[c] + f.specular);
+                    acc.orders[k - 1][c] += x;
+                    if k >= 2 {
+                        acc.multi[c] += x;
+                    }
                 }
                 if k == 2 {
+                    let side = usize::from(cyl.group != visible);
+                    for c in 0..3 {
+                        acc.pp[side][c] += thr[c] * (fd[c] + f.specular);
+                    }
                     let (d0, s0) = first;
                     for c in 0..3 {
                         acc.split[0][c] += s0 * f.specular;
@@ -226,6 +256,10 @@ fn summarise(accs: &[Acc], k_max: usize) -> PathEstimate {
         }
     }
     for c in 0..3 {
+        (est.multiple[c], est.multiple_err[c]) = ratio(&|a: &Acc| a.multi[c]);
+        for side in 0..2 {
+            (est.i2_split[side][c], est.i2_split_err[side][c]) = ratio(&|a: &Acc| a.pp[side][c]);
+        }
         est.secondary.ss[c] = ratio(&|a: &Acc| a.split[0][c]).0;
         est.secondary.sd[c] = ratio(&|a: &Acc| a.split[1][c]).0;
         est.secondary.ds[c] = ratio(&|a: &Acc| a.split[2][c]).0;
@@ -301,6 +335,7 @@ mod tests {
                         max_bounces: 2,
                         kernel,
                         roulette_from: 9,
+                        first_order: 1,
                     },
                 );
                 let (b, e) = (p.orders[1][0], p.std_err[1][0]);
