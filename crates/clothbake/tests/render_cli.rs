@@ -27,6 +27,16 @@ fn clothbake(args: &[&str]) -> Output {
         .expect("run the clothbake binary")
 }
 
+/// Runs the binary and asserts it succeeded.
+fn succeeds(args: &[&str]) {
+    let out = clothbake(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// Exit 2, one line on stderr naming every needle, nothing on stdout.
 fn fails(out: &Output, needles: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
@@ -56,12 +66,7 @@ fn render_writes_png_and_exr_of_the_stated_size() {
         "--exr",
         exr_path.to_str().unwrap(),
     ];
-    let out = clothbake(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeds(&args);
     let dec = png::Decoder::new(std::io::BufReader::new(
         std::fs::File::open(&png_path).unwrap(),
     ));
@@ -159,7 +164,7 @@ fn render_and_plot_refuse_bad_requests_with_one_line() {
 fn render_from_a_table() {
     let t = tables().join("golden/twill.bin");
     let p = temp("table.png");
-    let out = clothbake(&[
+    succeeds(&[
         "render",
         "--table",
         t.to_str().unwrap(),
@@ -171,11 +176,6 @@ fn render_from_a_table() {
         "-o",
         p.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert!(p.exists());
 }
 
@@ -183,7 +183,7 @@ fn render_from_a_table() {
 fn plot_writes_png_and_svg() {
     let (p, s) = (temp("plot.png"), temp("plot.svg"));
     let w = weave("twill");
-    let out = clothbake(&[
+    succeeds(&[
         "plot",
         "--weave",
         &w,
@@ -196,11 +196,6 @@ fn plot_writes_png_and_svg() {
         "-o",
         s.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert!(std::fs::read_to_string(&s).unwrap().contains("theta_i 30"));
     assert!(std::fs::metadata(&p).unwrap().len() > 1000);
 }
@@ -230,12 +225,7 @@ fn swatch_pixels(table: &Path, periods: Option<&str>, name: &str) -> Vec<[f32; 3
     if let Some(n) = periods {
         args.extend(["--periods", n]);
     }
-    let out = clothbake(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeds(&args);
     let img = exr::prelude::read_first_rgba_layer_from_file(
         &exr_path,
         |res, _| vec![[0f32; 3]; res.width() * res.height()],
@@ -251,7 +241,7 @@ fn swatch_pixels(table: &Path, periods: Option<&str>, name: &str) -> Vec<[f32; 3
 fn periods_show_the_weave_up_close_and_the_average_from_afar() {
     let table = temp("gingham-spatial.exr");
     let draft = tables().join("gingham.wif");
-    let out = clothbake(&[
+    succeeds(&[
         "bake",
         "--weave",
         draft.to_str().unwrap(),
@@ -262,11 +252,6 @@ fn periods_show_the_weave_up_close_and_the_average_from_afar() {
         "-o",
         table.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let avg = swatch_pixels(&table, None, "avg");
     // Far away every footprint spans a period or more: the averaged table, value for value.
     assert_eq!(swatch_pixels(&table, Some("100000"), "far"), avg);
