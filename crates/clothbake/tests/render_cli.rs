@@ -73,15 +73,7 @@ fn render_writes_png_and_exr_of_the_stated_size() {
     let info = dec.read_info().unwrap().info().clone();
     assert_eq!((info.width, info.height), (24, 16));
     // The EXR read back by the exr crate's generic reader: same size, finite linear values.
-    let img = exr::prelude::read_first_rgba_layer_from_file(
-        &exr_path,
-        |res, _| vec![[0f32; 3]; res.width() * res.height()],
-        |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            px[pos.y() * 24 + pos.x()] = [r, g, b];
-        },
-    )
-    .unwrap();
-    let px = &img.layer_data.channel_data.pixels;
+    let px = &read_rgb(&exr_path, 24);
     assert_eq!(px.len(), 24 * 16);
     assert!(px.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
     assert!(px.iter().any(|p| p[0] > 0.3), "the lit cloth is in view");
@@ -226,11 +218,16 @@ fn swatch_pixels(table: &Path, periods: Option<&str>, name: &str) -> Vec<[f32; 3
         args.extend(["--periods", n]);
     }
     succeeds(&args);
+    read_rgb(&exr_path, 64)
+}
+
+/// The linear RGB pixels of an EXR `width` pixels wide, read by the exr crate's generic reader.
+fn read_rgb(path: &Path, width: usize) -> Vec<[f32; 3]> {
     let img = exr::prelude::read_first_rgba_layer_from_file(
-        &exr_path,
+        path,
         |res, _| vec![[0f32; 3]; res.width() * res.height()],
         |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            px[pos.y() * 64 + pos.x()] = [r, g, b];
+            px[pos.y() * width + pos.x()] = [r, g, b];
         },
     )
     .unwrap();
