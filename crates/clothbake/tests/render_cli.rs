@@ -226,7 +226,7 @@ fn read_rgb(path: &Path, width: usize) -> Vec<[f32; 3]> {
     let img = exr::prelude::read_first_rgba_layer_from_file(
         path,
         |res, _| vec![[0f32; 3]; res.width() * res.height()],
-        |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+        move |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
             px[pos.y() * width + pos.x()] = [r, g, b];
         },
     )
