@@ -10,17 +10,24 @@
 //!   above the plane toward (0, -cos 75, sin 75), as `cargo xtask ch5`) shaded with I_ss alone
 //!   (Fig. 5.10) and I_2 alone (Fig. 5.11) for n = 1, 2, 4, 8, 16, 24, 32, left to right.
 //!
-//! All are rendered with the model directly (`clothbake render --weave`: exact, no table
+//! * `up-close.png`: the weave up close (docs/spatial.md): the gingham, the twill and the denim
+//!   draft on the swatch seen close (eye (0, -20, 24), 40 degrees of view, light from the
+//!   side toward (0.8, -0.2, 0.56)),
+//!   each from its averaged table (left) and from its spatial table with 16 weave periods
+//!   across the swatch (`render --periods 16`, right); tables baked with `--spatial` on a
+//!   16 x 32 x 16 x 32 grid, direct reflection.
+//!
+//! All but `up-close.png` are rendered with the model directly (`clothbake render --weave`: exact, no table
 //! interpolation; the direct-reflection scenes would render as fast from a table). Tone mapping: clamp + sRGB, one exposure per
 //! figure (Fig. 4.5 and 5.17 share exposure 1, V itself, so the inter-reflection's brightening shows;
 //! each disk figure uses 1 / its largest value over all seven n).
 
 use clothbake_core::{Fabric, FacetModel, SecondaryOptions, Variant, Vec3};
 use clothbake_render::camera::Camera;
-use clothbake_render::render;
 use clothbake_render::scene::Scene;
 use clothbake_render::shade::{Component, Lighting, Shader};
 use clothbake_render::tonemap::{self, Curve, Image};
+use clothbake_render::{render, render_weave};
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -146,6 +153,46 @@ fn disks(dir: &Path, size: u32) {
     eprintln!("disks: {:.1} s", start.elapsed().as_secs_f64());
 }
 
+/// The weave up close: averaged and spatial lookups of spatial tables, side by side.
+fn up_close(root: &Path, dir: &Path, width: u32, height: u32) {
+    let start = Instant::now();
+    let lighting = Lighting {
+        light: unit(Vec3::new(0.8, -0.2, 0.56)),
+        irradiance: std::f64::consts::PI,
+        ambient: 0.3,
+    };
+    let scene = Scene::swatch(30.0);
+    // A close view: the frame filled with cloth (the swatch runs past its edges).
+    let eye = Vec3::new(0.0, -20.0, 24.0);
+    let cam = Camera::new(eye, Vec3::default(), 40.0, width, height).expect("valid camera");
+    let mut images = Vec::new();
+    for file in ["gingham.wif", "twill.json", "denim.wif"] {
+        let f = Fabric::from_path(&root.join("tables").join(file)).unwrap();
+        let opts = clothbake_bake::BakeOptions {
+            grid: clothbake_loader::Grid {
+                n_theta_i: 16,
+                n_phi_i: 32,
+                n_theta_o: 16,
+                n_phi_o: 32,
+            },
+            spatial: true,
+            ..Default::default()
+        };
+        let table = clothbake_bake::bake(&f, &opts, &|_| {}, &AtomicBool::new(false))
+            .expect("bake")
+            .table;
+        let brdf = clothbake_loader::Brdf::from_table(table, Default::default()).unwrap();
+        let s = Shader::new(Box::new(brdf), clothbake_render::shade::fabric_tint(&f));
+        for periods in [None, Some(16.0)] {
+            let never = AtomicBool::new(false);
+            let img = render_weave(&scene, &cam, &lighting, &s, 2, periods, &|_| {}, &never);
+            images.push(img.expect("not cancelled"));
+        }
+    }
+    save(&dir.join("up-close.png"), &montage(&images, 2), 1.0);
+    eprintln!("up-close: {:.1} s", start.elapsed().as_secs_f64());
+}
+
 /// Renders the figures named in `only` (`fig4-5`, `disks` for figs 5.10-5.11, `fig5-17`), or
 /// every figure when `only` is empty, into `docs/figures/`.
 pub fn run(root: &Path, only: &[String]) {
@@ -160,5 +207,8 @@ pub fn run(root: &Path, only: &[String]) {
     }
     if wanted("fig5-17") {
         cloth(root, &dir, 2, 192, 1, "fig5-17.png");
+    }
+    if wanted("up-close") {
+        up_close(root, &dir, 480, 270);
     }
 }

@@ -90,7 +90,7 @@ impl Shader {
 }
 
 /// A fabric's tint: the mean of its two groups' diffuse colours over its largest channel.
-fn fabric_tint(fabric: &Fabric) -> [f32; 3] {
+pub fn fabric_tint(fabric: &Fabric) -> [f32; 3] {
     tint_of(std::array::from_fn(|k| {
         0.5 * (fabric.warp().material.albedo[k] + fabric.weft().material.albedo[k])
     }))
