@@ -2,7 +2,7 @@
 //! the `clothbake bake` command runs: in memory, or into a table or shard file with
 //! checkpoints and resume.
 
-use crate::fabric::{check_bounces, facet_model, PyFabric};
+use crate::fabric::{bounces_arg, facet_model, PyFabric};
 use crate::table::{table_err, PyTable};
 use clothbake_bake::job::{self, Hooks, Job, JobError, Target};
 use clothbake_bake::output::Format;
@@ -85,7 +85,9 @@ fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) ->
 /// thread count, shard split or resume.
 ///
 /// res: (n_theta_i, n_phi_i, n_theta_o, n_phi_o) cells, default (32, 64, 32, 64).
-/// bounces: 1, or 2 to add the secondary reflection (thesis ch. 5; minutes at full res).
+/// bounces: 1 (default), or 2 to add the secondary reflection (thesis ch. 5; minutes at full
+/// res), or N from 3 to 64 or "all": every bounce, path-traced from the second on over the
+/// analytic second bounce on a coarse grid (docs/transport.md; about 5 minutes at full res).
 /// facet: "huo" (default) or "lewis". progress: True prints the percentage done to stderr; a
 /// callable is called as progress(done, total) (cells evaluated) and stops the bake by
 /// returning False (the rows done are kept in the checkpoint; KeyboardInterrupt is raised).
@@ -101,7 +103,7 @@ fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) ->
 /// average (docs/spatial.md; analytic model, bounces=1); look it up with Table.eval_at(wi, wo, uv, width).
 /// Returns the Table (None for a shard).
 #[pyfunction]
-#[pyo3(signature = (fabric, res=(32, 64, 32, 64), bounces=1, facet="huo", progress=None, *,
+#[pyo3(signature = (fabric, res=(32, 64, 32, 64), bounces=None, facet="huo", progress=None, *,
     output=None, overwrite=false, resume=false, shard=None, format=None, precision=None,
     method="analytic", variant=None, samples=None, seed=None, caps=None, secondary=None,
     kernel=None, orders=None, sampling=None, checkpoint_every=None, spatial=false))]
@@ -110,7 +112,7 @@ pub fn bake(
     py: Python<'_>,
     fabric: &PyFabric,
     res: (u32, u32, u32, u32),
-    bounces: u32,
+    bounces: Option<Bound<'_, PyAny>>,
     facet: &str,
     progress: Option<Bound<'_, PyAny>>,
     output: Option<PathBuf>,
@@ -131,7 +133,7 @@ pub fn bake(
     checkpoint_every: Option<f64>,
     spatial: bool,
 ) -> PyResult<Option<PyTable>> {
-    check_bounces(bounces)?;
+    let bounces = bounces_arg(bounces.as_ref())?;
     let grid = Grid {
         n_theta_i: res.0,
         n_phi_i: res.1,

@@ -4,7 +4,7 @@
 use crate::vectors::{check_unit, rows, same_len, to_array, to_array1, unit_rows};
 use clothbake_core::{
     intensity_to_brdf, AnalyticModel, Fabric, FacetModel, LocalReflection, PeriodPoint, RayTracer,
-    Reflection, SecondaryOptions, UnitVec3, Vec3,
+    Reflection, SecondaryOptions, Transport, UnitVec3, Vec3, ALL_BOUNCES,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -23,13 +23,21 @@ pub fn facet_model(name: &str) -> PyResult<FacetModel> {
     }
 }
 
-/// Checks a bounce count (1 or 2).
-pub fn check_bounces(bounces: u32) -> PyResult<()> {
-    if bounces == 1 || bounces == 2 {
-        return Ok(());
+/// Reads a bounce count: absent (1), 1, 2, a whole number N from 3 to 64, or "all"
+/// (`ALL_BOUNCES`; docs/transport.md).
+pub fn bounces_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<u32> {
+    let Some(obj) = obj else {
+        return Ok(1);
+    };
+    if let Ok(n) = obj.extract::<i64>() {
+        if (1..=64).contains(&n) {
+            return Ok(n as u32);
+        }
+    } else if obj.extract::<String>().is_ok_and(|s| s == "all") {
+        return Ok(ALL_BOUNCES);
     }
     Err(PyValueError::new_err(format!(
-        "bounces: {bounces}; use 1 (direct reflection) or 2 (+ the secondary reflection of thesis ch. 5)"
+        "bounces: {obj}; use 1 (direct reflection), 2 (+ the secondary reflection of thesis ch. 5), a whole number N from 3 to 64 or \"all\" (every bounce, path-traced from the second on; docs/transport.md)"
     )))
 }
 
@@ -124,7 +132,10 @@ impl PyFabric {
     ///
     /// method: "analytic" (the thesis's model) or "raytrace" (the exact ray tracer of the same
     /// micro-geometry, `samples` rays per pair, seeded `seed + row`: ground truth, slow).
-    /// bounces: 1, or 2 to add the secondary reflection (thesis ch. 5; analytic only).
+    /// bounces: 1 (default), or 2 to add the secondary reflection (thesis ch. 5; analytic
+    /// only), or N from 3 to 64 or "all": the analytic direct term plus orders 2 to N
+    /// path-traced on the micro-geometry, `samples` paths a pair, seeded from `seed` and the
+    /// pair (docs/transport.md); "secondary" of `split=True` is then that multiple-bounce part.
     /// facet: "huo" (default, eqs 4.6 and 4.8) or "lewis" (energy conserving).
     /// split: also return the diffuse, specular and secondary parts, each as f_r in 1/sr.
     /// uv: points of the weave period, (N, 2) or (2,), in period fractions (u along the weft
@@ -132,7 +143,7 @@ impl PyFabric {
     /// over that crossing instead of the period's average (docs/spatial.md); with `split=True`
     /// the dict also holds "coverage", c(x; wo) per row.
     /// Returns an (N, 3) float64 array, or a dict of them with `split=True`.
-    #[pyo3(signature = (wi, wo, method="analytic", bounces=1, facet="huo", split=false, samples=100_000, seed=1, uv=None))]
+    #[pyo3(signature = (wi, wo, method="analytic", bounces=None, facet="huo", split=false, samples=100_000, seed=1, uv=None))]
     #[allow(clippy::too_many_arguments)]
     fn eval<'py>(
         &self,
@@ -140,7 +151,7 @@ impl PyFabric {
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
         method: &str,
-        bounces: u32,
+        bounces: Option<&Bound<'py, PyAny>>,
         facet: &str,
         split: bool,
         samples: usize,
@@ -148,7 +159,12 @@ impl PyFabric {
         uv: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let facet = facet_model(facet)?;
-        check_bounces(bounces)?;
+        let bounces = bounces_arg(bounces)?;
+        if bounces > 2 && (method != "analytic" || uv.is_some()) {
+            return Err(PyValueError::new_err(
+                "bounces: more than 2 adds path-traced orders to the analytic model's period average; use method=\"analytic\" without uv",
+            ));
+        }
         let wi = unit_rows("wi", wi)?;
         let wo = unit_rows("wo", wo)?;
         same_len(("wi", wi.rows.len()), ("wo", wo.rows.len()))?;
@@ -201,6 +217,24 @@ impl PyFabric {
                     .zip(&pairs)
                     .map(|(l, &(a, _))| parts(&l.reflection, a))
                     .collect()
+            }
+            ("analytic", None) if bounces > 2 => {
+                let m = self.model(facet);
+                let t = Transport::new(RayTracer::new(&self.fabric, facet), bounces, samples, seed);
+                py.detach(|| {
+                    pairs
+                        .par_iter()
+                        .map(|&(a, b)| {
+                            let mut p = parts(&m.intensity(a, b), a);
+                            if a.above_horizon() && b.above_horizon() {
+                                let i = t.multiple(a, b).multiple;
+                                p[3] = intensity_to_brdf(i, a);
+                                p[0] = std::array::from_fn(|k| p[0][k] + p[3][k]);
+                            }
+                            p
+                        })
+                        .collect()
+                })
             }
             ("analytic", None) => {
                 let m = self.model(facet);

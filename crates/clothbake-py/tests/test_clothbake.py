@@ -49,6 +49,25 @@ def test_split_terms_add_up_and_horizon_is_zero(twill_path):
     np.testing.assert_array_equal(fab.eval(below, wo[:1]), 0.0)
 
 
+def test_every_bounce_adds_to_the_analytic_second_bounce(twill_path):
+    # docs/transport.md: the direct term plus path-traced orders 2 to N. On the parallel surface
+    # I_2 is the thesis's analytic second bounce (no perpendicular pairs), so the path-traced
+    # part of orders 2 to N lies above it by the orders past the second.
+    fab = clothbake.Fabric(twill_path.parent / "parallel.json")
+    wi, wo = dirs([30, 50], [180, 20]), dirs([40, 35], [0, 250])
+    two = fab.eval(wi, wo, bounces=2, split=True)
+    three = fab.eval(wi, wo, bounces=3, split=True, samples=200_000)
+    every = fab.eval(wi, wo, bounces="all", split=True, samples=200_000)
+    for s in (three, every):
+        np.testing.assert_allclose(s["brdf"], s["diffuse"] + s["specular"] + s["secondary"], rtol=1e-12)
+        np.testing.assert_array_equal(s["diffuse"], two["diffuse"])
+        assert (s["secondary"] > 0.97 * two["secondary"]).all()
+    assert (every["secondary"] > three["secondary"]).all()
+    np.testing.assert_array_equal(every["brdf"], fab.eval(wi, wo, bounces="all", samples=200_000))
+    with pytest.raises(ValueError, match="analytic"):
+        fab.eval(wi, wo, bounces="all", method="raytrace")
+
+
 def test_points_of_the_period_average_to_the_period(twill_path):
     """docs/spatial.md: the coverage-weighted mean of f_r over the period is the average."""
     fab = clothbake.Fabric(twill_path)
@@ -200,8 +219,9 @@ def test_bad_fabric_names_the_field(twill_path):
     fab = clothbake.Fabric(twill_path)
     with pytest.raises(ValueError, match="facet"):
         fab.eval(dirs([10], [0]), dirs([10], [0]), facet="phong")
-    with pytest.raises(ValueError, match="bounces"):
-        fab.eval(dirs([10], [0]), dirs([10], [0]), bounces=3)
+    for bad in (0, 65, "most", 2.5):
+        with pytest.raises(ValueError, match="bounces"):
+            fab.eval(dirs([10], [0]), dirs([10], [0]), bounces=bad)
     with pytest.raises(ValueError, match="res"):
         clothbake.bake(fab, res=(0, 4, 4, 4))
 

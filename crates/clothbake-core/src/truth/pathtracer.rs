@@ -11,6 +11,12 @@
 //! estimator has finite variance). With [`Kernel::Thesis`] the transition at the visible point
 //! carries the thesis's extra factor pi (N . w) (see [`crate::interreflection`]), and only the
 //! first two orders are meaningful. Russian roulette from order `roulette_from` on.
+//!
+//! Besides the orders it reports their sum from the second on, estimated jointly
+//! ([`PathEstimate::multiple`], what `--bounces all` adds to the analytic direct term, see
+//! `crate::transport`), and I_2 split by the yarn the light met first: parallel to the visible
+//! segment (same group) or perpendicular (the crossing group). `first_order: 2` skips the
+//! shadow rays of the direct reflection when another method supplies it.
 
 use super::estimate::{batch_ratio, BATCHES};
 use super::intersect::Surface;
