@@ -187,6 +187,27 @@ fn footprints_move_from_the_cell_to_the_average() {
             model.coverage(wo_v)
         );
     }
+    // Both kernels (portable and, where the processor has it, AVX2) give the same lookups.
+    let portable = brdf
+        .clone()
+        .with_simd_path(clothbake_loader::SimdPath::Portable)
+        .unwrap();
+    for (k, (wi, wo)) in clothbake_tests::accuracy::random_pairs(500, 3)
+        .into_iter()
+        .enumerate()
+    {
+        let (u, v, w) = (k as f64 * 0.137, k as f64 * 0.291, [0.0, 0.2][k % 2]);
+        let (a, b) = (
+            brdf.eval_at(f32s(wi), f32s(wo), u, v, w),
+            portable.eval_at(f32s(wi), f32s(wo), u, v, w),
+        );
+        for c in 0..3 {
+            assert!(
+                close(f64::from(a[c]), f64::from(b[c]), 1e-5),
+                "{a:?} vs {b:?}"
+            );
+        }
+    }
     // The twill's cells differ: warp floats against weft floats.
     let (wi, wo) = (
         f32s(UnitVec3::from_degrees(52.5, 15.0)),

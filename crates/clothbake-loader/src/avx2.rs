@@ -231,6 +231,17 @@ unsafe fn corner(nodes: &Nodes, pos: __m128) -> Corner {
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
 unsafe fn gather<V: Lane>(nodes: &Nodes, v: &[V], k: &Corner) -> [f32; 3] {
+    let [r, g, b, _] = gather4(nodes, v, k);
+    [r, g, b]
+}
+
+/// [`gather`] of all four lanes.
+///
+/// # Safety
+/// As [`gather`].
+#[inline]
+#[target_feature(enable = "avx2,fma,f16c")]
+unsafe fn gather4<V: Lane>(nodes: &Nodes, v: &[V], k: &Corner) -> [f32; 4] {
     let Corner { base, w, d } = *k;
     let sum = nodes.with_runs(
         v,
@@ -253,13 +264,32 @@ unsafe fn gather<V: Lane>(nodes: &Nodes, v: &[V], k: &Corner) -> [f32; 3] {
         },
     );
     let Some(sum) = sum else {
-        return [0.0; 3];
+        return [0.0; 4];
     };
     let acc = _mm256_mul_ps(sum, d);
     let rgb = _mm_add_ps(_mm256_castps256_ps128(acc), _mm256_extractf128_ps::<1>(acc));
     let mut out = [0f32; 4];
     _mm_storeu_ps(out.as_mut_ptr(), rgb); // 4 f32, unaligned
-    [out[0], out[1], out[2]]
+    out
+}
+
+/// The four lanes of one pair's lookup (no symmetrising): a spatial table's two classes.
+///
+/// # Safety
+/// The processor must have AVX2, FMA and F16C ([`available`]).
+#[inline]
+#[target_feature(enable = "avx2,fma,f16c")]
+pub(crate) unsafe fn eval4<V: Lane>(
+    nodes: &Nodes,
+    v: &[V],
+    wi: [f32; 3],
+    wo: [f32; 3],
+) -> [f32; 4] {
+    let (pos, ok) = positions(nodes, wi, wo);
+    if !ok {
+        return [0.0; 4];
+    }
+    gather4(nodes, v, &corner(nodes, pos))
 }
 
 /// Swaps the incident and outgoing angles: `[theta_o, phi_o, theta_i, phi_i]`.

@@ -182,19 +182,19 @@ impl Brdf {
     pub fn from_stored(table: StoredTable, options: Options) -> Result<Brdf, TableError> {
         let StoredTable { meta, mut samples } = StoredTable::new(table.meta, table.samples)?;
         let g = meta.grid;
+        let f16 = matches!(
+            (&samples, options.memory),
+            (Samples::F16(_), Memory::AsStored)
+        );
         let spatial = meta.spatial.clone().map(|layout| {
             let classes = samples.split_off(3 * g.len());
-            SpatialLookup::new(layout, g, classes)
+            SpatialLookup::new(layout, g, &classes, f16)
         });
         let value = |ti: u32, pi: u32, to: u32, po: u32| -> [f32; 3] {
             let c = 3 * g.index(ti, pi, to, po);
             [samples.get(c), samples.get(c + 1), samples.get(c + 2)]
         };
         let sampler = options.sampling.then(|| Sampler::new(&g, &value));
-        let f16 = matches!(
-            (&samples, options.memory),
-            (Samples::F16(_), Memory::AsStored)
-        );
         let nodes = pad(&g, &value, f16);
         drop(samples);
         let simd = if nodes.lanes.exact {
@@ -225,7 +225,7 @@ impl Brdf {
     pub fn eval_at(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64, width: f64) -> [f32; 3] {
         self.spatial
             .as_ref()
-            .and_then(|s| s.eval_at(wi, wo, u, v, width))
+            .and_then(|s| s.eval_at(self.simd, wi, wo, u, v, width))
             .unwrap_or_else(|| self.eval(wi, wo))
     }
 
@@ -458,23 +458,35 @@ impl Brdf {
 /// The padded node table ([`Nodes`]), where polar row 0 is the pole node (the mean over the
 /// azimuths of the first ring) and row `k + 1` is cell `k`; half floats when `f16`.
 fn pad(g: &Grid, value: &dyn Fn(u32, u32, u32, u32) -> [f32; 3], f16: bool) -> Nodes {
+    pad4(
+        g,
+        &|a, b, c, d| {
+            let [r, g, b] = value(a, b, c, d);
+            [r, g, b, 0.0]
+        },
+        f16,
+    )
+}
+
+/// [`pad`] of four lanes (a spatial table's two classes a node, `crate::spatial`).
+pub(crate) fn pad4(g: &Grid, value: &dyn Fn(u32, u32, u32, u32) -> [f32; 4], f16: bool) -> Nodes {
     let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
     // Mean of `value` over the listed azimuth pairs, in f64, in a fixed order.
-    let mean = |pairs: &mut dyn Iterator<Item = [f32; 3]>| -> [f32; 3] {
-        let (mut sum, mut n) = ([0f64; 3], 0f64);
+    let mean = |pairs: &mut dyn Iterator<Item = [f32; 4]>| -> [f32; 4] {
+        let (mut sum, mut n) = ([0f64; 4], 0f64);
         for x in pairs {
-            for k in 0..3 {
+            for k in 0..4 {
                 sum[k] += f64::from(x[k]);
             }
             n += 1.0;
         }
         sum.map(|s| (s / n) as f32)
     };
-    let pole_i: Vec<[f32; 3]> = (0..nto)
+    let pole_i: Vec<[f32; 4]> = (0..nto)
         .flat_map(|to| (0..npo).map(move |po| (to, po)))
         .map(|(to, po)| mean(&mut (0..npi).map(|pi| value(0, pi, to, po))))
         .collect();
-    let pole_o: Vec<[f32; 3]> = (0..nti)
+    let pole_o: Vec<[f32; 4]> = (0..nti)
         .flat_map(|ti| (0..npi).map(move |pi| (ti, pi)))
         .map(|(ti, pi)| mean(&mut (0..npo).map(|po| value(ti, pi, 0, po))))
         .collect();
@@ -485,7 +497,7 @@ fn pad(g: &Grid, value: &dyn Fn(u32, u32, u32, u32) -> [f32; 3], f16: bool) -> N
         (_, 0) => pole_o[((ri - 1) * npi + pi) as usize],
         _ => value(ri - 1, pi, ro - 1, po),
     };
-    Nodes::new(g, &node, f16)
+    Nodes::new4(g, &node, f16)
 }
 
 #[cfg(test)]

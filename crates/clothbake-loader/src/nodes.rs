@@ -188,8 +188,25 @@ pub(crate) struct Corner {
 
 impl Nodes {
     /// The padded table of `g` from `node(polar row i, phi_i, polar row o, phi_o)` (rows as in
-    /// the module documentation), widened or narrowed by `f16`.
+    /// the module documentation), widened or narrowed by `f16`; the fourth lane 0.
+    #[cfg(test)]
     pub(crate) fn new(g: &Grid, node: &dyn Fn(u32, u32, u32, u32) -> [f32; 3], f16: bool) -> Nodes {
+        Nodes::new4(
+            g,
+            &|a, b, c, d| {
+                let [r, g, b] = node(a, b, c, d);
+                [r, g, b, 0.0]
+            },
+            f16,
+        )
+    }
+
+    /// As [`Nodes::new`] with all four lanes given (a spatial table's two classes a node).
+    pub(crate) fn new4(
+        g: &Grid,
+        node: &dyn Fn(u32, u32, u32, u32) -> [f32; 4],
+        f16: bool,
+    ) -> Nodes {
         let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
         let s_to = LANES * (npo as usize + 1);
         let s_pi = s_to * (nto as usize + 1);
@@ -200,8 +217,7 @@ impl Nodes {
             for pi in 0..npi {
                 for ro in 0..=nto {
                     for po in 0..=npo {
-                        let [r, g, b] = node(ri, pi, ro, po % npo);
-                        out.extend_from_slice(&[r, g, b, 0.0]);
+                        out.extend_from_slice(&node(ri, pi, ro, po % npo));
                     }
                 }
             }
@@ -295,6 +311,13 @@ impl Nodes {
     /// The portable quadrilinear blend at `ang` (see [`Nodes::corner`]) of the values `v`.
     #[inline(always)]
     pub(crate) fn blend<V: Lane>(&self, v: &[V], ang: [f32; 4]) -> [f32; 3] {
+        let [r, g, b, _] = self.blend4(v, ang);
+        [r, g, b]
+    }
+
+    /// [`Nodes::blend`] of all four lanes.
+    #[inline(always)]
+    pub(crate) fn blend4<V: Lane>(&self, v: &[V], ang: [f32; 4]) -> [f32; 4] {
         let k = self.corner(ang);
         let sum = self.with_runs(
             v,
@@ -311,13 +334,14 @@ impl Nodes {
             },
         );
         let Some(acc) = sum else {
-            return [0.0; 3];
+            return [0.0; 4];
         };
         let (u, t) = (1.0 - k.t_po, k.t_po);
         [
             acc[0] * u + acc[4] * t,
             acc[1] * u + acc[5] * t,
             acc[2] * u + acc[6] * t,
+            acc[3] * u + acc[7] * t,
         ]
     }
 }

@@ -14,8 +14,11 @@
 use serde::{Deserialize, Serialize};
 
 use crate::angles::{above_horizon, theta_phi};
+#[cfg(target_arch = "x86_64")]
+use crate::avx2;
 use crate::error::TableError;
-use crate::nodes::Lane;
+use crate::lookup::{pad4, SimdPath};
+use crate::nodes::{Nodes, Values};
 use crate::stored::Samples;
 use crate::table::Grid;
 
@@ -230,12 +233,16 @@ fn angles(w: [f32; 3]) -> Option<(f32, f32)> {
 }
 
 /// The classes' values of a spatial table and its layout, for lookups at a point of the period.
+///
+/// The classes are held two to a node table of the averaged lookup's kind (`crate::nodes`, its
+/// padding, pole rows and kernels): lanes (D, S) of class 2 m and of class 2 m + 1, so that a
+/// point lookup costs one averaged lookup and the cell's location.
 #[derive(Clone, Debug)]
 pub struct SpatialLookup {
     layout: Spatial,
     grid: Grid,
-    /// The classes' (D, S) values: `2 (k N + c) + j`, `N` grid cells.
-    values: Samples,
+    /// Class pair m's nodes.
+    pairs: Vec<Nodes>,
 }
 
 /// What a footprint of the period sees of each class.
@@ -247,13 +254,40 @@ struct Seen {
 }
 
 impl SpatialLookup {
-    /// The lookup of a table's class values (`values`, as [`Spatial::values_len`] counts them).
-    pub(crate) fn new(layout: Spatial, grid: Grid, values: Samples) -> SpatialLookup {
+    /// The lookup of a table's class values (`values`, as [`Spatial::values_len`] counts them),
+    /// held in half floats when `f16`.
+    pub(crate) fn new(layout: Spatial, grid: Grid, values: &Samples, f16: bool) -> SpatialLookup {
         debug_assert_eq!(values.len(), layout.values_len(&grid));
+        let k = layout.classes as usize;
+        let n = grid.len();
+        let pairs = (0..k.div_ceil(2))
+            .map(|m| {
+                let at = |class: usize, c: usize, j: usize| {
+                    if class < k {
+                        values.get(2 * (class * n + c) + j)
+                    } else {
+                        0.0
+                    }
+                };
+                pad4(
+                    &grid,
+                    &|ti, pi, to, po| {
+                        let c = grid.index(ti, pi, to, po);
+                        [
+                            at(2 * m, c, 0),
+                            at(2 * m, c, 1),
+                            at(2 * m + 1, c, 0),
+                            at(2 * m + 1, c, 1),
+                        ]
+                    },
+                    f16,
+                )
+            })
+            .collect();
         SpatialLookup {
             layout,
             grid,
-            values,
+            pairs,
         }
     }
 
@@ -264,46 +298,34 @@ impl SpatialLookup {
 
     /// Bytes held by the class values.
     pub fn memory_bytes(&self) -> usize {
-        let lane = match self.values {
-            Samples::F16(_) => 2,
-            Samples::F32(_) => 4,
+        self.pairs
+            .iter()
+            .map(|p| {
+                let lane = match p.values {
+                    Values::F16(_) => 2,
+                    Values::F32(_) => 4,
+                };
+                lane * p.len()
+            })
+            .sum()
+    }
+
+    /// Class `k`'s (D, S) at the directions, interpolated as the averaged table is (16 nodes,
+    /// pole rows), by `simd`'s kernel.
+    fn class_f(&self, simd: SimdPath, k: usize, wi: [f32; 3], wo: [f32; 3]) -> [f32; 2] {
+        let nodes = &self.pairs[k / 2];
+        let f = match (&nodes.values, simd) {
+            // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C (the
+            // table's `SimdPath`, checked by `Brdf::with_simd_path` and `SimdPath::best`).
+            #[cfg(target_arch = "x86_64")]
+            (Values::F16(v), SimdPath::Avx2) => unsafe { avx2::eval4(nodes, v, wi, wo) },
+            #[cfg(target_arch = "x86_64")]
+            (Values::F32(v), SimdPath::Avx2) => unsafe { avx2::eval4(nodes, v, wi, wo) },
+            (Values::F16(v), _) => nodes.blend4(v, crate::nodes::angles(wi, wo)),
+            (Values::F32(v), _) => nodes.blend4(v, crate::nodes::angles(wi, wo)),
         };
-        lane * self.values.len()
-    }
-
-    /// Class `k`'s (D, S) at the directions, interpolated over the 16 grid nodes around them.
-    fn class_f(&self, k: usize, i: (f32, f32), o: (f32, f32)) -> [f32; 2] {
-        match &self.values {
-            Samples::F16(v) => self.class_f_in(v, k, i, o),
-            Samples::F32(v) => self.class_f_in(v, k, i, o),
-        }
-    }
-
-    fn class_f_in<V: Lane>(
-        &self,
-        values: &[V],
-        k: usize,
-        i: (f32, f32),
-        o: (f32, f32),
-    ) -> [f32; 2] {
-        let g = self.grid;
-        let (a, b) = (Axis::polar(i.0, g.n_theta_i), Axis::azimuth(i.1, g.n_phi_i));
-        let (c, d) = (Axis::polar(o.0, g.n_theta_o), Axis::azimuth(o.1, g.n_phi_o));
-        let base = k * g.len();
-        let mut out = [0.0f32; 2];
-        for (ti, wa) in a.taps() {
-            for (pi, wb) in b.taps() {
-                for (to, wc) in c.taps() {
-                    for (po, wd) in d.taps() {
-                        let w = wa * wb * wc * wd;
-                        let n = base + g.index(ti as u32, pi as u32, to as u32, po as u32);
-                        out[0] += w * values[2 * n].widen();
-                        out[1] += w * values[2 * n + 1].widen();
-                    }
-                }
-            }
-        }
-        out
+        let j = 2 * (k % 2);
+        [f[j], f[j + 1]]
     }
 
     /// Class `k`'s visible share of the period at outgoing angles `o`, interpolated.
@@ -344,6 +366,7 @@ impl SpatialLookup {
     /// (the averaged table answers), `Some(0)` below the horizon.
     pub fn eval_at(
         &self,
+        simd: SimdPath,
         wi: [f32; 3],
         wo: [f32; 3],
         u: f64,
@@ -353,19 +376,19 @@ impl SpatialLookup {
         if width >= 1.0 || !(u.is_finite() && v.is_finite()) {
             return None;
         }
-        let (Some(i), Some(o)) = (angles(wi), angles(wo)) else {
+        if angles(wi).is_none() {
+            return Some([0.0; 3]);
+        }
+        let Some(o) = angles(wo) else {
             return Some([0.0; 3]);
         };
         if width.is_nan() || width <= 0.0 {
-            // A point: its cell's f_r, rho_d D + S (its coverage cancels).
+            // A point: its cell's f_r, rho_d D + S (its coverage cancels; where the class is
+            // not seen, D and S are 0).
             let l = &self.layout;
             let (nx, _) = l.dims();
             let c = Spatial::locate(&l.v_edges, v) * nx + Spatial::locate(&l.u_edges, u);
-            let k = l.cell_class[c] as usize;
-            if self.visible(k, o) <= 0.0 {
-                return Some([0.0; 3]);
-            }
-            let [d, s] = self.class_f(k, i, o);
+            let [d, s] = self.class_f(simd, l.cell_class[c] as usize, wi, wo);
             return Some(l.cell_albedo[c].map(|a| (a * d + s).max(0.0)));
         }
         let seen = self.seen(u, v, width);
@@ -378,7 +401,7 @@ impl SpatialLookup {
             if vis <= 0.0 {
                 continue;
             }
-            let [d, s] = self.class_f(k, i, o);
+            let [d, s] = self.class_f(simd, k, wi, wo);
             for (n, a) in num.iter_mut().zip(a) {
                 *n += vis * (a * d + share * s);
             }
