@@ -16,8 +16,41 @@
 //!   the line's normal (-sin psi, cos psi): the numerators of eqs 3.4 and 3.5;
 //! * common tangent of two discs: eqs 3.7 (disc-disc), 3.8 (disc-corner), 3.9 (corner-disc).
 
-use crate::arc::{Arc, Projected};
-use std::f64::consts::FRAC_PI_2;
+use crate::arc::{ArcTrig, Projected};
+use crate::trig::{asin, atan2, sin_cos};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// An elevation psi with its sine and cosine, computed once per direction and shared by the
+/// formulas that need them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Elevation {
+    /// psi.
+    pub psi: f64,
+    /// sin(psi).
+    pub sin: f64,
+    /// cos(psi).
+    pub cos: f64,
+}
+
+impl Elevation {
+    /// Elevation `psi`.
+    pub fn new(psi: f64) -> Elevation {
+        let (sin, cos) = psi.sin_cos();
+        Elevation { psi, sin, cos }
+    }
+
+    /// The elevation of a direction that rises `rise` per `run` outward (`run` > 0, not both
+    /// zero): psi = atan2(rise, run), the sine and cosine from the components (inline).
+    #[inline]
+    pub fn of(rise: f64, run: f64) -> Elevation {
+        let len = (rise * rise + run * run).sqrt();
+        Elevation {
+            psi: atan2(rise, run),
+            sin: rise / len,
+            cos: run / len,
+        }
+    }
+}
 
 /// An occluder in a profile: a disc centred at (`u`, `z`) of radius `rho` (0 for a rectangle corner).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -272,29 +305,33 @@ pub enum ArcOcclusion {
 /// elevation `psi` by occluder `o` (eqs 3.2-3.5): theta = psi + asin(s / r1) where `s` is the
 /// support line's offset from the circle's centre.
 pub fn occluded_arc(r1: f64, h1: f64, o: &Occluder, psi: f64) -> ArcOcclusion {
-    let (sp, cp) = psi.sin_cos();
-    let s = o.support(sp, cp) - h1 * cp;
+    occluded_arc_at(r1, h1, o, &Elevation::new(psi))
+}
+
+/// [`occluded_arc`] with the elevation's sine and cosine given.
+#[inline]
+pub fn occluded_arc_at(r1: f64, h1: f64, o: &Occluder, psi: &Elevation) -> ArcOcclusion {
+    let s = o.support(psi.sin, psi.cos) - h1 * psi.cos;
     if s <= -r1 {
         ArcOcclusion::None
     } else if s >= r1 {
         ArcOcclusion::All
     } else {
-        ArcOcclusion::UpTo(psi + (s / r1).asin())
+        ArcOcclusion::UpTo(psi.psi + asin(s / r1))
     }
 }
 
 /// Length of the flat top (height `top`, starting at u = 0 and running toward -u) of an
 /// equal-area rectangle hidden by occluder `o` from direction of elevation `psi` (eq. 3.6):
 /// l = (s - top cos psi) / sin psi, at least 0 (infinite at grazing elevation when hidden).
-pub fn occluded_length(top: f64, o: &Occluder, psi: f64) -> f64 {
-    let (sp, cp) = psi.sin_cos();
-    let num = o.support(sp, cp) - top * cp;
+pub fn occluded_length(top: f64, o: &Occluder, psi: &Elevation) -> f64 {
+    let num = o.support(psi.sin, psi.cos) - top * psi.cos;
     if num <= 0.0 {
         0.0
-    } else if sp <= 0.0 {
+    } else if psi.sin <= 0.0 {
         f64::INFINITY
     } else {
-        num / sp
+        num / psi.sin
     }
 }
 
@@ -306,53 +343,63 @@ pub fn mean_occluded_length(
     r: f64,
     h: f64,
     o: &Occluder,
-    psi: f64,
-    arc: Arc,
+    psi: &Elevation,
+    arc: &ArcTrig,
     e: Projected,
     max_len: f64,
 ) -> f64 {
-    let (sp, cp) = psi.sin_cos();
-    if arc.is_empty() || sp <= 0.0 {
+    let (sp, cp) = (psi.sin, psi.cos);
+    if arc.arc.is_empty() || sp <= 0.0 {
         return occluded_length(crate::geometry::equal_area_height(r, h), o, psi).min(max_len);
     }
+    let (lo, hi) = (arc.arc.lo, arc.arc.hi);
     // l(theta) = a - b sin(theta)
     let a = (o.support(sp, cp) - h * cp) / sp;
     let b = r * cp / sp;
-    // Break points: sin(theta) = a / b (l = 0) and (a - max_len) / b (l = max_len).
-    let mut cuts = [0.0f64; 8];
-    cuts[0] = arc.lo;
+    // Break points (theta, sin, cos): sin(theta) = a / b (l = 0) and (a - max_len) / b
+    // (l = max_len); their cosines from the sines.
+    let mut cuts = [(0.0f64, 0.0f64, 0.0f64); 8];
+    cuts[0] = (lo, arc.lo.0, arc.lo.1);
     let mut n = 1;
     if b > 0.0 {
         for x in [a / b, (a - max_len) / b] {
             if x.abs() < 1.0 {
-                let t = x.asin();
-                for c in [t, std::f64::consts::PI - t, t - 2.0 * std::f64::consts::PI] {
-                    if c > arc.lo && c < arc.hi {
-                        cuts[n] = c;
+                let t = asin(x);
+                let c = ((1.0 - x) * (1.0 + x)).sqrt();
+                for cut in [(t, x, c), (PI - t, x, -c), (t - 2.0 * PI, x, c)] {
+                    if cut.0 > lo && cut.0 < hi {
+                        cuts[n] = cut;
                         n += 1;
                     }
                 }
             }
         }
     }
-    cuts[n] = arc.hi;
+    cuts[n] = (hi, arc.hi.0, arc.hi.1);
     let cuts = &mut cuts[..=n];
-    cuts.sort_unstable_by(f64::total_cmp);
-    // Primitives of w = e.c cos + e.z sin and of sin * w.
-    let pw = |t: f64| e.c * t.sin() - e.z * t.cos();
-    let psw = |t: f64| e.c * 0.5 * t.sin().powi(2) + e.z * (0.5 * t - 0.25 * (2.0 * t).sin());
+    // Insertion sort by angle (at most 8 entries, most often 2).
+    for i in 1..cuts.len() {
+        let mut j = i;
+        while j > 0 && cuts[j - 1].0 > cuts[j].0 {
+            cuts.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+    // Primitives of w = e.c cos + e.z sin and of sin * w (sin 2t / 4 = sin t cos t / 2).
+    let pw = |(_, s, c): (f64, f64, f64)| e.c * s - e.z * c;
+    let psw = |(t, s, c): (f64, f64, f64)| e.c * 0.5 * s * s + e.z * 0.5 * (t - s * c);
     let (mut num, mut den) = (0.0, 0.0);
     for w in cuts.windows(2) {
-        let (t0, t1) = (w[0], w[1]);
-        let l_mid = a - b * (0.5 * (t0 + t1)).sin();
-        let wsum = pw(t1) - pw(t0);
+        let (p0, p1) = (w[0], w[1]);
+        let l_mid = a - b * sin_cos(0.5 * (p0.0 + p1.0)).0;
+        let wsum = pw(p1) - pw(p0);
         den += wsum;
         num += if l_mid <= 0.0 {
             0.0
         } else if l_mid >= max_len {
             max_len * wsum
         } else {
-            a * wsum - b * (psw(t1) - psw(t0))
+            a * wsum - b * (psw(p1) - psw(p0))
         };
     }
     if den <= 0.0 {
@@ -365,7 +412,6 @@ pub fn mean_occluded_length(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
 
     /// Eq. 3.4 as printed: segment 1 (radius r1) hidden by the rectangle of height h at gap d.
     fn eq_3_4(r1: f64, d: f64, h: f64, psi: f64) -> f64 {
@@ -410,7 +456,7 @@ mod tests {
             };
             let want = eq_3_6(r2, d, top, psi).max(0.0);
             assert!(
-                (occluded_length(top, &disc, psi) - want).abs() < 1e-12,
+                (occluded_length(top, &disc, &Elevation::new(psi)) - want).abs() < 1e-12,
                 "{deg}"
             );
         }
@@ -474,7 +520,7 @@ mod tests {
             rho: 1.5,
         };
         let e = Projected { c: 0.4, z: 0.8 };
-        let arc = Arc { lo: 0.1, hi: 2.9 };
+        let arc = crate::arc::Arc { lo: 0.1, hi: 2.9 };
         for deg in [15.0, 30.0, 50.0, 75.0] {
             let psi = f64::to_radians(deg);
             let (r, h, max_len) = (1.5, 0.2, 2.0);
@@ -486,7 +532,15 @@ mod tests {
             let w = |t: f64| e.c * t.cos() + e.z * t.sin();
             let num = crate::quad::integrate(&mut |t| pointwise(t) * w(t), arc.lo, arc.hi, 1e-12);
             let den = crate::quad::integrate(&mut |t| w(t), arc.lo, arc.hi, 1e-12);
-            let got = mean_occluded_length(r, h, &o, psi, arc, e, max_len);
+            let got = mean_occluded_length(
+                r,
+                h,
+                &o,
+                &Elevation::new(psi),
+                &ArcTrig::new(arc),
+                e,
+                max_len,
+            );
             assert!(
                 (got - num / den).abs() < 1e-6,
                 "{deg}: {got} vs {}",
