@@ -17,7 +17,8 @@
 //! 4. the area-weighted average I = sum D_i I_i / sum D_i S_v,i (eq. 4.11 and its pseudocode).
 
 use crate::arc::{
-    diffuse_integral, huo_specular_integral, projected_width, Arc, ArcTrig, Polar, Projected,
+    diffuse_integral, huo_specular_integral, projected_width, Arc, ArcTrig, Heading, Polar,
+    Projected,
 };
 use crate::cells::{Cell, CellGrid, PeriodPoint};
 use crate::fabric::{Fabric, Material};
@@ -36,7 +37,7 @@ use crate::shadowing::{
 use crate::unit_index::UnitIndex;
 use crate::vec3::{UnitVec3, Vec3};
 use crate::weave::Group;
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
 /// Below this, a projected component counts as zero (direction in a symmetry plane).
 const EPS: f64 = 1e-12;
@@ -50,7 +51,7 @@ struct SegmentData {
     /// Height of the segment's equal-area rectangle (eq. 3.1), its top in axial profiles.
     top: f64,
     /// The arc of its cross-section above the floor.
-    floor: Arc,
+    floor: ArcTrig,
     /// Extent along the axis; `None` when endless.
     extent: Option<(f64, f64)>,
     /// Occluders beyond the +axis end and beyond the -axis end.
@@ -242,7 +243,7 @@ struct Views {
     l: View,
     e: View,
     /// The projected unit half vector (L + E) / |L + E|, for the Huo facets' closed form.
-    h: Polar,
+    h: Heading,
 }
 
 impl Views {
@@ -253,7 +254,7 @@ impl Views {
         let [ew, ef] = View::both(e);
         let h = l + e;
         let h = h * (1.0 / h.length());
-        let hp = |c: f64| Polar::new(Projected { c, z: h.z });
+        let hp = |c: f64| Heading::new(Projected { c, z: h.z });
         [
             Views {
                 l: lw,
@@ -536,7 +537,7 @@ impl AnalyticModel {
                 radius: seg.radius,
                 height: seg.height,
                 top,
-                floor: Arc::above_floor(seg.radius, seg.height),
+                floor: ArcTrig::new(Arc::above_floor(seg.radius, seg.height)),
                 extent: seg.extent,
                 end_plus,
                 end_minus,
@@ -754,11 +755,10 @@ impl AnalyticModel {
     /// What of unit `u` is visible from the eye's view `e`: `None` where nothing is.
     fn visible(&self, u: &Unit, e: &View) -> Option<Visible> {
         let seg = &u.seg;
-        let arc = self.side_arc(u, e).meet(seg.floor);
-        if arc.is_empty() {
+        let arc = self.side_arc(u, e).meet(&seg.floor);
+        if arc.arc.is_empty() {
             return None;
         }
-        let arc = ArcTrig::new(arc);
         let along = self.end_interval(u, e, &arc, e.p.p);
         let l_v = overlap(u.range, along);
         if l_v <= 0.0 {
@@ -787,14 +787,14 @@ impl AnalyticModel {
         let seg = &u.seg;
         let v = self.visible(u, &views.e)?;
         let ep = views.e.p.p;
-        let lit = self.side_arc(u, &views.l).meet(seg.floor);
-        let vi = v.arc.meet(lit);
+        let lit = self.side_arc(u, &views.l).meet(&seg.floor);
+        let vi = v.arc.meet(&lit);
         let lit_len = self.end_interval(u, &views.l, &vi, ep);
         let secondary = secondary.map_or_else(Vec::new, |opts| {
             let (l, e) = (wi.get(), wo.get());
             variants
                 .iter()
-                .map(|(nbs, n)| (self.secondary(u, nbs, opts, l, e, v.arc.arc, lit), *n))
+                .map(|(nbs, n)| (self.secondary(u, nbs, opts, l, e, v.arc.arc, lit.arc), *n))
                 .collect()
         });
         let l_vi = overlap(u.range, meet(v.along, lit_len));
@@ -973,12 +973,8 @@ impl AnalyticModel {
 
     /// Arc of the unit's cross-section that faces `v` and is not hidden by a neighbour on the
     /// side `v` comes from (self-shadowing/blocking plus eqs 3.4-3.5 via the active table).
-    fn side_arc(&self, u: &Unit, v: &View) -> Arc {
-        let theta = v.p.angle;
-        let mut arc = Arc {
-            lo: theta - FRAC_PI_2,
-            hi: theta + FRAC_PI_2,
-        };
+    fn side_arc(&self, u: &Unit, v: &View) -> ArcTrig {
+        let mut arc = ArcTrig::facing(&v.p);
         let Some((psi, mirrored)) = v.side else {
             return arc;
         };
@@ -992,9 +988,23 @@ impl AnalyticModel {
         };
         match occluded_arc_at(u.seg.radius, u.seg.height, o, &psi) {
             ArcOcclusion::None => {}
-            ArcOcclusion::All => arc.hi = arc.lo,
-            ArcOcclusion::UpTo(t) if mirrored => arc.hi = arc.hi.min(PI - t),
-            ArcOcclusion::UpTo(t) => arc.lo = arc.lo.max(t),
+            ArcOcclusion::All => {
+                arc.arc.hi = arc.arc.lo;
+                arc.hi = arc.lo;
+            }
+            ArcOcclusion::UpTo(t, (s, c)) if mirrored => {
+                // pi - t
+                if PI - t < arc.arc.hi {
+                    arc.arc.hi = PI - t;
+                    arc.hi = (s, -c);
+                }
+            }
+            ArcOcclusion::UpTo(t, sc) => {
+                if t > arc.arc.lo {
+                    arc.arc.lo = t;
+                    arc.lo = sc;
+                }
+            }
         }
         arc
     }
@@ -1044,7 +1054,8 @@ impl AnalyticModel {
             return (kd, 0.0);
         }
         if self.facet == FacetModel::Huo {
-            if let Some(s) = huo_specular_integral(arc, &views.h, &views.e.p, m.exponent) {
+            let e = Heading::from(&views.e.p);
+            if let Some(s) = huo_specular_integral(arc, &views.h, &e, m.exponent) {
                 return (kd, m.specular * s);
             }
         }

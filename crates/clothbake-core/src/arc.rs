@@ -63,6 +63,41 @@ impl Polar {
     }
 }
 
+/// A projected direction's length |V_p| and its angle's cosine and sine: the polar form
+/// without the angle itself (an `atan2` spared where only these are needed).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Heading {
+    /// |V_p|.
+    pub norm: f64,
+    /// cos(theta_V).
+    pub cos: f64,
+    /// sin(theta_V).
+    pub sin: f64,
+}
+
+impl Heading {
+    /// The heading of `p` (not zero).
+    #[inline]
+    pub fn new(p: Projected) -> Heading {
+        let norm = (p.c * p.c + p.z * p.z).sqrt();
+        Heading {
+            norm,
+            cos: p.c / norm,
+            sin: p.z / norm,
+        }
+    }
+}
+
+impl From<&Polar> for Heading {
+    fn from(p: &Polar) -> Heading {
+        Heading {
+            norm: p.norm,
+            cos: p.cos,
+            sin: p.sin,
+        }
+    }
+}
+
 /// An arc with the sine and cosine of each end, `(sin, cos)`, for the closed-form integrals.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ArcTrig {
@@ -85,22 +120,37 @@ impl ArcTrig {
         }
     }
 
-    /// The intersection with `o`, reusing this arc's sines and cosines at the ends it keeps.
+    /// The intersection, each end with its sine and cosine.
     #[inline]
-    pub fn meet(self, o: Arc) -> ArcTrig {
-        let arc = self.arc.meet(o);
+    pub fn meet(self, o: &ArcTrig) -> ArcTrig {
+        let (lo, slo) = if o.arc.lo > self.arc.lo {
+            (o.arc.lo, o.lo)
+        } else {
+            (self.arc.lo, self.lo)
+        };
+        let (hi, shi) = if o.arc.hi < self.arc.hi {
+            (o.arc.hi, o.hi)
+        } else {
+            (self.arc.hi, self.hi)
+        };
         ArcTrig {
-            arc,
-            lo: if arc.lo == self.arc.lo {
-                self.lo
-            } else {
-                sin_cos(arc.lo)
+            arc: Arc { lo, hi },
+            lo: slo,
+            hi: shi,
+        }
+    }
+
+    /// The normals facing the direction `v` (N.V > 0, [`Arc::facing`]): theta_V -+ pi/2, whose
+    /// sines and cosines are -+cos(theta_V) and +-sin(theta_V).
+    #[inline]
+    pub fn facing(v: &Polar) -> ArcTrig {
+        ArcTrig {
+            arc: Arc {
+                lo: v.angle - FRAC_PI_2,
+                hi: v.angle + FRAC_PI_2,
             },
-            hi: if arc.hi == self.arc.hi {
-                self.hi
-            } else {
-                sin_cos(arc.hi)
-            },
+            lo: (-v.cos, v.sin),
+            hi: (v.cos, -v.sin),
         }
     }
 }
@@ -174,7 +224,7 @@ pub fn diffuse_integral(arc: &ArcTrig, l: Projected, e: Projected) -> f64 {
 /// (N.H)^n (N.E) over the arc, where N.H = |H_p| cos(theta - theta_H) with H the full 3-D half
 /// vector. Closed form for integer n (reduction formula for the integral of cos^m); `None` for a
 /// non-integer or very large exponent (use quadrature). The arc must lie where N.H >= 0.
-pub fn huo_specular_integral(arc: &ArcTrig, h: &Polar, e: &Polar, n: f64) -> Option<f64> {
+pub fn huo_specular_integral(arc: &ArcTrig, h: &Heading, e: &Heading, n: f64) -> Option<f64> {
     if n.fract() != 0.0 || !(0.0..=4096.0).contains(&n) {
         return None;
     }
@@ -182,7 +232,6 @@ pub fn huo_specular_integral(arc: &ArcTrig, h: &Polar, e: &Polar, n: f64) -> Opt
         return Some(0.0);
     }
     let n = n as u32;
-    let th = h.angle;
     // delta = theta_H - theta_E by the angle-difference formulas.
     let sd = h.sin * e.cos - h.cos * e.sin;
     let cd = h.cos * e.cos + h.sin * e.sin;
@@ -190,12 +239,14 @@ pub fn huo_specular_integral(arc: &ArcTrig, h: &Polar, e: &Polar, n: f64) -> Opt
     // u = t - theta_H, its sine and cosine from the end's and theta_H's.
     let su_cu = |(st, ct): (f64, f64)| [st * h.cos - ct * h.sin, ct * h.cos + st * h.sin];
     let ([s0, c0], [s1, c1]) = (su_cu(arc.lo), su_cu(arc.hi));
-    let ([p0, p1], [q0, q1]) = cos_power_integral(
-        n + 1,
-        [s0, s1],
-        [c0, c1],
-        [arc.arc.lo - th, arc.arc.hi - th],
-    );
+    // u itself only for an even power (theta_H's atan2 only then).
+    let u = if (n + 1).is_multiple_of(2) {
+        let th = atan2(h.sin, h.cos);
+        [arc.arc.lo - th, arc.arc.hi - th]
+    } else {
+        [0.0; 2]
+    };
+    let ([p0, p1], [q0, q1]) = cos_power_integral(n + 1, [s0, s1], [c0, c1], u);
     let prim = |p: f64, q: f64| cd * p + sd * q / (n as f64 + 1.0);
     let v = prim(p1, q1) - prim(p0, q0);
     Some(h.norm.powi(n as i32) * e.norm * v)
@@ -256,16 +307,22 @@ mod tests {
                 arc.hi,
                 1e-14,
             );
-            let c = huo_specular_integral(&at, &Polar::new(h), &Polar::new(e), n).unwrap();
+            let c = huo_specular_integral(&at, &Heading::new(h), &Heading::new(e), n).unwrap();
             assert!(
                 (c - q).abs() < 1e-11 * q.abs().max(1.0),
                 "n={n}: {c} vs {q}"
             );
         }
-        assert!(huo_specular_integral(&at, &Polar::new(h), &Polar::new(e), 2.5).is_none());
-        // An arc met with another keeps the sines and cosines of its ends or computes new ones.
-        let m = at.meet(Arc { lo: 0.7, hi: 3.0 });
+        assert!(huo_specular_integral(&at, &Heading::new(h), &Heading::new(e), 2.5).is_none());
+        // An arc met with another keeps the sines and cosines of the ends it keeps.
+        let m = at.meet(&ArcTrig::new(Arc { lo: 0.7, hi: 3.0 }));
         assert_eq!(m, ArcTrig::new(Arc { lo: 0.7, hi: 2.2 }));
+        let f = ArcTrig::facing(&Polar::new(l));
+        let g = ArcTrig::new(Arc::facing(l));
+        assert!((f.arc.lo - g.arc.lo).abs() < 1e-15 && (f.arc.hi - g.arc.hi).abs() < 1e-15);
+        for (x, y) in [(f.lo, g.lo), (f.hi, g.hi)] {
+            assert!((x.0 - y.0).abs() < 1e-15 && (x.1 - y.1).abs() < 1e-15);
+        }
         let pl = Polar::new(l);
         assert!((pl.angle - 0.9).abs() < 1e-15 && (pl.norm - 0.8).abs() < 1e-15);
         assert!((pl.cos - 0.9f64.cos()).abs() < 1e-15 && (pl.sin - 0.9f64.sin()).abs() < 1e-15);

@@ -17,8 +17,8 @@
 //! * common tangent of two discs: eqs 3.7 (disc-disc), 3.8 (disc-corner), 3.9 (corner-disc).
 
 use crate::arc::{ArcTrig, Projected};
-use crate::trig::{asin, atan2, sin_cos};
-use std::f64::consts::{FRAC_PI_2, PI};
+use crate::trig::{atan2, sin_cos};
+use std::f64::consts::FRAC_PI_2;
 
 /// An elevation psi with its sine and cosine, computed once per direction and shared by the
 /// formulas that need them.
@@ -295,8 +295,9 @@ pub enum ArcOcclusion {
     /// Nothing of the circle is hidden.
     None,
     /// The arc from the floor on that side up to this angle (measured from the outward
-    /// horizontal toward +z, the thesis's theta of eqs 3.4-3.5) is hidden.
-    UpTo(f64),
+    /// horizontal toward +z, the thesis's theta of eqs 3.4-3.5) is hidden; with the angle's
+    /// (sine, cosine).
+    UpTo(f64, (f64, f64)),
     /// The whole circle lies below the support line.
     All,
 }
@@ -317,7 +318,13 @@ pub fn occluded_arc_at(r1: f64, h1: f64, o: &Occluder, psi: &Elevation) -> ArcOc
     } else if s >= r1 {
         ArcOcclusion::All
     } else {
-        ArcOcclusion::UpTo(psi.psi + asin(s / r1))
+        // theta = psi + alpha, sin(alpha) = s / r1, cos(alpha) >= 0.
+        let sa = s / r1;
+        let ca = ((1.0 - sa) * (1.0 + sa)).sqrt();
+        ArcOcclusion::UpTo(
+            psi.psi + atan2(sa, ca),
+            (psi.sin * ca + psi.cos * sa, psi.cos * ca - psi.sin * sa),
+        )
     }
 }
 
@@ -349,35 +356,41 @@ pub fn mean_occluded_length(
     max_len: f64,
 ) -> f64 {
     let (sp, cp) = (psi.sin, psi.cos);
+    // The arc faces E: at most pi long.
     if arc.arc.is_empty() || sp <= 0.0 {
         return occluded_length(crate::geometry::equal_area_height(r, h), o, psi).min(max_len);
     }
-    let (lo, hi) = (arc.arc.lo, arc.arc.hi);
     // l(theta) = a - b sin(theta)
     let a = (o.support(sp, cp) - h * cp) / sp;
     let b = r * cp / sp;
-    // Break points (theta, sin, cos): sin(theta) = a / b (l = 0) and (a - max_len) / b
-    // (l = max_len); their cosines from the sines.
-    let mut cuts = [(0.0f64, 0.0f64, 0.0f64); 8];
-    cuts[0] = (lo, arc.lo.0, arc.lo.1);
+    // Points of the arc as (key, sin, cos, theta): the arc is at most pi long (it faces E), so
+    // a point's angle phi from arc.lo is in [0, pi], ordered by key = -cos(phi); theta is
+    // computed only where needed (NaN until then).
+    let (s0, c0) = arc.lo;
+    let from_lo = |(s, c): (f64, f64)| (s * c0 - c * s0, c * c0 + s * s0);
+    let cos_len = from_lo(arc.hi).1;
+    let mut cuts = [(0.0f64, 0.0f64, 0.0f64, f64::NAN); 6];
+    cuts[0] = (-1.0, s0, c0, arc.arc.lo);
     let mut n = 1;
     if b > 0.0 {
+        // Break points: sin(theta) = a / b (l = 0) and (a - max_len) / b (l = max_len), the
+        // two points of the circle with that sine, where they lie inside the arc.
         for x in [a / b, (a - max_len) / b] {
             if x.abs() < 1.0 {
-                let t = asin(x);
                 let c = ((1.0 - x) * (1.0 + x)).sqrt();
-                for cut in [(t, x, c), (PI - t, x, -c), (t - 2.0 * PI, x, c)] {
-                    if cut.0 > lo && cut.0 < hi {
-                        cuts[n] = cut;
+                for point in [(x, c), (x, -c)] {
+                    let (sf, cf) = from_lo(point);
+                    if sf > 0.0 && cf > cos_len {
+                        cuts[n] = (-cf, point.0, point.1, f64::NAN);
                         n += 1;
                     }
                 }
             }
         }
     }
-    cuts[n] = (hi, arc.hi.0, arc.hi.1);
+    cuts[n] = (-cos_len, arc.hi.0, arc.hi.1, arc.arc.hi);
     let cuts = &mut cuts[..=n];
-    // Insertion sort by angle (at most 8 entries, most often 2).
+    // Insertion sort by key (at most 6 entries, most often 2).
     for i in 1..cuts.len() {
         let mut j = i;
         while j > 0 && cuts[j - 1].0 > cuts[j].0 {
@@ -385,20 +398,41 @@ pub fn mean_occluded_length(
             j -= 1;
         }
     }
+    let theta = |cuts: &mut [(f64, f64, f64, f64)], k: usize| {
+        if cuts[k].3.is_nan() {
+            let (sf, cf) = from_lo((cuts[k].1, cuts[k].2));
+            cuts[k].3 = arc.arc.lo + atan2(sf, cf);
+        }
+        cuts[k]
+    };
     // Primitives of w = e.c cos + e.z sin and of sin * w (sin 2t / 4 = sin t cos t / 2).
-    let pw = |(_, s, c): (f64, f64, f64)| e.c * s - e.z * c;
-    let psw = |(t, s, c): (f64, f64, f64)| e.c * 0.5 * s * s + e.z * 0.5 * (t - s * c);
+    let pw = |(_, s, c, _): (f64, f64, f64, f64)| e.c * s - e.z * c;
+    let psw = |(_, s, c, t): (f64, f64, f64, f64)| e.c * 0.5 * s * s + e.z * 0.5 * (t - s * c);
+    // Which clamp holds on a window: l at an end of the arc, where l is known from the end's
+    // sine, if it is clearly off both switch values there (no switch lies inside a window),
+    // else at the window's middle.
+    let tol = 1e-9 * (a.abs() + b.abs() + max_len);
+    let clear = |l: f64| (l.abs() > tol && (l - max_len).abs() > tol).then_some(l);
+    let last = n - 1;
     let (mut num, mut den) = (0.0, 0.0);
-    for w in cuts.windows(2) {
-        let (p0, p1) = (w[0], w[1]);
-        let l_mid = a - b * sin_cos(0.5 * (p0.0 + p1.0)).0;
-        let wsum = pw(p1) - pw(p0);
+    for k in 0..n {
+        let (q0, q1) = (cuts[k], cuts[k + 1]);
+        let l_end = (k == 0)
+            .then(|| clear(a - b * q0.1))
+            .flatten()
+            .or_else(|| (k == last).then(|| clear(a - b * q1.1)).flatten());
+        let l_mid = l_end.unwrap_or_else(|| {
+            let (p0, p1) = (theta(cuts, k), theta(cuts, k + 1));
+            a - b * sin_cos(0.5 * (p0.3 + p1.3)).0
+        });
+        let wsum = pw(q1) - pw(q0);
         den += wsum;
         num += if l_mid <= 0.0 {
             0.0
         } else if l_mid >= max_len {
             max_len * wsum
         } else {
+            let (p0, p1) = (theta(cuts, k), theta(cuts, k + 1));
             a * wsum - b * (psw(p1) - psw(p0))
         };
     }
@@ -412,6 +446,7 @@ pub fn mean_occluded_length(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     /// Eq. 3.4 as printed: segment 1 (radius r1) hidden by the rectangle of height h at gap d.
     fn eq_3_4(r1: f64, d: f64, h: f64, psi: f64) -> f64 {
@@ -437,15 +472,16 @@ mod tests {
                 z: h,
                 rho: 0.0,
             };
-            if let ArcOcclusion::UpTo(t) = occluded_arc(r1, 0.0, &corner, psi) {
+            if let ArcOcclusion::UpTo(t, (s, c)) = occluded_arc(r1, 0.0, &corner, psi) {
                 assert!((t - eq_3_4(r1, d, h, psi)).abs() < 1e-12, "{deg}");
+                assert!((s - t.sin()).abs() < 1e-15 && (c - t.cos()).abs() < 1e-15);
             }
             let disc = Occluder {
                 u: r1 + d + r2,
                 z: 0.0,
                 rho: r2,
             };
-            if let ArcOcclusion::UpTo(t) = occluded_arc(r1, 0.0, &disc, psi) {
+            if let ArcOcclusion::UpTo(t, _) = occluded_arc(r1, 0.0, &disc, psi) {
                 assert!((t - eq_3_5(r1, r2, d, psi)).abs() < 1e-12, "{deg}");
             }
             let top = PI * r1 / 4.0;
