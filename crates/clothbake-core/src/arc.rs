@@ -53,12 +53,13 @@ impl Polar {
     #[inline]
     pub fn new(p: Projected) -> Polar {
         let norm = (p.c * p.c + p.z * p.z).sqrt();
+        let inv = 1.0 / norm;
         Polar {
             p,
             angle: atan2(p.z, p.c),
             norm,
-            cos: p.c / norm,
-            sin: p.z / norm,
+            cos: p.c * inv,
+            sin: p.z * inv,
         }
     }
 }
@@ -80,10 +81,11 @@ impl Heading {
     #[inline]
     pub fn new(p: Projected) -> Heading {
         let norm = (p.c * p.c + p.z * p.z).sqrt();
+        let inv = 1.0 / norm;
         Heading {
             norm,
-            cos: p.c / norm,
-            sin: p.z / norm,
+            cos: p.c * inv,
+            sin: p.z * inv,
         }
     }
 }

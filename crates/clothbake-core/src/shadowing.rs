@@ -43,11 +43,11 @@ impl Elevation {
     /// zero): psi = atan2(rise, run), the sine and cosine from the components (inline).
     #[inline]
     pub fn of(rise: f64, run: f64) -> Elevation {
-        let len = (rise * rise + run * run).sqrt();
+        let inv = 1.0 / (rise * rise + run * run).sqrt();
         Elevation {
             psi: atan2(rise, run),
-            sin: rise / len,
-            cos: run / len,
+            sin: rise * inv,
+            cos: run * inv,
         }
     }
 }
@@ -360,9 +360,13 @@ pub fn mean_occluded_length(
     if arc.arc.is_empty() || sp <= 0.0 {
         return occluded_length(crate::geometry::equal_area_height(r, h), o, psi).min(max_len);
     }
-    // l(theta) = a - b sin(theta)
-    let a = (o.support(sp, cp) - h * cp) / sp;
-    let b = r * cp / sp;
+    // l(theta) = a - b sin(theta); the divisions independent of one another (their latency
+    // dominated this function).
+    let num0 = o.support(sp, cp) - h * cp;
+    let rc = r * cp;
+    let inv_sp = 1.0 / sp;
+    let inv_rc = 1.0 / rc;
+    let (a, b) = (num0 * inv_sp, rc * inv_sp);
     // Points of the arc as (key, sin, cos, theta): the arc is at most pi long (it faces E), so
     // a point's angle phi from arc.lo is in [0, pi], ordered by key = -cos(phi); theta is
     // computed only where needed (NaN until then).
@@ -375,7 +379,7 @@ pub fn mean_occluded_length(
     if b > 0.0 {
         // Break points: sin(theta) = a / b (l = 0) and (a - max_len) / b (l = max_len), the
         // two points of the circle with that sine, where they lie inside the arc.
-        for x in [a / b, (a - max_len) / b] {
+        for x in [num0 * inv_rc, (num0 - max_len * sp) * inv_rc] {
             if x.abs() < 1.0 {
                 let c = ((1.0 - x) * (1.0 + x)).sqrt();
                 for point in [(x, c), (x, -c)] {

@@ -101,20 +101,24 @@ fn atan_kernel(t: f64) -> f64 {
 /// `y.atan2(x)` within 5e-16, inline; the standard library's for non-finite input or the origin.
 #[inline]
 pub fn atan2(y: f64, x: f64) -> f64 {
+    // Written as selects, not branches (random directions mispredict them): one division.
     let (ax, ay) = (x.abs(), y.abs());
-    let (num, den) = if ay > ax { (ax, ay) } else { (ay, ax) };
+    let swap = ay > ax;
+    let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
     if !(den > 0.0 && den < f64::INFINITY) {
         return y.atan2(x);
     }
-    // atan(num / den) in [0, pi/4].
-    let a = if num > 0.414_213_562_373_095_03 * den {
-        let t = (num - den) / (num + den);
-        PI_4_HI - ((atan_kernel(t) - PI_4_LO) - t)
+    // atan(num / den) in [0, pi/4]: above tan(pi/8), pi/4 + atan((num - den) / (num + den)).
+    let big = num > 0.414_213_562_373_095_03 * den;
+    let (n2, d2) = if big {
+        (num - den, num + den)
     } else {
-        let t = num / den;
-        t - atan_kernel(t)
+        (num, den)
     };
-    let a = if ay > ax {
+    let (hi, lo) = if big { (PI_4_HI, PI_4_LO) } else { (0.0, 0.0) };
+    let t = n2 / d2;
+    let a = hi - ((atan_kernel(t) - lo) - t);
+    let a = if swap {
         (std::f64::consts::FRAC_PI_2 - a) + PI_2_LO_FULL
     } else {
         a
