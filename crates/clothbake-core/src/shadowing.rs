@@ -227,11 +227,15 @@ impl ActiveTable {
 
     /// The active occluder for elevation `psi` in (0, pi/2].
     pub fn active(&self, psi: f64) -> Option<&Occluder> {
-        self.entries
+        // The first entry with psi >= its bound: the bounds decrease, so that is the number of
+        // bounds above psi (counted without branches: random directions mispredict a search).
+        let above: usize = self
+            .entries
             .iter()
-            .find(|(lo, _)| psi >= *lo)
-            .or(self.entries.last())
-            .map(|(_, o)| o)
+            .map(|(lo, _)| usize::from(*lo > psi))
+            .sum();
+        let last = self.entries.len().checked_sub(1)?;
+        Some(&self.entries[above.min(last)].1)
     }
 }
 
