@@ -754,8 +754,13 @@ impl AnalyticModel {
 
     /// What of unit `u` is visible from the eye's view `e`: `None` where nothing is.
     fn visible(&self, u: &Unit, e: &View) -> Option<Visible> {
+        self.visible_of(u, e, self.side_arc(u, e).meet(&u.seg.floor))
+    }
+
+    /// As [`AnalyticModel::visible`], given the arc of the cross-section that faces the eye
+    /// above the floor and not behind the side neighbour.
+    fn visible_of(&self, u: &Unit, e: &View, arc: ArcTrig) -> Option<Visible> {
         let seg = &u.seg;
-        let arc = self.side_arc(u, e).meet(&seg.floor);
         if arc.arc.is_empty() {
             return None;
         }
@@ -785,9 +790,12 @@ impl AnalyticModel {
         secondary: Option<&SecondaryOptions>,
     ) -> Option<UnitTerms> {
         let seg = &u.seg;
-        let v = self.visible(u, &views.e)?;
-        let ep = views.e.p.p;
+        // The eye's and the light's arcs first: two independent chains of divisions and
+        // square roots that the processor can overlap.
+        let seen = self.side_arc(u, &views.e).meet(&seg.floor);
         let lit = self.side_arc(u, &views.l).meet(&seg.floor);
+        let v = self.visible_of(u, &views.e, seen)?;
+        let ep = views.e.p.p;
         let vi = v.arc.meet(&lit);
         let lit_len = self.end_interval(u, &views.l, &vi, ep);
         let secondary = secondary.map_or_else(Vec::new, |opts| {
