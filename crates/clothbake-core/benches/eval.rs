@@ -1,9 +1,12 @@
-//! Criterion benchmarks of the direct model: the analytic path per (wi, wo) pair.
-//! The ray tracer's cost at 1% error is reported beside it by the `raytrace_1pct` group; the
-//! secondary reflection per pair, and against the two-level sampling, by `secondary` and
-//! `secondary_vs_sampling`.
+//! Criterion benchmarks of the direct model: the analytic path per (wi, wo) pair, on distinct
+//! random pairs (a pool of 2^16, uniform in solid angle: the branches cannot be learnt) beside 64
+//! pairs cycled (`coherent`, as neighbouring rays of a renderer). The ray tracer's cost at 1%
+//! error is reported beside it by the `raytrace_1pct` group; the secondary reflection per pair
+//! (random pairs), and against the two-level sampling (the fixed direction set whose errors
+//! `cargo xtask ir-accuracy` tabulates), by `secondary` and `secondary_vs_sampling`.
 
 use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
+use clothbake_core::rng::Rng;
 use clothbake_core::validate::secondary_direction_set;
 use clothbake_core::{
     AnalyticModel, Fabric, FacetModel, Kernel, RayTracer, SecondaryMethod, SecondaryOptions,
@@ -18,34 +21,36 @@ fn twill() -> Fabric {
     Fabric::from_path(&p).expect("tables/twill.json")
 }
 
-/// A fixed spread of direction pairs over the upper hemisphere (deterministic).
+/// `n` (a power of two) random direction pairs, uniform in solid angle over the upper
+/// hemisphere, strictly above the horizon (deterministic).
 fn directions(n: usize) -> Vec<(UnitVec3, UnitVec3)> {
-    (0..n)
-        .map(|k| {
-            let t = k as f64 + 0.5;
-            let wi = UnitVec3::from_degrees((t * 37.0) % 85.0, (t * 61.0) % 360.0);
-            let wo = UnitVec3::from_degrees((t * 53.0) % 85.0, (t * 97.0) % 360.0);
-            (wi, wo)
-        })
-        .collect()
+    assert!(n.is_power_of_two());
+    let mut rng = Rng::new(22);
+    let mut dir = move || {
+        let mu = 1e-6 + (1.0 - 1e-6) * rng.next_f64();
+        UnitVec3::from_spherical(mu.acos(), std::f64::consts::TAU * rng.next_f64())
+    };
+    (0..n).map(|_| (dir(), dir())).collect()
 }
 
 fn analytic(c: &mut Criterion) {
     let fabric = twill();
-    let dirs = directions(256);
+    let dirs = directions(1 << 16);
     for facet in [FacetModel::Huo, FacetModel::Lewis] {
         let m = AnalyticModel::new(&fabric, facet);
-        c.bench_function(
-            &format!("analytic_direct/twill/{}/per_pair", facet.name()),
-            |b| {
-                let mut k = 0;
-                b.iter(|| {
-                    let (wi, wo) = dirs[k % dirs.len()];
-                    k += 1;
-                    black_box(m.intensity(black_box(wi), black_box(wo)))
-                })
-            },
-        );
+        for (name, mask) in [("random", dirs.len() - 1), ("coherent", 63)] {
+            c.bench_function(
+                &format!("analytic_direct/twill/{}/{name}", facet.name()),
+                |b| {
+                    let mut k = 0;
+                    b.iter(|| {
+                        k = (k + 1) & mask;
+                        let (wi, wo) = dirs[k];
+                        black_box(m.intensity(black_box(wi), black_box(wo)))
+                    })
+                },
+            );
+        }
     }
     c.bench_function("analytic_preprocess/twill", |b| {
         b.iter(|| black_box(AnalyticModel::new(black_box(&fabric), FacetModel::Huo)))
@@ -72,7 +77,7 @@ fn raytrace_1pct(c: &mut Criterion) {
 
 /// Secondary reflection on the parallel-cylinder surface (thesis ch. 5) and on the twill.
 fn secondary(c: &mut Criterion) {
-    let dirs = directions(64);
+    let dirs = directions(1 << 12);
     let pf = Fabric::from_path(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/parallel.json"),
     )
@@ -80,11 +85,11 @@ fn secondary(c: &mut Criterion) {
     for (name, fabric) in [("parallel", pf), ("twill", twill())] {
         let m = AnalyticModel::new(&fabric, FacetModel::Huo);
         let opts = SecondaryOptions::default();
-        c.bench_function(&format!("secondary_analytic/{name}/per_pair"), |b| {
+        c.bench_function(&format!("secondary_analytic/{name}/random"), |b| {
             let mut k = 0;
             b.iter(|| {
-                let (wi, wo) = dirs[k % dirs.len()];
-                k += 1;
+                k = (k + 1) & (dirs.len() - 1);
+                let (wi, wo) = dirs[k];
                 black_box(m.intensity_with(black_box(wi), black_box(wo), Some(&opts)))
             })
         });

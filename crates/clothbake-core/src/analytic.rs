@@ -16,7 +16,10 @@
 //!    cos(theta - theta_E) correction (eqs 4.4-4.10);
 //! 4. the area-weighted average I = sum D_i I_i / sum D_i S_v,i (eq. 4.11 and its pseudocode).
 
-use crate::arc::{diffuse_integral, huo_specular_integral, projected_width, Arc, Projected};
+use crate::arc::{
+    diffuse_integral, huo_specular_integral, projected_width, Arc, ArcTrig, Heading, Polar,
+    Projected,
+};
 use crate::cells::{Cell, CellGrid, PeriodPoint};
 use crate::fabric::{Fabric, Material};
 use crate::facet::{Facet, FacetModel};
@@ -28,7 +31,8 @@ use crate::interreflection::{
 use crate::quad::integrate;
 use crate::reflect::{intensity_to_brdf, Reflection};
 use crate::shadowing::{
-    mean_occluded_length, occluded_arc, occluded_length, ActiveTable, ArcOcclusion, Occluder,
+    mean_occluded_length, occluded_arc_at, occluded_length, ActiveTable, ArcOcclusion, Elevation,
+    Occluder,
 };
 use crate::unit_index::UnitIndex;
 use crate::vec3::{UnitVec3, Vec3};
@@ -46,6 +50,8 @@ struct SegmentData {
     height: f64,
     /// Height of the segment's equal-area rectangle (eq. 3.1), its top in axial profiles.
     top: f64,
+    /// The arc of its cross-section above the floor.
+    floor: ArcTrig,
     /// Extent along the axis; `None` when endless.
     extent: Option<(f64, f64)>,
     /// Occluders beyond the +axis end and beyond the -axis end.
@@ -199,18 +205,99 @@ pub struct LocalReflection {
     pub coverage: f64,
 }
 
+/// A direction as the units of one group see it, computed once per evaluation rather than per
+/// unit (issue 22): the projection on their cross-section plane in polar form, the elevation
+/// their side tables are read at, and its axial component with the elevation their end tables
+/// are read at.
+#[derive(Clone, Copy, Debug)]
+struct View {
+    /// Projection on the cross-section plane.
+    p: Polar,
+    /// Elevation from the side it comes from: (psi, mirrored: from the -c side); `None` in the
+    /// plane of the axis and the normal (|V.c| <= EPS).
+    side: Option<(Elevation, bool)>,
+    /// Component along the axis.
+    va: f64,
+    /// Elevation along the axis from the end it comes from; `None` across it (|V.a| <= EPS).
+    end: Option<Elevation>,
+}
+
+impl View {
+    /// The views of `v` from the warp's units and from the weft's. A warp's cross-section is
+    /// the XZ plane and its axis Y, a weft's the other way round, so the two share the
+    /// direction's two elevations atan2(z, |x|) and atan2(z, |y|).
+    fn both(v: Vec3) -> [View; 2] {
+        let (ex, ey) = (Elevation::of(v.z, v.x.abs()), Elevation::of(v.z, v.y.abs()));
+        [
+            View::new(v.x, v.y, v.z, ex, ey),
+            View::new(v.y, v.x, v.z, ey, ex),
+        ]
+    }
+
+    /// The view of a direction with components `vc` across, `va` along and `vz` up, and
+    /// elevations `ec` = atan2(vz, |vc|) and `ea` = atan2(vz, |va|).
+    fn new(vc: f64, va: f64, vz: f64, ec: Elevation, ea: Elevation) -> View {
+        let mirrored = vc < 0.0;
+        let norm = (vc * vc + vz * vz).sqrt();
+        let p = Polar {
+            p: Projected { c: vc, z: vz },
+            angle: if mirrored { PI - ec.psi } else { ec.psi },
+            norm,
+            cos: if mirrored { -ec.cos } else { ec.cos },
+            sin: ec.sin,
+        };
+        View {
+            p,
+            side: (vc.abs() > EPS).then_some((ec, mirrored)),
+            va,
+            end: (va.abs() > EPS).then_some(ea),
+        }
+    }
+}
+
+/// The views of light and eye (and of the Huo half vector) for the units of one group.
+#[derive(Clone, Copy, Debug)]
+struct Views {
+    l: View,
+    e: View,
+    /// The projected unit half vector (L + E) / |L + E|, for the Huo facets' closed form.
+    h: Heading,
+}
+
+impl Views {
+    /// The views of the warp's units and of the weft's.
+    fn both(wi: UnitVec3, wo: UnitVec3) -> [Views; 2] {
+        let (l, e) = (wi.get(), wo.get());
+        let [lw, lf] = View::both(l);
+        let [ew, ef] = View::both(e);
+        let h = l + e;
+        let h = h * (1.0 / h.length());
+        let hp = |c: f64| Heading::new(Projected { c, z: h.z });
+        [
+            Views {
+                l: lw,
+                e: ew,
+                h: hp(h.x),
+            },
+            Views {
+                l: lf,
+                e: ef,
+                h: hp(h.y),
+            },
+        ]
+    }
+}
+
 /// What of a unit the eye sees.
 struct Visible {
     /// The visible arc of the cross-section (above the floor, not self- or neighbour-hidden).
-    arc: Arc,
+    arc: ArcTrig,
     /// The interval along the axis the ends' occluders leave visible.
     along: (f64, f64),
     /// Visible length l_v within the piece.
     l_v: f64,
     /// Projected width of the visible arc, with |E_p|.
     width: f64,
-    /// The eye direction projected on the cross-section plane.
-    ep: Projected,
 }
 
 /// A unit's share of eq. 4.11 for one pair of directions, before the multiplicity D_i.
@@ -472,6 +559,7 @@ impl AnalyticModel {
                 radius: seg.radius,
                 height: seg.height,
                 top,
+                floor: ArcTrig::new(Arc::above_floor(seg.radius, seg.height)),
                 extent: seg.extent,
                 end_plus,
                 end_minus,
@@ -664,8 +752,10 @@ impl AnalyticModel {
         let mut i_d = [0.0; 3];
         let mut i_s = 0.0;
         let mut i_2 = Secondary::default();
+        let views = Views::both(wi, wo);
         for u in &self.units {
-            let Some(t) = self.unit_terms(u, &u.neighbours, wi, wo, secondary) else {
+            let v = &views[u.seg.group as usize];
+            let Some(t) = self.unit_terms(u, &u.neighbours, v, wi, wo, secondary) else {
                 continue;
             };
             let d = u.count as f64;
@@ -695,62 +785,62 @@ impl AnalyticModel {
         }
     }
 
-    /// What of unit `u` is visible from `e`: `None` where nothing is.
-    fn visible(&self, u: &Unit, e: Vec3) -> Option<Visible> {
+    /// What of unit `u` is visible from the eye's view `e`: `None` where nothing is.
+    fn visible(&self, u: &Unit, e: &View) -> Option<Visible> {
+        self.visible_of(u, e, self.side_arc(u, e).meet(&u.seg.floor))
+    }
+
+    /// As [`AnalyticModel::visible`], given the arc of the cross-section that faces the eye
+    /// above the floor and not behind the side neighbour.
+    fn visible_of(&self, u: &Unit, e: &View, arc: ArcTrig) -> Option<Visible> {
         let seg = &u.seg;
-        let (c, a) = frame(seg.group);
-        let ep = Projected {
-            c: e.dot(c),
-            z: e.z,
-        };
-        let floor = Arc::above_floor(seg.radius, seg.height);
-        let arc = self.side_arc(u, ep).meet(floor);
-        let along = self.end_interval(u, e.dot(a), e.z, arc, ep);
+        if arc.arc.is_empty() {
+            return None;
+        }
+        let along = self.end_interval(u, e, &arc, e.p.p);
         let l_v = overlap(u.range, along);
-        if arc.is_empty() || l_v <= 0.0 {
+        if l_v <= 0.0 {
             return None;
         }
         Some(Visible {
             arc,
             along,
             l_v,
-            width: projected_width(seg.radius, arc, ep),
-            ep,
+            width: projected_width(seg.radius, &arc, e.p.p),
         })
     }
 
     /// Unit `u`'s terms of eq. 4.11 (and of I_2 with `secondary`) for light from `wi` seen
-    /// from `wo`, both above the horizon: `None` where nothing of it is visible.
+    /// from `wo` (both above the horizon; `views` of its group): `None` where nothing of it is
+    /// visible.
     fn unit_terms(
         &self,
         u: &Unit,
         variants: &[([Option<Neighbour>; 2], u32)],
+        views: &Views,
         wi: UnitVec3,
         wo: UnitVec3,
         secondary: Option<&SecondaryOptions>,
     ) -> Option<UnitTerms> {
-        let (l, e) = (wi.get(), wo.get());
         let seg = &u.seg;
-        let v = self.visible(u, e)?;
-        let (c, a) = frame(seg.group);
-        let lp = Projected {
-            c: l.dot(c),
-            z: l.z,
-        };
-        let lit = self
-            .side_arc(u, lp)
-            .meet(Arc::above_floor(seg.radius, seg.height));
-        let vi = v.arc.meet(lit);
-        let lit_len = self.end_interval(u, l.dot(a), l.z, vi, v.ep);
+        // The eye's and the light's arcs first: two independent chains of divisions and
+        // square roots that the processor can overlap.
+        let seen = self.side_arc(u, &views.e).meet(&seg.floor);
+        let lit = self.side_arc(u, &views.l).meet(&seg.floor);
+        let v = self.visible_of(u, &views.e, seen)?;
+        let ep = views.e.p.p;
+        let vi = v.arc.meet(&lit);
+        let lit_len = self.end_interval(u, &views.l, &vi, ep);
         let secondary = secondary.map_or_else(Vec::new, |opts| {
+            let (l, e) = (wi.get(), wo.get());
             variants
                 .iter()
-                .map(|(nbs, n)| (self.secondary(u, nbs, opts, l, e, v.arc, lit), *n))
+                .map(|(nbs, n)| (self.secondary(u, nbs, opts, l, e, v.arc.arc, lit.arc), *n))
                 .collect()
         });
         let l_vi = overlap(u.range, meet(v.along, lit_len));
-        let lit = (!vi.is_empty() && l_vi > 0.0).then(|| {
-            let (kd, ks) = self.arc_integral(&seg.material, seg.group, vi, wi, wo, lp, v.ep);
+        let lit = (!vi.arc.is_empty() && l_vi > 0.0).then(|| {
+            let (kd, ks) = self.arc_integral(&seg.material, seg.group, &vi, views, wi, wo);
             (l_vi, kd, ks)
         });
         Some(UnitTerms {
@@ -800,7 +890,8 @@ impl AnalyticModel {
         let (unit, variant) = self.cell_units[self.grid.index(cell)];
         let u = &self.units[unit as usize];
         let variants = std::slice::from_ref(&u.neighbours[variant as usize]);
-        let Some(t) = self.unit_terms(u, variants, wi, wo, secondary) else {
+        let views = Views::both(wi, wo)[u.seg.group as usize];
+        let Some(t) = self.unit_terms(u, variants, &views, wi, wo, secondary) else {
             return empty;
         };
         let s_v = t.l_v * t.width;
@@ -855,13 +946,15 @@ impl AnalyticModel {
     /// and `visible` over the cell's area share its coverage.
     pub fn class_terms(&self, wi: UnitVec3, wo: UnitVec3, out: &mut [ClassTerms]) {
         assert_eq!(out.len(), self.classes(), "one entry per class");
+        out.fill(ClassTerms::default());
+        if !(wi.above_horizon() && wo.above_horizon()) {
+            return;
+        }
+        let views = Views::both(wi, wo);
         for (o, &u) in out.iter_mut().zip(&self.class_unit) {
-            *o = ClassTerms::default();
-            if !(wi.above_horizon() && wo.above_horizon()) {
-                continue;
-            }
             let u = &self.units[u as usize];
-            let Some(t) = self.unit_terms(u, &[], wi, wo, None) else {
+            let v = &views[u.seg.group as usize];
+            let Some(t) = self.unit_terms(u, &[], v, wi, wo, None) else {
                 continue;
             };
             let s_v = t.l_v * t.width;
@@ -905,7 +998,8 @@ impl AnalyticModel {
             return 0.0;
         }
         let (unit, _) = self.cell_units[self.grid.index(cell)];
-        self.visible(&self.units[unit as usize], wo.get())
+        let u = &self.units[unit as usize];
+        self.visible(u, &View::both(wo.get())[u.seg.group as usize])
             .map_or(0.0, |v| self.cell_coverage(cell, v.l_v * v.width, wo))
     }
 
@@ -915,11 +1009,12 @@ impl AnalyticModel {
         if !wo.above_horizon() {
             return 0.0;
         }
+        let views = View::both(wo.get());
         let s: f64 = self
             .units
             .iter()
             .filter_map(|u| {
-                let v = self.visible(u, wo.get())?;
+                let v = self.visible(u, &views[u.seg.group as usize])?;
                 Some(u.count as f64 * v.l_v * v.width)
             })
             .sum();
@@ -987,50 +1082,65 @@ impl AnalyticModel {
 
     /// Arc of the unit's cross-section that faces `v` and is not hidden by a neighbour on the
     /// side `v` comes from (self-shadowing/blocking plus eqs 3.4-3.5 via the active table).
-    fn side_arc(&self, u: &Unit, v: Projected) -> Arc {
-        let mut arc = Arc::facing(v);
-        let theta = v.angle();
-        let (table, psi, mirrored) = if v.c > EPS {
-            (&u.side_plus, theta, false)
-        } else if v.c < -EPS {
-            (&u.side_minus, PI - theta, true)
+    fn side_arc(&self, u: &Unit, v: &View) -> ArcTrig {
+        let mut arc = ArcTrig::facing(&v.p);
+        let Some((psi, mirrored)) = v.side else {
+            return arc;
+        };
+        let table = if mirrored {
+            &u.side_minus
         } else {
+            &u.side_plus
+        };
+        let Some(o) = table.active(psi.psi) else {
             return arc;
         };
-        let Some(o) = table.active(psi) else {
-            return arc;
-        };
-        match occluded_arc(u.seg.radius, u.seg.height, o, psi) {
+        match occluded_arc_at(u.seg.radius, u.seg.height, o, &psi) {
             ArcOcclusion::None => {}
-            ArcOcclusion::All => arc.hi = arc.lo,
-            ArcOcclusion::UpTo(t) if mirrored => arc.hi = arc.hi.min(PI - t),
-            ArcOcclusion::UpTo(t) => arc.lo = arc.lo.max(t),
+            ArcOcclusion::All => {
+                arc.arc.hi = arc.arc.lo;
+                arc.hi = arc.lo;
+            }
+            ArcOcclusion::UpTo(t, (s, c)) if mirrored => {
+                // pi - t
+                if PI - t < arc.arc.hi {
+                    arc.arc.hi = PI - t;
+                    arc.hi = (s, -c);
+                }
+            }
+            ArcOcclusion::UpTo(t, sc) => {
+                if t > arc.arc.lo {
+                    arc.arc.lo = t;
+                    arc.lo = sc;
+                }
+            }
         }
         arc
     }
 
-    /// Interval along the axis not hidden by the occluders at the end that direction
-    /// (axial component `va`, vertical `vz`) comes from (eq. 3.6 via the active table).
-    /// `arc` and `e` give the points and weights the refined variant averages over.
-    fn end_interval(&self, u: &Unit, va: f64, vz: f64, arc: Arc, e: Projected) -> (f64, f64) {
+    /// Interval along the axis not hidden by the occluders at the end that direction `v` comes
+    /// from (eq. 3.6 via the active table). `arc` and `e` give the points and weights the
+    /// refined variant averages over.
+    fn end_interval(&self, u: &Unit, v: &View, arc: &ArcTrig, e: Projected) -> (f64, f64) {
         let Some((y0, y1)) = u.seg.extent else {
             return (f64::NEG_INFINITY, f64::INFINITY);
         };
-        let (table, psi) = if va > EPS {
-            (&u.seg.end_plus, vz.atan2(va))
-        } else if va < -EPS {
-            (&u.seg.end_minus, vz.atan2(-va))
-        } else {
+        let Some(psi) = v.end else {
             return (y0, y1);
         };
         let seg = &u.seg;
-        let hidden = table.active(psi).map_or(0.0, |o| match self.variant {
-            Variant::Thesis => occluded_length(seg.top, o, psi),
+        let table = if v.va > 0.0 {
+            &seg.end_plus
+        } else {
+            &seg.end_minus
+        };
+        let hidden = table.active(psi.psi).map_or(0.0, |o| match self.variant {
+            Variant::Thesis => occluded_length(seg.top, o, &psi),
             Variant::Refined => {
-                mean_occluded_length(seg.radius, seg.height, o, psi, arc, e, y1 - y0)
+                mean_occluded_length(seg.radius, seg.height, o, &psi, arc, e, y1 - y0)
             }
         });
-        if va > 0.0 {
+        if v.va > 0.0 {
             (y0, y1 - hidden)
         } else {
             (y0 + hidden, y1)
@@ -1039,33 +1149,26 @@ impl AnalyticModel {
 
     /// Integrals over the arc of the facet's diffuse factor and specular intensity, each times
     /// N.E (the cos(theta - theta_E) correction of eqs 4.7 and 4.9, times |E_p|).
-    #[allow(clippy::too_many_arguments)]
     fn arc_integral(
         &self,
         m: &Material,
         g: Group,
-        arc: Arc,
+        arc: &ArcTrig,
+        views: &Views,
         wi: UnitVec3,
         wo: UnitVec3,
-        lp: Projected,
-        ep: Projected,
     ) -> (f64, f64) {
-        let kd = diffuse_integral(arc, lp, ep);
+        let kd = diffuse_integral(arc, views.l.p.p, views.e.p.p);
         if m.specular == 0.0 {
             return (kd, 0.0);
         }
         if self.facet == FacetModel::Huo {
-            let h = wi.get() + wo.get();
-            let hl = h.length();
-            let (c, _) = frame(g);
-            let hp = Projected {
-                c: h.dot(c) / hl,
-                z: h.z / hl,
-            };
-            if let Some(s) = huo_specular_integral(arc, hp, ep, m.exponent) {
+            let e = Heading::from(&views.e.p);
+            if let Some(s) = huo_specular_integral(arc, &views.h, &e, m.exponent) {
                 return (kd, m.specular * s);
             }
         }
+        let arc = arc.arc;
         // Quadrature of the facet model, split at the specular peak.
         let (c, _) = frame(g);
         let (l, e) = (wi.get(), wo.get());
@@ -1094,6 +1197,9 @@ fn overlap(a: (f64, f64), b: (f64, f64)) -> f64 {
     let (lo, hi) = meet(a, b);
     (hi - lo).max(0.0)
 }
+
+#[cfg(test)]
+mod reference;
 
 #[cfg(test)]
 mod tests {

@@ -16,8 +16,41 @@
 //!   the line's normal (-sin psi, cos psi): the numerators of eqs 3.4 and 3.5;
 //! * common tangent of two discs: eqs 3.7 (disc-disc), 3.8 (disc-corner), 3.9 (corner-disc).
 
-use crate::arc::{Arc, Projected};
+use crate::arc::{ArcTrig, Projected};
+use crate::trig::{atan2, sin_cos};
 use std::f64::consts::FRAC_PI_2;
+
+/// An elevation psi with its sine and cosine, computed once per direction and shared by the
+/// formulas that need them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Elevation {
+    /// psi.
+    pub psi: f64,
+    /// sin(psi).
+    pub sin: f64,
+    /// cos(psi).
+    pub cos: f64,
+}
+
+impl Elevation {
+    /// Elevation `psi`.
+    pub fn new(psi: f64) -> Elevation {
+        let (sin, cos) = psi.sin_cos();
+        Elevation { psi, sin, cos }
+    }
+
+    /// The elevation of a direction that rises `rise` per `run` outward (`run` > 0, not both
+    /// zero): psi = atan2(rise, run), the sine and cosine from the components (inline).
+    #[inline]
+    pub fn of(rise: f64, run: f64) -> Elevation {
+        let inv = 1.0 / (rise * rise + run * run).sqrt();
+        Elevation {
+            psi: atan2(rise, run),
+            sin: rise * inv,
+            cos: run * inv,
+        }
+    }
+}
 
 /// An occluder in a profile: a disc centred at (`u`, `z`) of radius `rho` (0 for a rectangle corner).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -194,11 +227,15 @@ impl ActiveTable {
 
     /// The active occluder for elevation `psi` in (0, pi/2].
     pub fn active(&self, psi: f64) -> Option<&Occluder> {
-        self.entries
+        // The first entry with psi >= its bound: the bounds decrease, so that is the number of
+        // bounds above psi (counted without branches: random directions mispredict a search).
+        let above: usize = self
+            .entries
             .iter()
-            .find(|(lo, _)| psi >= *lo)
-            .or(self.entries.last())
-            .map(|(_, o)| o)
+            .map(|(lo, _)| usize::from(*lo > psi))
+            .sum();
+        let last = self.entries.len().checked_sub(1)?;
+        Some(&self.entries[above.min(last)].1)
     }
 }
 
@@ -262,8 +299,9 @@ pub enum ArcOcclusion {
     /// Nothing of the circle is hidden.
     None,
     /// The arc from the floor on that side up to this angle (measured from the outward
-    /// horizontal toward +z, the thesis's theta of eqs 3.4-3.5) is hidden.
-    UpTo(f64),
+    /// horizontal toward +z, the thesis's theta of eqs 3.4-3.5) is hidden; with the angle's
+    /// (sine, cosine).
+    UpTo(f64, (f64, f64)),
     /// The whole circle lies below the support line.
     All,
 }
@@ -272,29 +310,39 @@ pub enum ArcOcclusion {
 /// elevation `psi` by occluder `o` (eqs 3.2-3.5): theta = psi + asin(s / r1) where `s` is the
 /// support line's offset from the circle's centre.
 pub fn occluded_arc(r1: f64, h1: f64, o: &Occluder, psi: f64) -> ArcOcclusion {
-    let (sp, cp) = psi.sin_cos();
-    let s = o.support(sp, cp) - h1 * cp;
+    occluded_arc_at(r1, h1, o, &Elevation::new(psi))
+}
+
+/// [`occluded_arc`] with the elevation's sine and cosine given.
+#[inline]
+pub fn occluded_arc_at(r1: f64, h1: f64, o: &Occluder, psi: &Elevation) -> ArcOcclusion {
+    let s = o.support(psi.sin, psi.cos) - h1 * psi.cos;
     if s <= -r1 {
         ArcOcclusion::None
     } else if s >= r1 {
         ArcOcclusion::All
     } else {
-        ArcOcclusion::UpTo(psi + (s / r1).asin())
+        // theta = psi + alpha, sin(alpha) = s / r1, cos(alpha) >= 0.
+        let sa = s / r1;
+        let ca = ((1.0 - sa) * (1.0 + sa)).sqrt();
+        ArcOcclusion::UpTo(
+            psi.psi + atan2(sa, ca),
+            (psi.sin * ca + psi.cos * sa, psi.cos * ca - psi.sin * sa),
+        )
     }
 }
 
 /// Length of the flat top (height `top`, starting at u = 0 and running toward -u) of an
 /// equal-area rectangle hidden by occluder `o` from direction of elevation `psi` (eq. 3.6):
 /// l = (s - top cos psi) / sin psi, at least 0 (infinite at grazing elevation when hidden).
-pub fn occluded_length(top: f64, o: &Occluder, psi: f64) -> f64 {
-    let (sp, cp) = psi.sin_cos();
-    let num = o.support(sp, cp) - top * cp;
+pub fn occluded_length(top: f64, o: &Occluder, psi: &Elevation) -> f64 {
+    let num = o.support(psi.sin, psi.cos) - top * psi.cos;
     if num <= 0.0 {
         0.0
-    } else if sp <= 0.0 {
+    } else if psi.sin <= 0.0 {
         f64::INFINITY
     } else {
-        num / sp
+        num / psi.sin
     }
 }
 
@@ -306,53 +354,94 @@ pub fn mean_occluded_length(
     r: f64,
     h: f64,
     o: &Occluder,
-    psi: f64,
-    arc: Arc,
+    psi: &Elevation,
+    arc: &ArcTrig,
     e: Projected,
     max_len: f64,
 ) -> f64 {
-    let (sp, cp) = psi.sin_cos();
-    if arc.is_empty() || sp <= 0.0 {
+    let (sp, cp) = (psi.sin, psi.cos);
+    // The arc faces E: at most pi long.
+    if arc.arc.is_empty() || sp <= 0.0 {
         return occluded_length(crate::geometry::equal_area_height(r, h), o, psi).min(max_len);
     }
-    // l(theta) = a - b sin(theta)
-    let a = (o.support(sp, cp) - h * cp) / sp;
-    let b = r * cp / sp;
-    // Break points: sin(theta) = a / b (l = 0) and (a - max_len) / b (l = max_len).
-    let mut cuts = [0.0f64; 8];
-    cuts[0] = arc.lo;
+    // l(theta) = a - b sin(theta); the divisions independent of one another (their latency
+    // dominated this function).
+    let num0 = o.support(sp, cp) - h * cp;
+    let rc = r * cp;
+    let inv_sp = 1.0 / sp;
+    let inv_rc = 1.0 / rc;
+    let (a, b) = (num0 * inv_sp, rc * inv_sp);
+    // Points of the arc as (key, sin, cos, theta): the arc is at most pi long (it faces E), so
+    // a point's angle phi from arc.lo is in [0, pi], ordered by key = -cos(phi); theta is
+    // computed only where needed (NaN until then).
+    let (s0, c0) = arc.lo;
+    let from_lo = |(s, c): (f64, f64)| (s * c0 - c * s0, c * c0 + s * s0);
+    let cos_len = from_lo(arc.hi).1;
+    let mut cuts = [(0.0f64, 0.0f64, 0.0f64, f64::NAN); 6];
+    cuts[0] = (-1.0, s0, c0, arc.arc.lo);
     let mut n = 1;
     if b > 0.0 {
-        for x in [a / b, (a - max_len) / b] {
+        // Break points: sin(theta) = a / b (l = 0) and (a - max_len) / b (l = max_len), the
+        // two points of the circle with that sine, where they lie inside the arc.
+        for x in [num0 * inv_rc, (num0 - max_len * sp) * inv_rc] {
             if x.abs() < 1.0 {
-                let t = x.asin();
-                for c in [t, std::f64::consts::PI - t, t - 2.0 * std::f64::consts::PI] {
-                    if c > arc.lo && c < arc.hi {
-                        cuts[n] = c;
+                let c = ((1.0 - x) * (1.0 + x)).sqrt();
+                for point in [(x, c), (x, -c)] {
+                    let (sf, cf) = from_lo(point);
+                    if sf > 0.0 && cf > cos_len {
+                        cuts[n] = (-cf, point.0, point.1, f64::NAN);
                         n += 1;
                     }
                 }
             }
         }
     }
-    cuts[n] = arc.hi;
+    cuts[n] = (-cos_len, arc.hi.0, arc.hi.1, arc.arc.hi);
     let cuts = &mut cuts[..=n];
-    cuts.sort_unstable_by(f64::total_cmp);
-    // Primitives of w = e.c cos + e.z sin and of sin * w.
-    let pw = |t: f64| e.c * t.sin() - e.z * t.cos();
-    let psw = |t: f64| e.c * 0.5 * t.sin().powi(2) + e.z * (0.5 * t - 0.25 * (2.0 * t).sin());
+    // Insertion sort by key (at most 6 entries, most often 2).
+    for i in 1..cuts.len() {
+        let mut j = i;
+        while j > 0 && cuts[j - 1].0 > cuts[j].0 {
+            cuts.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+    let theta = |cuts: &mut [(f64, f64, f64, f64)], k: usize| {
+        if cuts[k].3.is_nan() {
+            let (sf, cf) = from_lo((cuts[k].1, cuts[k].2));
+            cuts[k].3 = arc.arc.lo + atan2(sf, cf);
+        }
+        cuts[k]
+    };
+    // Primitives of w = e.c cos + e.z sin and of sin * w (sin 2t / 4 = sin t cos t / 2).
+    let pw = |(_, s, c, _): (f64, f64, f64, f64)| e.c * s - e.z * c;
+    let psw = |(_, s, c, t): (f64, f64, f64, f64)| e.c * 0.5 * s * s + e.z * 0.5 * (t - s * c);
+    // Which clamp holds on a window: l at an end of the arc, where l is known from the end's
+    // sine, if it is clearly off both switch values there (no switch lies inside a window),
+    // else at the window's middle.
+    let tol = 1e-9 * (a.abs() + b.abs() + max_len);
+    let clear = |l: f64| (l.abs() > tol && (l - max_len).abs() > tol).then_some(l);
+    let last = n - 1;
     let (mut num, mut den) = (0.0, 0.0);
-    for w in cuts.windows(2) {
-        let (t0, t1) = (w[0], w[1]);
-        let l_mid = a - b * (0.5 * (t0 + t1)).sin();
-        let wsum = pw(t1) - pw(t0);
+    for k in 0..n {
+        let (q0, q1) = (cuts[k], cuts[k + 1]);
+        let l_end = (k == 0)
+            .then(|| clear(a - b * q0.1))
+            .flatten()
+            .or_else(|| (k == last).then(|| clear(a - b * q1.1)).flatten());
+        let l_mid = l_end.unwrap_or_else(|| {
+            let (p0, p1) = (theta(cuts, k), theta(cuts, k + 1));
+            a - b * sin_cos(0.5 * (p0.3 + p1.3)).0
+        });
+        let wsum = pw(q1) - pw(q0);
         den += wsum;
         num += if l_mid <= 0.0 {
             0.0
         } else if l_mid >= max_len {
             max_len * wsum
         } else {
-            a * wsum - b * (psw(t1) - psw(t0))
+            let (p0, p1) = (theta(cuts, k), theta(cuts, k + 1));
+            a * wsum - b * (psw(p1) - psw(p0))
         };
     }
     if den <= 0.0 {
@@ -391,15 +480,16 @@ mod tests {
                 z: h,
                 rho: 0.0,
             };
-            if let ArcOcclusion::UpTo(t) = occluded_arc(r1, 0.0, &corner, psi) {
+            if let ArcOcclusion::UpTo(t, (s, c)) = occluded_arc(r1, 0.0, &corner, psi) {
                 assert!((t - eq_3_4(r1, d, h, psi)).abs() < 1e-12, "{deg}");
+                assert!((s - t.sin()).abs() < 1e-15 && (c - t.cos()).abs() < 1e-15);
             }
             let disc = Occluder {
                 u: r1 + d + r2,
                 z: 0.0,
                 rho: r2,
             };
-            if let ArcOcclusion::UpTo(t) = occluded_arc(r1, 0.0, &disc, psi) {
+            if let ArcOcclusion::UpTo(t, _) = occluded_arc(r1, 0.0, &disc, psi) {
                 assert!((t - eq_3_5(r1, r2, d, psi)).abs() < 1e-12, "{deg}");
             }
             let top = PI * r1 / 4.0;
@@ -410,7 +500,7 @@ mod tests {
             };
             let want = eq_3_6(r2, d, top, psi).max(0.0);
             assert!(
-                (occluded_length(top, &disc, psi) - want).abs() < 1e-12,
+                (occluded_length(top, &disc, &Elevation::new(psi)) - want).abs() < 1e-12,
                 "{deg}"
             );
         }
@@ -474,7 +564,7 @@ mod tests {
             rho: 1.5,
         };
         let e = Projected { c: 0.4, z: 0.8 };
-        let arc = Arc { lo: 0.1, hi: 2.9 };
+        let arc = crate::arc::Arc { lo: 0.1, hi: 2.9 };
         for deg in [15.0, 30.0, 50.0, 75.0] {
             let psi = f64::to_radians(deg);
             let (r, h, max_len) = (1.5, 0.2, 2.0);
@@ -486,7 +576,15 @@ mod tests {
             let w = |t: f64| e.c * t.cos() + e.z * t.sin();
             let num = crate::quad::integrate(&mut |t| pointwise(t) * w(t), arc.lo, arc.hi, 1e-12);
             let den = crate::quad::integrate(&mut |t| w(t), arc.lo, arc.hi, 1e-12);
-            let got = mean_occluded_length(r, h, &o, psi, arc, e, max_len);
+            let got = mean_occluded_length(
+                r,
+                h,
+                &o,
+                &Elevation::new(psi),
+                &ArcTrig::new(arc),
+                e,
+                max_len,
+            );
             assert!(
                 (got - num / den).abs() < 1e-6,
                 "{deg}: {got} vs {}",

@@ -1,5 +1,12 @@
-//! Sine and cosine together, inline, for the quadrature loops of the secondary reflection
-//! (the library's `sin_cos` is an out-of-line call that dominated them).
+//! Inline trigonometry: sine and cosine together, for the quadrature loops of the secondary
+//! reflection (the library's `sin_cos` is an out-of-line call that dominated them), and
+//! `atan2`/`asin` for the direct model's arcs (issue 22: the library's calls were half its time).
+//!
+//! `atan2`: octant reduction to t = min(|x|, |y|) / max(|x|, |y|) in [0, 1], then once more by
+//! tan(pi/8) (t > tan(pi/8): atan t = pi/4 + atan((t - 1)/(t + 1))) onto |t| <= 0.4143, where
+//! FDLIBM's `s_atan.c` polynomial (11 terms, < 1 ulp on |t| < 7/16) gives atan t; the quadrant
+//! fix-ups subtract from pi/2 and pi with their low parts. `asin x = atan2(x, sqrt((1-x)(1+x)))`.
+//! Both within 5e-16 (two units in the last place near pi) of the standard library's, tested.
 //!
 //! Quadrant reduction x = k pi/2 + r with |r| <= pi/4 (pi/2 split in two parts, Cody & Waite, so
 //! r keeps full precision for the |x| of a few turns these loops use), then the Taylor series of
@@ -60,6 +67,79 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     }
 }
 
+/// FDLIBM `s_atan.c`'s coefficients: atan t = t - t (s1 + s2) with s1 the even-indexed terms
+/// in w = t^4 times z = t^2, s2 the odd-indexed ones times w.
+const AT: [f64; 11] = [
+    f64::from_bits(0x3FD5_5555_5555_550D), //  3.33333333333329318027e-01
+    f64::from_bits(0xBFC9_9999_9998_EBC4), // -1.99999999998764832476e-01
+    f64::from_bits(0x3FC2_4924_9200_83FF), //  1.42857142725034663711e-01
+    f64::from_bits(0xBFBC_71C6_FE23_1671), // -1.11111104054623557880e-01
+    f64::from_bits(0x3FB7_45CD_C54C_206E), //  9.09088713343650656196e-02
+    f64::from_bits(0xBFB3_B0F2_AF74_9A6D), // -7.69187620504482999495e-02
+    f64::from_bits(0x3FB1_0D66_A0D0_3D51), //  6.66107313738753120669e-02
+    f64::from_bits(0xBFAD_DE2D_52DE_FD9A), // -5.83357013379057348645e-02
+    f64::from_bits(0x3FA9_7B4B_2476_0DEB), //  4.97687799461593236017e-02
+    f64::from_bits(0xBFA2_B444_2C6A_6C2F), // -3.65315727442169155270e-02
+    f64::from_bits(0x3F90_AD3A_E322_DA11), //  1.62858201153657823623e-02
+];
+/// pi/4 in two parts (high part the nearest double, low part the rest); pi/2 and pi's low parts.
+const PI_4_HI: f64 = std::f64::consts::FRAC_PI_4;
+const PI_4_LO: f64 = f64::from_bits(0x3C81_A626_3314_5C07);
+const PI_2_LO_FULL: f64 = f64::from_bits(0x3C91_A626_3314_5C07);
+const PI_LO: f64 = f64::from_bits(0x3CA1_A626_3314_5C07);
+
+/// atan(t) for |t| <= 0.4375 (FDLIBM's kernel, no reduction).
+#[inline(always)]
+fn atan_kernel(t: f64) -> f64 {
+    let z = t * t;
+    let w = z * z;
+    let s1 = z * (AT[0] + w * (AT[2] + w * (AT[4] + w * (AT[6] + w * (AT[8] + w * AT[10])))));
+    let s2 = w * (AT[1] + w * (AT[3] + w * (AT[5] + w * (AT[7] + w * AT[9]))));
+    t * (s1 + s2)
+}
+
+/// `y.atan2(x)` within 5e-16, inline; the standard library's for non-finite input or the origin.
+#[inline]
+pub fn atan2(y: f64, x: f64) -> f64 {
+    // Written as selects, not branches (random directions mispredict them): one division.
+    let (ax, ay) = (x.abs(), y.abs());
+    let swap = ay > ax;
+    let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
+    if !(den > 0.0 && den < f64::INFINITY) {
+        return y.atan2(x);
+    }
+    // atan(num / den) in [0, pi/4]: above tan(pi/8), pi/4 + atan((num - den) / (num + den)).
+    let big = num > 0.414_213_562_373_095_03 * den;
+    let (n2, d2) = if big {
+        (num - den, num + den)
+    } else {
+        (num, den)
+    };
+    let (hi, lo) = if big { (PI_4_HI, PI_4_LO) } else { (0.0, 0.0) };
+    let t = n2 / d2;
+    let a = hi - ((atan_kernel(t) - lo) - t);
+    let a = if swap {
+        (std::f64::consts::FRAC_PI_2 - a) + PI_2_LO_FULL
+    } else {
+        a
+    };
+    let a = if x < 0.0 {
+        (std::f64::consts::PI - a) + PI_LO
+    } else {
+        a
+    };
+    a.copysign(y)
+}
+
+/// `x.asin()` within 5e-16 for |x| <= 1, inline (NaN outside).
+#[inline]
+pub fn asin(x: f64) -> f64 {
+    if x.is_nan() || x.abs() > 1.0 {
+        return f64::NAN;
+    }
+    atan2(x, ((1.0 - x) * (1.0 + x)).sqrt())
+}
+
 /// The integer nearest `x` (ties to even) for |x| < 2^51, by the 1.5 * 2^52 shift: no `round`
 /// library call on baseline x86-64.
 #[inline(always)]
@@ -90,6 +170,65 @@ mod tests {
         }
         let (s, c) = sin_cos(f64::NAN);
         assert!(s.is_nan() && c.is_nan());
+    }
+
+    #[test]
+    fn atan2_and_asin_match_the_standard_library() {
+        let mut rng = crate::rng::Rng::new(7);
+        let mut worst = 0f64;
+        for i in 0..400_000 {
+            // Every octant, both signs of zero, magnitudes far apart and on the reduction's
+            // break points (|t| = tan(pi/8), 1).
+            let (y, x) = match i % 4 {
+                0 => {
+                    let t = std::f64::consts::TAU * rng.next_f64();
+                    let r = 1e-3 + rng.next_f64();
+                    (r * t.sin(), r * t.cos())
+                }
+                1 => (rng.next_f64() - 0.5, 1e-12 * (rng.next_f64() - 0.5)),
+                2 => {
+                    let s = if rng.next_u64().is_multiple_of(2) {
+                        1.0
+                    } else {
+                        -1.0
+                    };
+                    let t = 0.414_213_562_373_095 * (1.0 + 1e-9 * (rng.next_f64() - 0.5));
+                    (s * t, -s * (1.0 + 1e-15 * (rng.next_f64() - 0.5)))
+                }
+                _ => {
+                    let x = 2.0 * rng.next_f64() - 1.0;
+                    worst = worst.max((asin(x) - x.asin()).abs());
+                    (x, 1.0 - x)
+                }
+            };
+            worst = worst.max((atan2(y, x) - y.atan2(x)).abs());
+        }
+        assert!(worst < 5e-16, "worst {worst:e}");
+        for (y, x) in [
+            (0.0, 1.0),
+            (-0.0, 1.0),
+            (0.0, -1.0),
+            (-0.0, -1.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (1.0, 1.0),
+            (-1.0, -1.0),
+            (0.0, 0.0),
+            (-0.0, -0.0),
+            (1.0, f64::INFINITY),
+            (f64::INFINITY, -1.0),
+        ] {
+            let (a, b) = (atan2(y, x), y.atan2(x));
+            assert!(
+                (a - b).abs() < 5e-16 && a.is_sign_negative() == b.is_sign_negative(),
+                "{y} {x}: {a} {b}"
+            );
+        }
+        assert!(atan2(f64::NAN, 1.0).is_nan() && atan2(1.0, f64::NAN).is_nan());
+        for x in [-1.0, -0.5, 0.0, 0.5, 1.0, 1e-300, 0.999_999_999_999] {
+            assert!((asin(x) - x.asin()).abs() < 5e-16, "{x}");
+        }
+        assert!(asin(1.5).is_nan() && asin(f64::NAN).is_nan());
     }
 
     #[test]

@@ -1,10 +1,10 @@
 //! Criterion benchmarks of the render-time lookup on a default-size (32 x 64 x 32 x 64) table
 //! of synthetic values: one lookup (f16 and f32 storage, vector and degree entry points), the
 //! batched lookup per item, reciprocal lookups, `sample` and `pdf`; the default kernel (AVX2
-//! where the processor has it) and the portable one (`*_portable`). Direction pairs cycle
-//! through a fixed set of 64 random pairs (`warm`: the nodes of each stay in the caches, as
-//! for coherent rays) or of 1 << 20 (`random`: most of the 8 cache lines a lookup touches
-//! come from memory).
+//! where the processor has it) and the portable one (`*_portable`). Every function runs on
+//! two sets of random pairs: 64 cycled (`warm`: the nodes of each stay in the caches, as for
+//! coherent rays) and 1 << 20 walked in order (`random`: most of the 8 cache lines a lookup
+//! touches come from memory).
 //! The side-by-side comparison with the analytic model is `cargo bench -p clothbake-tests`.
 
 use clothbake_loader::{
@@ -15,6 +15,8 @@ use std::hint::black_box;
 
 /// Pairs of the cache-warm set.
 const WARM: usize = 64;
+/// Pairs of the random pool (24 MiB of pairs; the table is 50 MiB at f16, 100 MiB at f32).
+const RANDOM: usize = 1 << 20;
 
 const GRID: Grid = Grid {
     n_theta_i: 32,
@@ -62,6 +64,7 @@ fn lookup(c: &mut Criterion) {
     let portable = |b: &Brdf| b.clone().with_simd_path(SimdPath::Portable).unwrap();
     let (half_p, wide_p) = (portable(&half), portable(&wide));
     let (wi, wo) = pairs(WARM);
+    let (cold_i, cold_o) = pairs(RANDOM);
     let mut g = c.benchmark_group("lookup");
     println!("default kernel: {:?}", half.simd_path());
     for (name, b) in [
@@ -71,45 +74,49 @@ fn lookup(c: &mut Criterion) {
         ("f16_portable", &half_p),
         ("f32_portable", &wide_p),
     ] {
-        g.bench_function(format!("eval/{name}/warm"), |bench| {
-            let mut k = 0;
-            bench.iter(|| {
-                k = (k + 1) % WARM;
-                black_box(b.eval(black_box(wi[k]), black_box(wo[k])))
-            })
-        });
+        for (set, mask, (vi, vo)) in [
+            ("warm", WARM - 1, (&wi, &wo)),
+            ("random", RANDOM - 1, (&cold_i, &cold_o)),
+        ] {
+            g.bench_function(format!("eval/{name}/{set}"), |bench| {
+                let mut k = 0;
+                bench.iter(|| {
+                    k = (k + 1) & mask;
+                    black_box(b.eval(black_box(vi[k]), black_box(vo[k])))
+                })
+            });
+        }
     }
     // The same pairs as angles in degrees.
     let angles = |w: [f32; 3]| {
         let (t, p) = (w[2].acos().to_degrees(), w[1].atan2(w[0]).to_degrees());
         [t, p.rem_euclid(360.0)]
     };
-    let deg: Vec<([f32; 2], [f32; 2])> = wi
-        .iter()
-        .zip(&wo)
-        .map(|(&a, &b)| (angles(a), angles(b)))
-        .collect();
-    g.bench_function("eval_deg/f16/warm", |bench| {
-        let mut k = 0;
-        bench.iter(|| {
-            k = (k + 1) % WARM;
-            let (a, b) = (deg[k].0, deg[k].1);
-            black_box(half.eval_deg(
-                black_box(a[0]),
-                black_box(a[1]),
-                black_box(b[0]),
-                black_box(b[1]),
-            ))
-        })
-    });
-    let (cold_i, cold_o) = pairs(1 << 20);
-    g.bench_function("eval/f16/random", |bench| {
-        let mut k = 0;
-        bench.iter(|| {
-            k = (k + 1) & ((1 << 20) - 1);
-            black_box(half.eval(black_box(cold_i[k]), black_box(cold_o[k])))
-        })
-    });
+    let degrees = |vi: &[[f32; 3]], vo: &[[f32; 3]]| -> Vec<([f32; 2], [f32; 2])> {
+        vi.iter()
+            .zip(vo)
+            .map(|(&a, &b)| (angles(a), angles(b)))
+            .collect()
+    };
+    for (set, deg) in [
+        ("warm", degrees(&wi, &wo)),
+        ("random", degrees(&cold_i, &cold_o)),
+    ] {
+        let mask = deg.len() - 1;
+        g.bench_function(format!("eval_deg/f16/{set}"), |bench| {
+            let mut k = 0;
+            bench.iter(|| {
+                k = (k + 1) & mask;
+                let (a, b) = (deg[k].0, deg[k].1);
+                black_box(half.eval_deg(
+                    black_box(a[0]),
+                    black_box(a[1]),
+                    black_box(b[0]),
+                    black_box(b[1]),
+                ))
+            })
+        });
+    }
     let mut out = vec![[0f32; 3]; WARM];
     g.throughput(Throughput::Elements(WARM as u64));
     g.bench_function("eval_batch/f16/warm", |bench| {
@@ -124,39 +131,46 @@ fn lookup(c: &mut Criterion) {
     let n = 4096;
     let mut out = vec![[0f32; 3]; n];
     g.throughput(Throughput::Elements(n as u64));
-    g.bench_function("eval_batch/f16/random", |bench| {
-        let mut start = 0;
-        bench.iter(|| {
-            start = (start + n) & ((1 << 20) - 1);
-            let r = start..start + n;
-            half.eval_batch(
-                black_box(&cold_i[r.clone()]),
-                black_box(&cold_o[r]),
-                &mut out,
-            )
-        })
-    });
+    for (name, b) in [("f16", &half), ("f32", &wide)] {
+        g.bench_function(format!("eval_batch/{name}/random"), |bench| {
+            let mut start = 0;
+            bench.iter(|| {
+                start = (start + n) & (RANDOM - 1);
+                let r = start..start + n;
+                b.eval_batch(
+                    black_box(&cold_i[r.clone()]),
+                    black_box(&cold_o[r]),
+                    &mut out,
+                )
+            })
+        });
+    }
     g.finish();
 
     let mut g = c.benchmark_group("sampling");
-    g.bench_function("sample/f16/warm", |bench| {
-        let mut k = 0;
-        bench.iter(|| {
-            k = (k + 1) % WARM;
-            black_box(half.sample(
-                black_box(wo[k]),
-                black_box(wi[k][0].abs()),
-                black_box(wi[k][2]),
-            ))
-        })
-    });
-    g.bench_function("pdf/f16/warm", |bench| {
-        let mut k = 0;
-        bench.iter(|| {
-            k = (k + 1) % WARM;
-            black_box(half.pdf(black_box(wo[k]), black_box(wi[k])))
-        })
-    });
+    for (set, mask, (vi, vo)) in [
+        ("warm", WARM - 1, (&wi, &wo)),
+        ("random", RANDOM - 1, (&cold_i, &cold_o)),
+    ] {
+        g.bench_function(format!("sample/f16/{set}"), |bench| {
+            let mut k = 0;
+            bench.iter(|| {
+                k = (k + 1) & mask;
+                black_box(half.sample(
+                    black_box(vo[k]),
+                    black_box(vi[k][0].abs()),
+                    black_box(vi[k][2]),
+                ))
+            })
+        });
+        g.bench_function(format!("pdf/f16/{set}"), |bench| {
+            let mut k = 0;
+            bench.iter(|| {
+                k = (k + 1) & mask;
+                black_box(half.pdf(black_box(vo[k]), black_box(vi[k])))
+            })
+        });
+    }
     g.finish();
 }
 

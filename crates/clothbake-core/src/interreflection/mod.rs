@@ -288,10 +288,10 @@ mod tests {
                 Arc::facing(crate::arc::Projected { c: v.x, z: v.z }).meet(Arc { lo: 0.0, hi: PI });
             let th = v.z.atan2(v.x);
             if v.x > 0.0 {
-                if let ArcOcclusion::UpTo(t) = occluded_arc(1.0, 0.0, &nb, th) {
+                if let ArcOcclusion::UpTo(t, _) = occluded_arc(1.0, 0.0, &nb, th) {
                     a.lo = a.lo.max(t);
                 }
-            } else if let ArcOcclusion::UpTo(t) = occluded_arc(1.0, 0.0, &nb, PI - th) {
+            } else if let ArcOcclusion::UpTo(t, _) = occluded_arc(1.0, 0.0, &nb, PI - th) {
                 a.hi = a.hi.min(PI - t);
             }
             a
