@@ -193,17 +193,21 @@ fn validate() {
         .unwrap();
     }
     let path = root().join("docs/validation.md");
-    // Keep the full-transport section `cargo xtask transport` writes between its markers.
+    // Keep the sections `cargo xtask transport` and `validate-spatial` write between markers.
     let old = std::fs::read_to_string(&path).unwrap_or_default();
-    let keep = old
-        .find("<!-- transport-validation:begin -->")
-        .zip(old.find("<!-- transport-validation:end -->"))
-        .map(|(a, b)| &old[a..b + "<!-- transport-validation:end -->".len()]);
-    out.push('\n');
-    out.push_str(
-        keep.unwrap_or("<!-- transport-validation:begin -->\n<!-- transport-validation:end -->"),
-    );
-    out.push('\n');
+    for marker in ["transport-validation", "spatial-validation"] {
+        let (begin, end) = (
+            format!("<!-- {marker}:begin -->"),
+            format!("<!-- {marker}:end -->"),
+        );
+        let keep = old
+            .find(&begin)
+            .zip(old.find(&end))
+            .map(|(a, b)| old[a..b + end.len()].to_string());
+        out.push('\n');
+        out.push_str(&keep.unwrap_or(format!("{begin}\n{end}")));
+        out.push('\n');
+    }
     std::fs::write(&path, out).unwrap();
     eprintln!("wrote {}", path.display());
 }

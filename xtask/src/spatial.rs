@@ -15,6 +15,7 @@ const MIN_HITS: usize = 2000;
 pub fn run(root: &Path) {
     let pairs = direction_set(PAIRS, 70.0);
     let mut out = String::new();
+    let mut rows = String::new();
     writeln!(
         out,
         "# Validation per crossing cell: the spatial model against the ground truth\n\n\
@@ -58,7 +59,7 @@ pub fn run(root: &Path) {
         }
         let name = path.file_stem().unwrap().to_string_lossy();
         writeln!(
-            out,
+            rows,
             "| {name} | {} | {:.2}% | {:.2}% | {:.3} | {:.2}% |",
             nx * ny,
             100.0 * sum / n as f64,
@@ -69,7 +70,21 @@ pub fn run(root: &Path) {
         .unwrap();
         eprintln!("{name}: mean {:.4} worst {worst:.4}", sum / n as f64);
     }
+    out.push_str(&rows);
     let path = root.join("docs/validation-spatial.md");
     std::fs::write(&path, out).unwrap();
     eprintln!("wrote {}", path.display());
+    // The same table in docs/validation.md, between its `spatial-validation` markers.
+    crate::transport::write_between(
+        &root.join("docs/validation.md"),
+        "spatial-validation",
+        &format!(
+            "## Per crossing cell (the spatial model, docs/spatial.md)\n\n\
+             Written by `cargo xtask validate-spatial` (details and method in \
+             docs/validation-spatial.md): {PAIRS} pairs up to 70 degrees, {SAMPLES} rays each, \
+             the truth's hits sorted into the crossing cells by its own rule.\n\n\
+             | fabric | cells | mean rel. err | worst cell | worst coverage err | noise |\n\
+             |---|---|---|---|---|---|\n{rows}"
+        ),
+    );
 }
