@@ -173,7 +173,8 @@ impl std::fmt::Display for GridMismatch {
     }
 }
 
-/// Compares every value of `a` with the same value of `b`.
+/// Compares every value of `a` with the same value of `b` (only the averaged RGB values when
+/// one is a spatial table and the other not, or their classes differ).
 pub fn compare(a: &Table, b: &Table, tol: Tolerance) -> Result<Comparison, GridMismatch> {
     if a.meta.grid != b.meta.grid {
         return Err(GridMismatch {
@@ -182,12 +183,18 @@ pub fn compare(a: &Table, b: &Table, tol: Tolerance) -> Result<Comparison, GridM
         });
     }
     let g = a.meta.grid;
-    let n = a.values.len();
+    // A spatial table begins with its averaged values: against an averaged table, or a
+    // spatial one of other classes, the averaged parts are compared.
+    let n = if a.values.len() == b.values.len() {
+        a.values.len()
+    } else {
+        3 * g.len()
+    };
     let (mut sum_abs, mut sum_sq, mut sum_rel, mut n_rel) = (0.0, 0.0, 0.0, 0usize);
     let (mut max_abs, mut max_rel, mut peak) = (0.0f64, 0.0f64, f64::NEG_INFINITY);
     let mut beyond = 0;
     let mut worst: Option<(f64, f64, usize)> = None; // (ratio, diff, value index)
-    for (k, (&x, &y)) in a.values.iter().zip(&b.values).enumerate() {
+    for (k, (&x, &y)) in a.values[..n].iter().zip(&b.values[..n]).enumerate() {
         let (x64, y64) = (f64::from(x), f64::from(y));
         let d = (x64 - y64).abs();
         peak = peak.max(x64);

@@ -183,6 +183,27 @@ fn spatial_bakes_are_the_same_for_any_thread_count_and_shard_split() {
     identical(&d, "one.exr", "merged.exr");
     let info = succeeds(&run_in(&d, &["info", "merged.exr"]));
     assert!(info.contains("spatial    3 classes over 3 x 3"), "{info}");
+    // Against the averaged bake, `diff` compares the averaged parts: equal to rounding.
+    succeeds(&run_in(
+        &d,
+        &[
+            "bake",
+            "--weave",
+            twill.as_str(),
+            "--res",
+            RES,
+            "-o",
+            "avg.exr",
+        ],
+    ));
+    let out = succeeds(&run_in(
+        &d,
+        &["diff", "one.exr", "avg.exr", "--tol", "1e-5"],
+    ));
+    assert!(
+        out.contains(&format!("{} values", 3 * 8 * 16 * 8 * 16)),
+        "{out}"
+    );
     // What a spatial table cannot hold yet is refused before anything is written.
     fails_with(
         &run_in(
