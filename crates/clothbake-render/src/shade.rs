@@ -19,7 +19,9 @@
 //! * with `render --periods N`, f_r is looked up through the pixel's footprint of the weave
 //!   period (`Bsdf::f_at`, docs/spatial.md): a spatial table or the model shows the weave where
 //!   a pixel covers less than a period, and the average beyond. The cloth is drawn opaque (the
-//!   coverage of the gaps is not applied), so a distant render equals the averaged one.
+//!   coverage of the gaps is not applied), so a distant render equals the averaged one; with
+//!   `--gaps` every value is scaled by the coverage c of its footprint (the cloth over black:
+//!   `V c`), the directional coverage C(wo) without `--periods` (1 for an averaged table).
 
 pub use clothbake_core::Component;
 use clothbake_core::{
@@ -32,12 +34,25 @@ use clothbake_core::{
 pub struct Shader {
     bsdf: Box<dyn Bsdf>,
     tint: [f32; 3],
+    /// Whether the gaps between the yarns show: the value is scaled by the coverage.
+    gaps: bool,
 }
 
 impl Shader {
     /// Any BSDF with the tint of its ambient term.
     pub fn new(bsdf: Box<dyn Bsdf>, tint: [f32; 3]) -> Shader {
-        Shader { bsdf, tint }
+        Shader {
+            bsdf,
+            tint,
+            gaps: false,
+        }
+    }
+
+    /// The same shader showing the gaps between the yarns (`render --gaps`): each value is
+    /// scaled by the coverage of its footprint (`Bsdf::coverage_at`), as if the cloth lay
+    /// over black.
+    pub fn with_gaps(self) -> Shader {
+        Shader { gaps: true, ..self }
     }
 
     /// The analytic model of `fabric`; `secondary` adds I_2 (two bounces). [`Component::Secondary`]
@@ -151,6 +166,16 @@ pub fn radiance_at(
         for k in 0..3 {
             v[k] += f64::from(f[k]) * ce;
         }
+    }
+    if shader.gaps {
+        // Without a footprint, the whole period's (the directional coverage).
+        let at = at.unwrap_or(Footprint {
+            u: 0.0,
+            v: 0.0,
+            width: f64::INFINITY,
+        });
+        let c = shader.bsdf.coverage_at(at, wo);
+        v = v.map(|x| x * c);
     }
     v
 }

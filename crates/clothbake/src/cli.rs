@@ -1123,6 +1123,12 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", value_parser = parse_periods)]
     pub periods: Option<f64>,
 
+    /// Show the gaps between the yarns: each pixel scaled by the coverage of its footprint
+    /// (the cloth over black; a table baked with --spatial or the model carries the coverage,
+    /// an averaged table counts as opaque).
+    #[arg(long)]
+    pub gaps: bool,
+
     /// Ambient coefficient rho_a (thesis sec. 4.3 uses 0.3).
     #[arg(long, value_name = "RHO_A", value_parser = parse_ambient, default_value = "0.3")]
     pub ambient: f64,

@@ -141,6 +141,7 @@ const RENDER_BAR: &str = "{elapsed_precise} [{wide_bar}] {percent:>3}% {pos}/{le
 pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
     let mut srcs = sources(&a.brdf, 1)?;
     let (_, shader) = srcs.pop().expect("one source");
+    let shader = if a.gaps { shader.with_gaps() } else { shader };
     let mut outputs = vec![(a.output.as_path(), "PNG image")];
     if let Some(e) = &a.exr {
         outputs.push((e.as_path(), "OpenEXR image"));

@@ -195,6 +195,16 @@ fn plot_writes_png_and_svg() {
 /// Renders `table` on the swatch (64 x 48, one sample a pixel), with `--periods` when given,
 /// and returns the linear pixels of its `--exr` output.
 fn swatch_pixels(table: &Path, periods: Option<&str>, name: &str) -> Vec<[f32; 3]> {
+    swatch_pixels_with(table, periods, &[], name)
+}
+
+/// As [`swatch_pixels`], with `extra` flags.
+fn swatch_pixels_with(
+    table: &Path,
+    periods: Option<&str>,
+    extra: &[&str],
+    name: &str,
+) -> Vec<[f32; 3]> {
     let (png_path, exr_path) = (temp(&format!("{name}.png")), temp(&format!("{name}.exr")));
     let mut args = vec![
         "render",
@@ -217,6 +227,7 @@ fn swatch_pixels(table: &Path, periods: Option<&str>, name: &str) -> Vec<[f32; 3
     if let Some(n) = periods {
         args.extend(["--periods", n]);
     }
+    args.extend(extra);
     succeeds(&args);
     read_rgb(&exr_path, 64)
 }
@@ -273,6 +284,25 @@ fn periods_show_the_weave_up_close_and_the_average_from_afar() {
         spread(&c),
         spread(&a)
     );
+    // --gaps: each pixel times the coverage of its footprint, at most a little over 1 (a tall
+    // yarn seen over its neighbour's cell, docs/spatial.md) and well under 1 where the eye
+    // meets the floor between yarns; without --periods, the directional coverage C(wo).
+    for periods in [Some("12"), None] {
+        let plain = swatch_pixels(&table, periods, "plain");
+        let gaps = swatch_pixels_with(&table, periods, &["--gaps"], "gaps");
+        let ratios: Vec<f32> = plain
+            .iter()
+            .zip(&gaps)
+            .filter(|(p, _)| p[0] > 0.05)
+            .map(|(p, g)| g[0] / p[0])
+            .collect();
+        let mean = ratios.iter().sum::<f32>() / ratios.len() as f32;
+        let max = ratios.iter().fold(0f32, |m, &r| m.max(r));
+        assert!(
+            (0.6..0.99).contains(&mean) && max < 1.05,
+            "coverage: mean {mean}, max {max} ({periods:?})"
+        );
+    }
     let red = c.iter().filter(|&&h| h < 0.8).count();
     let white = c.iter().filter(|&&h| h > 0.95).count();
     assert!(
