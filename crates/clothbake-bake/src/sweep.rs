@@ -495,14 +495,8 @@ impl Baker {
                 })
             }
             (Method::Analytic { variant }, Some(mb)) => {
-                // The analytic direct term and second bounce (the control variate) plus the
-                // interpolated path-traced rest of the orders >= 2.
-                let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
-                let bsdf = AnalyticBsdf::new(m, mb.control());
-                Box::new(move |_, wi, wo, out| {
-                    let (d, r) = (bsdf.f(wi, wo), mb.f(wi, wo));
-                    out.push(std::array::from_fn(|k| (d[k] + r[k]) as f32));
-                })
+                let ft = crate::transport::FullTransport::with(fabric, opts.facet, variant, mb);
+                Box::new(move |_, wi, wo, out| out.push(ft.f(wi, wo).map(|x| x as f32)))
             }
             (Method::Analytic { variant }, None) => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);

@@ -18,13 +18,14 @@ use crate::sweep::{direction, representative, usable_symmetries};
 use clothbake_core::symmetry::Symmetry;
 use clothbake_core::transport::{bounces_name, max_order, Transport};
 use clothbake_core::{
-    AnalyticModel, Fabric, FacetModel, Kernel, RayTracer, SecondaryOptions, UnitVec3,
+    AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FacetModel, Kernel, RayTracer, Rgb,
+    SecondaryOptions, UnitVec3, Variant,
 };
 use clothbake_loader::Grid;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// The largest coarse grid: 8 x 16 x 8 x 16 nodes (11 degrees in theta, 22.5 in phi).
 pub const COARSE: Grid = Grid {
@@ -308,6 +309,48 @@ impl Multiple {
             std::array::from_fn(|k| v[k] * i1[k] / to_f),
             var.sqrt() * mean(i1) / to_f,
         )
+    }
+}
+
+/// The analytic model with every bounce (`--bounces N > 2`, `all`) as a [`Bsdf`]: the analytic
+/// direct term and second bounce (the control variate) plus the interpolated path-traced rest
+/// of the orders >= 2 ([`Multiple::f`]), the sum a full-transport bake tabulates. Nodes are
+/// computed on first use (about 4 minutes of CPU for all of them), each once.
+pub struct FullTransport {
+    model: AnalyticBsdf,
+    multiple: Arc<Multiple>,
+}
+
+impl FullTransport {
+    /// Full transport of `fabric` with `bounces` (> 2) on the coarse grid [`COARSE`].
+    pub fn new(fabric: &Fabric, facet: FacetModel, variant: Variant, bounces: u32) -> Self {
+        FullTransport::with(
+            fabric,
+            facet,
+            variant,
+            Arc::new(Multiple::new(fabric, facet, &COARSE, bounces)),
+        )
+    }
+
+    /// Full transport with the multiple-bounce part `multiple` (shared with a bake).
+    pub fn with(
+        fabric: &Fabric,
+        facet: FacetModel,
+        variant: Variant,
+        multiple: Arc<Multiple>,
+    ) -> Self {
+        let model = AnalyticBsdf::new(
+            AnalyticModel::with_variant(fabric, facet, variant),
+            multiple.control(),
+        );
+        FullTransport { model, multiple }
+    }
+}
+
+impl Bsdf for FullTransport {
+    fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb {
+        let (d, r) = (self.model.f(wi, wo), self.multiple.f(wi, wo));
+        std::array::from_fn(|k| d[k] + r[k])
     }
 }
 

@@ -729,26 +729,6 @@ impl BounceArgs {
         })
     }
 
-    /// An error for the commands that evaluate the model per direction (`render`, `plot`,
-    /// `export`; `command` names them):
-    /// full transport (--bounces N > 2, all) is path-traced and is made there from a table.
-    pub fn model_only(&self, command: &str) -> Result<(), CliError> {
-        if self.bounces > 2 {
-            return Err(CliError::new(
-                format!(
-                    "with --weave, {command} evaluates the model per direction and takes \
-                     --bounces 1 or 2; --bounces {} path-traces every bounce past the first",
-                    clothbake_core::transport::bounces_name(self.bounces)
-                ),
-                format!(
-                    "bake a table with `clothbake bake --bounces {}` and give it as --table",
-                    clothbake_core::transport::bounces_name(self.bounces)
-                ),
-            ));
-        }
-        Ok(())
-    }
-
     /// The secondary-reflection options (also for --bounces 1, where they are unused); the
     /// library's rules ([`Bounces::options`]).
     pub fn options(&self) -> Result<SecondaryOptions, CliError> {

@@ -46,7 +46,6 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
              table)",
         )),
         (Some(weave), None) => {
-            args.bounces.model_only("export")?;
             let secondary = args.bounces.options()?;
             let secondary = (args.bounces.bounces == 2).then_some(secondary);
             let fabric = apply_material(
@@ -58,7 +57,17 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);
             let model = AnalyticModel::with_variant(&fabric, facet, variant.into());
             let variant_name = model.variant().name();
-            let brdf = AnalyticBsdf::new(model, secondary);
+            // Full transport: the analytic terms plus the path-traced orders (docs/transport.md).
+            let brdf: Box<dyn Bsdf> = if args.bounces.bounces > 2 {
+                Box::new(clothbake_bake::transport::FullTransport::new(
+                    &fabric,
+                    facet,
+                    variant.into(),
+                    args.bounces.bounces,
+                ))
+            } else {
+                Box::new(AnalyticBsdf::new(model, secondary))
+            };
             let source = format!(
                 "fabric {}; f_r cos(theta_light) of the analytic model (facet {}, variant {}, \
                  bounces {})",
@@ -69,7 +78,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             );
             // A fabric unchanged by a half turn has a BRDF unchanged by it: half the rotations.
             let half_turn = symmetries(&fabric).contains(&Symmetry::Rotate180);
-            write_all(args, &brdf, &source, half_turn)
+            write_all(args, brdf.as_ref(), &source, half_turn)
         }
         (None, Some(table)) => {
             refuse_model_options(args)?;

@@ -20,7 +20,6 @@ use std::time::Instant;
 
 /// The model shader of `--weave`, with its options checked.
 fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
-    b.bounces.model_only("render (and plot)")?;
     let opts = b.bounces.options()?;
     let secondary = (b.bounces.bounces == 2).then_some(opts);
     let component = match b.component {
@@ -33,6 +32,30 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
         crate::fabrics::read(weave, &Default::default())?,
         &b.material,
     )?;
+    if b.bounces.bounces > 2 {
+        // Full transport: the analytic terms plus the path-traced orders (docs/transport.md),
+        // whole only.
+        if component != Component::Total {
+            return Err(CliError::new(
+                format!(
+                    "--component {} with --bounces {}: full transport is drawn whole",
+                    component_name(b.component),
+                    clothbake_core::transport::bounces_name(b.bounces.bounces)
+                ),
+                "use --component total, or --bounces 2 for the secondary reflection's parts",
+            ));
+        }
+        let ft = clothbake_bake::transport::FullTransport::new(
+            &fabric,
+            FacetModel::from(b.model.facet),
+            b.model.variant.into(),
+            b.bounces.bounces,
+        );
+        return Ok(Shader::new(
+            Box::new(ft),
+            clothbake_render::shade::fabric_tint(&fabric),
+        ));
+    }
     Shader::model(
         &fabric,
         FacetModel::from(b.model.facet),

@@ -119,11 +119,13 @@ fn full_transport_refusals_name_the_flag_and_the_fix() {
             twill.as_str(),
             "--bounces",
             "all",
+            "--component",
+            "direct",
             "-o",
             "x.png",
         ],
     );
-    common::fails_with(&out, 2, &["--bounces all", "--table"]);
+    common::fails_with(&out, 2, &["--component direct", "--bounces all"]);
     let out = common::run_in(
         &d,
         &[
