@@ -1,12 +1,12 @@
 //! Shards, merge, checkpoint and resume, driving the built binary as separate processes.
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output};
+use std::process::{Child, Output};
 use std::time::{Duration, Instant};
 
 mod common;
 
-use common::{cmd, fabric, listing, run_in, succeeds, text};
+use common::{bake_in, cmd, fabric, listing, run_in, succeeds, text};
 
 /// Exit status 2, one line `clothbake: ...` on stderr containing every needle.
 fn fails_with(out: &Output, needles: &[&str]) -> String {
@@ -91,19 +91,11 @@ fn four_shards_two_at_a_time_merge_to_the_single_bake() {
     );
     // A shard of another fabric.
     let plain = fabric("plain");
-    succeeds(&run_in(
+    succeeds(&bake_in(
         &d,
-        &[
-            "bake",
-            "--weave",
-            &plain,
-            "--res",
-            RES,
-            "--shard",
-            "2/4",
-            "-o",
-            "plain2.shard",
-        ],
+        &plain,
+        RES,
+        &["--shard", "2/4", "-o", "plain2.shard"],
     ));
     let before_plain = [&before[..], &["plain2.shard".to_string()]].concat();
     let other = [sh[0], sh[1], "plain2.shard", sh[3]];
@@ -385,11 +377,7 @@ fn interrupted_shard_resumes() {
         &d.join("a.shard.checkpoint"),
         Duration::from_secs(60)
     ));
-    let ok = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(ok.success());
+    common::signal(&child, "INT");
     let out = child.wait_with_output().unwrap();
     let err = text(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{err}");
