@@ -1,7 +1,8 @@
 //! Inputs and scratch folders shared by the integration tests.
 
 use clothbake_bake::{bake, BakeOptions};
-use clothbake_core::Fabric;
+use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel};
+use clothbake_export::rgl;
 use clothbake_loader::{write_exr, Brdf, Grid, Options, Precision};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
@@ -44,6 +45,20 @@ pub fn grid(n_theta: u32, n_phi: u32) -> Grid {
         n_phi_i: n_phi,
         n_theta_o: n_theta,
         n_phi_o: n_phi,
+    }
+}
+
+/// The thesis's model of `fabric` (Huo facets, one bounce) as a BSDF, f_r in 1/sr.
+pub fn huo_bsdf(fabric: &Fabric) -> AnalyticBsdf {
+    AnalyticBsdf::new(AnalyticModel::new(fabric, FacetModel::Huo), None)
+}
+
+/// An RGL export grid of `n_theta` x `n_phi` nodes and `n_slice` slices.
+pub fn rgl_grid(n_theta: usize, n_phi: usize, n_slice: usize) -> rgl::RglGrid {
+    rgl::RglGrid {
+        n_theta,
+        n_phi,
+        n_slice,
     }
 }
 

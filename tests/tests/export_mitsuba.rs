@@ -15,7 +15,9 @@
 use clothbake_core::{AnalyticBsdf, Bsdf};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Vec3};
 use clothbake_export::rgl;
-use clothbake_tests::fixtures::{self, bake_and_open, coloured_twill, succeeded, temp_dir};
+use clothbake_tests::fixtures::{
+    self, bake_and_open, coloured_twill, huo_bsdf, succeeded, temp_dir,
+};
 use clothbake_tests::probe::MITSUBA;
 use std::path::Path;
 
@@ -165,9 +167,7 @@ fn the_model_as(
     what: &str,
 ) {
     MITSUBA.require();
-    let model = AnalyticModel::new(&fabric(), FacetModel::Huo);
-    let source = AnalyticBsdf::new(model, None);
-    let c = render_and_compare(tag, &source, colour, variant, spp, prefix);
+    let c = render_and_compare(tag, &huo_bsdf(&fabric()), colour, variant, spp, prefix);
     report(what, &c);
 }
 

@@ -10,10 +10,9 @@
 //! Ignored, with the reason, when python3 cannot import numpy (the projection: mitsuba); under
 //! `CI` they run and fail without them (.ci/run and `cargo xtask test` install them).
 
-use clothbake_core::AnalyticBsdf;
-use clothbake_core::{AnalyticModel, Fabric, FacetModel};
+use clothbake_core::Fabric;
 use clothbake_export::rgl;
-use clothbake_tests::fixtures::{python, succeeded, tables, temp_dir};
+use clothbake_tests::fixtures::{huo_bsdf, python, rgl_grid, succeeded, tables, temp_dir};
 use clothbake_tests::probe::{MITSUBA, NUMPY};
 
 const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/python/rgl_check.py");
@@ -26,13 +25,8 @@ fn check(args: &[&str]) -> serde_json::Value {
 /// The denim draft exported as a spectral and an RGB RGL file into a fresh folder `name`.
 fn export(name: &str) -> (std::path::PathBuf, std::path::PathBuf, std::path::PathBuf) {
     let fabric = Fabric::from_path(&tables().join("denim.wif")).unwrap();
-    let model = AnalyticModel::new(&fabric, FacetModel::Huo);
-    let brdf = AnalyticBsdf::new(model.clone(), None);
-    let grid = rgl::RglGrid {
-        n_theta: 6,
-        n_phi: 8,
-        n_slice: 12,
-    };
+    let brdf = huo_bsdf(&fabric);
+    let grid = rgl_grid(6, 8, 12);
     let dir = temp_dir(name);
     let (spec, rgb) = (dir.join("denim_spec.bsdf"), dir.join("denim_rgb.bsdf"));
     for (p, c) in [(&spec, rgl::Colour::Spectral), (&rgb, rgl::Colour::Rgb)] {

@@ -95,8 +95,12 @@ pub fn signal(child: &Child, sig: &str) {
     assert!(sent.success(), "kill -{sig} {}", child.id());
 }
 
+/// The arguments `bake --weave <fabric> --res <res> <extra...>`.
+pub fn bake_args<'a>(fabric: &'a str, res: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    [&["bake", "--weave", fabric, "--res", res][..], extra].concat()
+}
+
 /// Runs `clothbake bake --weave <fabric> --res <res> <extra...>` in `dir` to its end.
 pub fn bake_in(dir: &Path, fabric: &str, res: &str, extra: &[&str]) -> Output {
-    let args = [&["bake", "--weave", fabric, "--res", res][..], extra].concat();
-    run_in(dir, &args)
+    run_in(dir, &bake_args(fabric, res, extra))
 }
