@@ -157,48 +157,38 @@ fn report(what: &str, c: &Compared) {
     assert!(c.rel_rmse < 0.05, "relative RMSE {}", c.rel_rmse);
 }
 
-/// The model's own f_r exported as `colour`, rendered with Mitsuba's `variant` at `spp`
-/// samples per pixel ([`render_and_compare`], with its `tag` and figure `prefix`) and
-/// reported as `what`.
-fn the_model_as(
-    (tag, prefix): (&str, &str),
-    colour: rgl::Colour,
-    (variant, spp): (&str, u32),
-    what: &str,
-) {
+#[test]
+#[cfg_attr(
+    missing_mitsuba,
+    ignore = "needs the mitsuba and numpy Python packages: python3 -m pip install mitsuba numpy, or run `cargo xtask test`"
+)]
+fn mitsuba_renders_the_exported_bsdfs_like_the_model() {
+    // The model's own f_r as the RGB file in scalar_rgb, and as the spectral file: Mitsuba
+    // samples wavelengths, interpolates `spectra` between our nodes, multiplies by its D65
+    // light and integrates against the CIE curves into sRGB.
     MITSUBA.require();
-    let c = render_and_compare(tag, &huo_bsdf(&fabric()), colour, variant, spp, prefix);
-    report(what, &c);
-}
-
-#[test]
-#[cfg_attr(
-    missing_mitsuba,
-    ignore = "needs the mitsuba and numpy Python packages: python3 -m pip install mitsuba numpy, or run `cargo xtask test`"
-)]
-fn mitsuba_renders_the_exported_bsdf_like_the_model() {
-    the_model_as(
-        ("rgb", "rgl"),
-        rgl::Colour::Rgb,
-        ("scalar_rgb", 16),
-        "scalar_rgb, RGB file",
-    );
-}
-
-#[test]
-#[cfg_attr(
-    missing_mitsuba,
-    ignore = "needs the mitsuba and numpy Python packages: python3 -m pip install mitsuba numpy, or run `cargo xtask test`"
-)]
-fn mitsuba_spectral_renders_the_spectral_bsdf_like_the_model() {
-    // The spectral file: Mitsuba samples wavelengths, interpolates `spectra` between our nodes,
-    // multiplies by its D65 light and integrates against the CIE curves into sRGB.
-    the_model_as(
-        ("spectral", "rgl_spectral"),
-        rgl::Colour::Spectral,
-        ("scalar_spectral", SPECTRAL_SPP),
-        "scalar_spectral, spectral file",
-    );
+    let model = huo_bsdf(&fabric());
+    for (tag, colour, variant, spp, prefix, what) in [
+        (
+            "rgb",
+            rgl::Colour::Rgb,
+            "scalar_rgb",
+            16,
+            "rgl",
+            "scalar_rgb, RGB file",
+        ),
+        (
+            "spectral",
+            rgl::Colour::Spectral,
+            "scalar_spectral",
+            SPECTRAL_SPP,
+            "rgl_spectral",
+            "scalar_spectral, spectral file",
+        ),
+    ] {
+        let c = render_and_compare(tag, &model, colour, variant, spp, prefix);
+        report(what, &c);
+    }
 }
 
 #[test]
