@@ -1,9 +1,12 @@
 //! Inputs and scratch folders shared by the integration tests.
 
 use clothbake_bake::{bake, BakeOptions};
-use clothbake_core::Fabric;
-use clothbake_loader::{write_exr, Brdf, Options, Precision};
+use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel};
+use clothbake_export::rgl;
+use clothbake_loader::{write_exr, Brdf, Grid, Options, Precision};
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 use std::sync::atomic::AtomicBool;
 
 /// The folder `clothbake-<name>-<process id>` in the system's temporary directory, created.
@@ -13,12 +16,93 @@ pub fn temp_dir(name: &str) -> PathBuf {
     d
 }
 
+/// The workspace root (the folder above this crate).
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The shipped fabrics' folder, `tables/`.
+pub fn tables() -> PathBuf {
+    root().join("tables")
+}
+
+/// The files in `tables/` whose extension is `ext`, sorted by name.
+pub fn shipped_files(ext: &str) -> Vec<PathBuf> {
+    let mut found: Vec<PathBuf> = std::fs::read_dir(tables())
+        .expect("tables/ lists")
+        .map(|e| e.expect("a tables/ entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == ext))
+        .collect();
+    found.sort();
+    found
+}
+
+/// A direction grid of `n_theta` by `n_phi` cells for both the incident and the outgoing
+/// direction.
+pub fn grid(n_theta: u32, n_phi: u32) -> Grid {
+    Grid {
+        n_theta_i: n_theta,
+        n_phi_i: n_phi,
+        n_theta_o: n_theta,
+        n_phi_o: n_phi,
+    }
+}
+
+/// The thesis's model of `fabric` (Huo facets, one bounce) as a BSDF, f_r in 1/sr.
+pub fn huo_bsdf(fabric: &Fabric) -> AnalyticBsdf {
+    AnalyticBsdf::new(AnalyticModel::new(fabric, FacetModel::Huo), None)
+}
+
+/// An RGL export grid of `n_theta` x `n_phi` nodes and `n_slice` slices.
+pub fn rgl_grid(n_theta: usize, n_phi: usize, n_slice: usize) -> rgl::RglGrid {
+    rgl::RglGrid {
+        n_theta,
+        n_phi,
+        n_slice,
+    }
+}
+
+/// The stdout of a finished process; panics naming `what`, its exit status, stdout and stderr
+/// unless it succeeded.
+pub fn succeeded(what: &str, out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "{what} failed ({}):\n{}{}",
+        out.status,
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Runs the Python script `script` (a path) with `args` under `python3`, finished.
+pub fn python<S: AsRef<OsStr>>(script: &str, args: &[S]) -> Output {
+    Command::new("python3")
+        .arg(script)
+        .args(args)
+        .output()
+        .expect("run python3")
+}
+
+/// The shipped twill (`tables/twill.json`) baked with `opts`, written to `dir/twill.exr` as an
+/// f16 EXR, and the loader (default options) on it.
+pub fn twill_table(dir: &Path, opts: &BakeOptions) -> (PathBuf, Brdf) {
+    let fabric = Fabric::from_path(&tables().join("twill.json")).expect("the shipped twill reads");
+    let table = bake(&fabric, opts, &|_| {}, &AtomicBool::new(false))
+        .expect("the bake succeeds")
+        .table;
+    let path = dir.join("twill.exr");
+    write_exr(&path, &table, Precision::F16, false).expect("the table is written");
+    let b = Brdf::open(&path, Options::default()).expect("the table reads back");
+    (path, b)
+}
+
 /// Builds `packages` in release mode with a nested cargo and returns the folder of their
 /// artefacts (target/release). Release, not the running test's profile: the running `cargo
 /// test` holds the lock of target/debug, so a nested build there would wait forever.
 pub fn release_build(packages: &[&str]) -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let mut cmd = std::process::Command::new(env!("CARGO"));
+    let root = root();
+    let mut cmd = Command::new(env!("CARGO"));
     cmd.current_dir(&root)
         .args(["build", "--quiet", "--release"]);
     for p in packages {
@@ -38,8 +122,7 @@ pub fn release_build(packages: &[&str]) -> PathBuf {
 /// The shipped twill (`tables/twill.json`) with the albedo (0.6, 0.3, 0.12) on both groups, so
 /// that the three channels differ.
 pub fn coloured_twill() -> Fabric {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/twill.json");
-    Fabric::from_path(&path)
+    Fabric::from_path(&tables().join("twill.json"))
         .expect("the shipped twill reads")
         .with_groups(
             |_, g| g.material.albedo = [0.6, 0.3, 0.12],

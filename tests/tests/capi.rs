@@ -3,18 +3,12 @@
 //! table and checks lookups, batched lookups, samples and pdfs against the Rust loader, bit for
 //! bit, and its error paths (missing file, NULL pointers, unknown flags).
 
-use clothbake_bake::{bake, BakeOptions};
-use clothbake_core::Fabric;
-use clothbake_loader::{write_exr, Brdf, Grid, Options, Precision};
-use clothbake_tests::fixtures::temp_dir;
+use clothbake_bake::BakeOptions;
+use clothbake_tests::fixtures::{grid, root, succeeded, temp_dir, twill_table};
+use std::ffi::OsStr;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::sync::atomic::AtomicBool;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 /// The static library cargo built for this test (a dev-dependency), next to the test binary.
 fn static_lib() -> PathBuf {
@@ -29,6 +23,21 @@ fn static_lib() -> PathBuf {
     panic!("libclothbake_capi.a not found next to {}", exe.display());
 }
 
+/// Compiles `sources` with `cc` in the workspace root, with `flags`, against the static library
+/// into `exe`; panics with the compiler's messages unless it succeeds.
+fn cc_against_capi<S: AsRef<OsStr>>(flags: &[&str], sources: &[S], exe: &Path) {
+    let out = Command::new("cc")
+        .current_dir(root())
+        .args(flags)
+        .args(sources)
+        .arg(static_lib())
+        .args(["-lpthread", "-ldl", "-lm", "-o"])
+        .arg(exe)
+        .output()
+        .expect("the C compiler `cc` runs");
+    succeeded("cc", &out);
+}
+
 fn f(x: f32) -> String {
     format!("{x:.9e}")
 }
@@ -40,25 +49,14 @@ fn v3(v: [f32; 3]) -> String {
 #[test]
 fn the_c_program_agrees_with_the_rust_loader() {
     let dir = temp_dir("capi-test");
-    let grid = Grid {
-        n_theta_i: 8,
-        n_phi_i: 16,
-        n_theta_o: 8,
-        n_phi_o: 16,
-    };
-    let fabric = Fabric::from_path(&root().join("tables/twill.json")).unwrap();
+    let grid = grid(8, 16);
     // A spatial table: the averaged lookups as any table's, and `clothbake_eval_at`'s weave.
     let opts = BakeOptions {
         grid,
         spatial: true,
         ..BakeOptions::default()
     };
-    let table = bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false))
-        .unwrap()
-        .table;
-    let table_path = dir.join("twill.exr");
-    write_exr(&table_path, &table, Precision::F16, false).unwrap();
-    let b = Brdf::open(&table_path, Options::default()).unwrap();
+    let (table_path, b) = twill_table(&dir, &opts);
 
     let mut cases = format!(
         "G {} {} {} {}\n",
@@ -115,19 +113,13 @@ fn the_c_program_agrees_with_the_rust_loader() {
     std::fs::write(&cases_path, cases).unwrap();
 
     let exe = dir.join("lookup");
-    let cc = Command::new("cc")
-        .args(["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-I"])
-        .arg(root().join("crates/clothbake-capi/include"))
-        .arg(root().join("tests/c/lookup.c"))
-        .arg(static_lib())
-        .args(["-lpthread", "-ldl", "-lm", "-o"])
-        .arg(&exe)
-        .output()
-        .expect("the C compiler `cc` runs");
-    assert!(
-        cc.status.success(),
-        "cc failed:\n{}",
-        String::from_utf8_lossy(&cc.stderr)
+    cc_against_capi(
+        &["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-I"],
+        &[
+            root().join("crates/clothbake-capi/include"),
+            root().join("tests/c/lookup.c"),
+        ],
+        &exe,
     );
     let run = Command::new(&exe)
         .arg(&table_path)
@@ -149,27 +141,6 @@ fn the_c_program_agrees_with_the_rust_loader() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A small twill table (8 x 16 x 8 x 16, f16 EXR) in `dir`, and the Rust loader on it.
-fn small_twill(dir: &Path) -> (PathBuf, Brdf) {
-    let fabric = Fabric::from_path(&root().join("tables/twill.json")).unwrap();
-    let opts = BakeOptions {
-        grid: Grid {
-            n_theta_i: 8,
-            n_phi_i: 16,
-            n_theta_o: 8,
-            n_phi_o: 16,
-        },
-        ..BakeOptions::default()
-    };
-    let table = bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false))
-        .unwrap()
-        .table;
-    let path = dir.join("twill.exr");
-    write_exr(&path, &table, Precision::F16, false).unwrap();
-    let b = Brdf::open(&path, Options::default()).unwrap();
-    (path, b)
-}
-
 #[test]
 fn the_documented_example_compiles_as_given_and_runs() {
     // docs/loader.md shows examples/c/sample.c whole.
@@ -180,22 +151,18 @@ fn the_documented_example_compiles_as_given_and_runs() {
         "the C block of docs/loader.md is not examples/c/sample.c"
     );
     let dir = temp_dir("capi-example");
-    let (table, b) = small_twill(&dir);
+    // A small twill table (8 x 16 x 8 x 16, f16 EXR) and the Rust loader on it.
+    let opts = BakeOptions {
+        grid: grid(8, 16),
+        ..BakeOptions::default()
+    };
+    let (table, b) = twill_table(&dir, &opts);
     let exe = dir.join("sample");
     // The documented command line, with the warnings a careful C programmer turns on.
-    let cc = Command::new("cc")
-        .current_dir(root())
-        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"])
-        .args(["-I", "crates/clothbake-capi/include", "examples/c/sample.c"])
-        .arg(static_lib())
-        .args(["-lpthread", "-ldl", "-lm", "-o"])
-        .arg(&exe)
-        .output()
-        .expect("the C compiler `cc` runs");
-    assert!(
-        cc.status.success(),
-        "cc failed:\n{}",
-        String::from_utf8_lossy(&cc.stderr)
+    cc_against_capi(
+        &["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-I"],
+        &["crates/clothbake-capi/include", "examples/c/sample.c"],
+        &exe,
     );
     let run = Command::new(&exe).arg(&table).output().unwrap();
     let stdout = String::from_utf8_lossy(&run.stdout);

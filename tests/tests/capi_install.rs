@@ -7,29 +7,13 @@
 //! reason, without pkg-config (the build script probes it); under `CI` it runs and fails
 //! without it (.ci/run installs it).
 
-use clothbake_bake::{bake, BakeOptions};
-use clothbake_core::Fabric;
-use clothbake_loader::{write_exr, Brdf, Grid, Options, Precision};
-use clothbake_tests::fixtures::{check_sample_c_output, temp_dir};
+use clothbake_bake::BakeOptions;
+use clothbake_tests::fixtures::{
+    check_sample_c_output, grid, root, succeeded as ok, temp_dir, twill_table,
+};
 use clothbake_tests::probe::PKG_CONFIG;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::atomic::AtomicBool;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn ok(what: &str, out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "{what} failed ({}):\n{}{}",
-        out.status,
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
+use std::path::Path;
+use std::process::Command;
 
 #[test]
 #[cfg_attr(
@@ -65,22 +49,11 @@ fn installed_library_builds_the_example_with_pkg_config() {
     );
 
     // A table to run the example on.
-    let fabric = Fabric::from_path(&root().join("tables/twill.json")).unwrap();
     let opts = BakeOptions {
-        grid: Grid {
-            n_theta_i: 4,
-            n_phi_i: 8,
-            n_theta_o: 4,
-            n_phi_o: 8,
-        },
+        grid: grid(4, 8),
         ..BakeOptions::default()
     };
-    let table = bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false))
-        .unwrap()
-        .table;
-    let table_path = dir.join("twill.exr");
-    write_exr(&table_path, &table, Precision::F16, false).unwrap();
-    let b = Brdf::open(&table_path, Options::default()).unwrap();
+    let (table_path, b) = twill_table(&dir, &opts);
 
     let example = root().join("examples/c/sample.c");
     let cc = |args: &[String], exe: &Path| {

@@ -5,11 +5,9 @@
 
 use clothbake_core::fabric::{DEFAULT_ALBEDO, DEFAULT_EXPONENT, DEFAULT_SPECULAR};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, Geometry, Group, Material, UnitVec3};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-fn tables_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables")
-}
+use clothbake_tests::fixtures::{shipped_files, tables as tables_dir};
 
 fn load(name: &str) -> Fabric {
     let p = tables_dir().join(format!("{name}.json"));
@@ -70,10 +68,8 @@ const SHIPPED: [Shipped; 6] = [
 
 #[test]
 fn every_json_in_tables_is_listed_here() {
-    let mut found: Vec<String> = std::fs::read_dir(tables_dir())
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+    let mut found: Vec<String> = shipped_files("json")
+        .iter()
         .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
         .collect();
     found.sort();

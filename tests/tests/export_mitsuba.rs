@@ -15,10 +15,11 @@
 use clothbake_core::{AnalyticBsdf, Bsdf};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Vec3};
 use clothbake_export::rgl;
-use clothbake_tests::fixtures::{bake_and_open, coloured_twill, temp_dir};
+use clothbake_tests::fixtures::{
+    self, bake_and_open, coloured_twill, huo_bsdf, succeeded, temp_dir,
+};
 use clothbake_tests::probe::MITSUBA;
 use std::path::Path;
-use std::process::Command;
 
 const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/python/mitsuba_render.py");
 const RES: usize = 48;
@@ -35,15 +36,9 @@ fn read_le<const N: usize, T>(path: &Path, f: fn([u8; N]) -> T) -> Vec<T> {
 }
 
 fn python(args: &[&str]) {
-    let out = Command::new("python3")
-        .arg(SCRIPT)
-        .args(args)
-        .output()
-        .expect("run python3");
-    assert!(
-        out.status.success(),
-        "mitsuba_render.py {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
+    succeeded(
+        &format!("mitsuba_render.py {args:?}"),
+        &fixtures::python(SCRIPT, args),
     );
 }
 
@@ -167,41 +162,33 @@ fn report(what: &str, c: &Compared) {
     missing_mitsuba,
     ignore = "needs the mitsuba and numpy Python packages: python3 -m pip install mitsuba numpy, or run `cargo xtask test`"
 )]
-fn mitsuba_renders_the_exported_bsdf_like_the_model() {
+fn mitsuba_renders_the_exported_bsdfs_like_the_model() {
+    // The model's own f_r as the RGB file in scalar_rgb, and as the spectral file: Mitsuba
+    // samples wavelengths, interpolates `spectra` between our nodes, multiplies by its D65
+    // light and integrates against the CIE curves into sRGB.
     MITSUBA.require();
-    let f = fabric();
-    let model = AnalyticModel::new(&f, FacetModel::Huo);
-    let c = render_and_compare(
-        "rgb",
-        &AnalyticBsdf::new(model.clone(), None),
-        rgl::Colour::Rgb,
-        "scalar_rgb",
-        16,
-        "rgl",
-    );
-    report("scalar_rgb, RGB file", &c);
-}
-
-#[test]
-#[cfg_attr(
-    missing_mitsuba,
-    ignore = "needs the mitsuba and numpy Python packages: python3 -m pip install mitsuba numpy, or run `cargo xtask test`"
-)]
-fn mitsuba_spectral_renders_the_spectral_bsdf_like_the_model() {
-    // The spectral file: Mitsuba samples wavelengths, interpolates `spectra` between our nodes,
-    // multiplies by its D65 light and integrates against the CIE curves into sRGB.
-    MITSUBA.require();
-    let f = fabric();
-    let model = AnalyticModel::new(&f, FacetModel::Huo);
-    let c = render_and_compare(
-        "spectral",
-        &AnalyticBsdf::new(model.clone(), None),
-        rgl::Colour::Spectral,
-        "scalar_spectral",
-        SPECTRAL_SPP,
-        "rgl_spectral",
-    );
-    report("scalar_spectral, spectral file", &c);
+    let model = huo_bsdf(&fabric());
+    for (tag, colour, variant, spp, prefix, what) in [
+        (
+            "rgb",
+            rgl::Colour::Rgb,
+            "scalar_rgb",
+            16,
+            "rgl",
+            "scalar_rgb, RGB file",
+        ),
+        (
+            "spectral",
+            rgl::Colour::Spectral,
+            "scalar_spectral",
+            SPECTRAL_SPP,
+            "rgl_spectral",
+            "scalar_spectral, spectral file",
+        ),
+    ] {
+        let c = render_and_compare(tag, &model, colour, variant, spp, prefix);
+        report(what, &c);
+    }
 }
 
 #[test]

@@ -10,42 +10,23 @@
 //! Ignored, with the reason, when python3 cannot import numpy (the projection: mitsuba); under
 //! `CI` they run and fail without them (.ci/run and `cargo xtask test` install them).
 
-use clothbake_core::AnalyticBsdf;
-use clothbake_core::{AnalyticModel, Fabric, FacetModel};
+use clothbake_core::Fabric;
 use clothbake_export::rgl;
-use clothbake_tests::fixtures::temp_dir;
+use clothbake_tests::fixtures::{huo_bsdf, python, rgl_grid, succeeded, tables, temp_dir};
 use clothbake_tests::probe::{MITSUBA, NUMPY};
-use std::path::Path;
-use std::process::Command;
 
 const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/python/rgl_check.py");
 
 fn check(args: &[&str]) -> serde_json::Value {
-    let out = Command::new("python3")
-        .arg(SCRIPT)
-        .args(args)
-        .output()
-        .expect("run python3");
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "rgl_check.py {args:?} failed: {text}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let text = succeeded(&format!("rgl_check.py {args:?}"), &python(SCRIPT, args));
     serde_json::from_str(text.trim()).unwrap()
 }
 
 /// The denim draft exported as a spectral and an RGB RGL file into a fresh folder `name`.
 fn export(name: &str) -> (std::path::PathBuf, std::path::PathBuf, std::path::PathBuf) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/denim.wif");
-    let fabric = Fabric::from_path(&path).unwrap();
-    let model = AnalyticModel::new(&fabric, FacetModel::Huo);
-    let brdf = AnalyticBsdf::new(model.clone(), None);
-    let grid = rgl::RglGrid {
-        n_theta: 6,
-        n_phi: 8,
-        n_slice: 12,
-    };
+    let fabric = Fabric::from_path(&tables().join("denim.wif")).unwrap();
+    let brdf = huo_bsdf(&fabric);
+    let grid = rgl_grid(6, 8, 12);
     let dir = temp_dir(name);
     let (spec, rgb) = (dir.join("denim_spec.bsdf"), dir.join("denim_rgb.bsdf"));
     for (p, c) in [(&spec, rgl::Colour::Spectral), (&rgb, rgl::Colour::Rgb)] {
@@ -68,11 +49,7 @@ fn the_spectral_file_meets_pbrt_v4s_reader() {
     assert_eq!(s["ok"], true);
     assert_eq!(s["shape"], serde_json::json!([9, 6, 25, 12, 12]));
     // The RGB file is not a pbrt-v4 file (no spectra): the check must say so.
-    let out = Command::new("python3")
-        .arg(SCRIPT)
-        .args(["pbrt", rgb.to_str().unwrap()])
-        .output()
-        .unwrap();
+    let out = python(SCRIPT, &["pbrt", rgb.to_str().unwrap()]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("missing field spectra"));
     std::fs::remove_dir_all(&dir).unwrap();

@@ -4,10 +4,8 @@
 //! within a few degrees of the horizon), so the luminance-weighted relative RMSE over all nodes
 //! must be small and most nodes close.
 
-use clothbake_core::AnalyticBsdf;
-use clothbake_core::{AnalyticModel, FacetModel};
 use clothbake_export::rgl;
-use clothbake_tests::fixtures::{bake_and_open, coloured_twill, temp_dir};
+use clothbake_tests::fixtures::{bake_and_open, coloured_twill, huo_bsdf, rgl_grid, temp_dir};
 
 fn rgb_values(fields: &[rgl::Field]) -> Vec<f32> {
     let f = fields
@@ -26,14 +24,9 @@ fn the_export_of_a_baked_table_matches_the_export_of_the_model() {
     let dir = temp_dir("export-table");
     let lookup = bake_and_open(&fabric, &dir.join("twill.exr"));
     let from_table = lookup;
-    let model = AnalyticModel::new(&fabric, FacetModel::Huo);
-    let from_model = AnalyticBsdf::new(model.clone(), None);
+    let from_model = huo_bsdf(&fabric);
     // A coarser grid than the default keeps the test fast; the nodes are where they always are.
-    let grid = rgl::RglGrid {
-        n_theta: 8,
-        n_phi: 12,
-        n_slice: 16,
-    };
+    let grid = rgl_grid(8, 12, 16);
     let t = rgb_values(&rgl::rgl_fields(&from_table, &grid, "t", rgl::Colour::Rgb));
     let m = rgb_values(&rgl::rgl_fields(&from_model, &grid, "m", rgl::Colour::Rgb));
     assert_eq!(t.len(), m.len());

@@ -8,10 +8,9 @@
 //! probe of Python.
 
 use std::path::Path;
-use std::process::Command;
 
 use clothbake_loader::{write_exr, Grid, Metadata, Precision, Table};
-use clothbake_tests::fixtures::temp_dir;
+use clothbake_tests::fixtures::{python, succeeded, temp_dir};
 use clothbake_tests::probe::OPENEXR;
 use serde_json::Value;
 
@@ -41,17 +40,8 @@ fn sample_table() -> Table {
 }
 
 fn run_script(path: &Path) -> Value {
-    let out = Command::new("python3")
-        .arg(SCRIPT)
-        .arg(path)
-        .output()
-        .expect("run python3");
-    assert!(
-        out.status.success(),
-        "{SCRIPT} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("the script prints JSON")
+    let stdout = succeeded(SCRIPT, &python(SCRIPT, &[path]));
+    serde_json::from_str(&stdout).expect("the script prints JSON")
 }
 
 fn check(precision: Precision) {

@@ -6,28 +6,21 @@
 use clothbake_bake::{bake, BakeOptions};
 use clothbake_core::{AnalyticModel, Cell, Fabric, FacetModel, UnitVec3};
 use clothbake_loader::{Brdf, Grid, Options, Table};
-use std::path::Path;
+use clothbake_tests::fixtures::{grid, tables};
 use std::sync::atomic::AtomicBool;
 
-const GRID: Grid = Grid {
-    n_theta_i: 6,
-    n_phi_i: 12,
-    n_theta_o: 6,
-    n_phi_o: 12,
-};
+/// The direction grid of every table here: 6 x 12 x 6 x 12.
+fn table_grid() -> Grid {
+    grid(6, 12)
+}
 
 fn fabric(file: &str) -> Fabric {
-    Fabric::from_path(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../tables")
-            .join(file),
-    )
-    .unwrap()
+    Fabric::from_path(&tables().join(file)).unwrap()
 }
 
 fn baked(f: &Fabric, spatial: bool) -> Table {
     let opts = BakeOptions {
-        grid: GRID,
+        grid: table_grid(),
         spatial,
         ..BakeOptions::default()
     };
@@ -56,7 +49,7 @@ fn cell_centres(model: &AnalyticModel) -> Vec<(Cell, f64, f64)> {
 /// Grid nodes (cell centres of the direction grid) to test at: a spread of both hemispheres.
 fn node_pairs() -> Vec<(UnitVec3, UnitVec3)> {
     let dir = |t: u32, nt: u32, p: u32, np: u32| clothbake_bake::direction(t, nt, p, np);
-    let g = GRID;
+    let g = table_grid();
     let mut out = Vec::new();
     for (ti, pi, to, po) in [
         (0, 0, 0, 0),
@@ -119,10 +112,10 @@ fn the_averaged_part_is_the_averaged_bake() {
     for file in ["twill.json", "gingham.wif"] {
         let f = fabric(file);
         let (s, a) = (baked(&f, true), baked(&f, false));
-        let n = 3 * GRID.len();
+        let n = 3 * table_grid().len();
         assert_eq!(a.values.len(), n);
         let classes = s.meta.spatial.as_ref().unwrap().classes as usize;
-        assert_eq!(s.values.len(), n + 2 * classes * GRID.len());
+        assert_eq!(s.values.len(), n + 2 * classes * table_grid().len());
         for (k, (x, y)) in s.values[..n].iter().zip(&a.values).enumerate() {
             assert!(
                 close(f64::from(*x), f64::from(*y), 1e-6),
@@ -239,6 +232,6 @@ fn spatial_tables_survive_both_file_formats() {
     bad.meta.spatial.as_mut().unwrap().cell_class[0] = 99;
     assert!(Table::new(bad.meta.clone(), bad.values.clone()).is_err());
     // A table whose values miss the classes is refused.
-    assert!(Table::new(t.meta.clone(), t.values[..3 * GRID.len()].to_vec()).is_err());
+    assert!(Table::new(t.meta.clone(), t.values[..3 * table_grid().len()].to_vec()).is_err());
     std::fs::remove_dir_all(&dir).unwrap();
 }

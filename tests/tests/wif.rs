@@ -3,14 +3,20 @@
 
 use clothbake_core::wif::{parse, WifOptions};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, Group, UnitVec3};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-fn tables() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables")
-}
+use clothbake_tests::fixtures::{shipped_files, tables};
 
 fn load(name: &str) -> Fabric {
     Fabric::from_path(&tables().join(name)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The shipped draft `name`, after checking that its point paper (row by row, 1 where the warp
+/// is over) is `rows`.
+fn woven_as<const N: usize>(name: &str, rows: [[u8; N]; N]) -> Fabric {
+    let f = load(name);
+    assert_eq!(f.weave().to_rows(), rows.map(Vec::from), "{name}");
+    f
 }
 
 fn close(a: f64, b: f64) -> bool {
@@ -29,13 +35,10 @@ fn lin(v: f64, hi: f64) -> f64 {
 
 #[test]
 fn every_wif_in_tables_is_checked_here() {
-    let mut found: Vec<String> = std::fs::read_dir(tables())
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "wif"))
+    let found: Vec<String> = shipped_files("wif")
+        .iter()
         .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
         .collect();
-    found.sort();
     assert_eq!(found, ["denim.wif", "gingham.wif", "twill22.wif"]);
 }
 
@@ -45,14 +48,10 @@ fn denim_is_the_warp_faced_3_1_twill() {
     // shafts t, t+1, t+2 (mod 4). Pick 1 lifts shafts 1,2,3: ends 1-3 over, end 4 under, so
     // row 0 = 1110; every later pick lifts the next three shafts, moving the under-cell one end
     // to the right (+X) and wrapping: 0111, 1011, 1101.
-    let f = load("denim.wif");
-    let want = vec![
-        vec![1, 1, 1, 0],
-        vec![0, 1, 1, 1],
-        vec![1, 0, 1, 1],
-        vec![1, 1, 0, 1],
-    ];
-    assert_eq!(f.weave().to_rows(), want);
+    let f = woven_as(
+        "denim.wif",
+        [[1, 1, 1, 0], [0, 1, 1, 1], [1, 0, 1, 1], [1, 1, 0, 1]],
+    );
     // The same point paper as the hand-written JSON fabric of the 3/1 twill.
     assert_eq!(load("twill31.json").weave(), f.weave());
     assert_eq!(f.name(), "denim");
@@ -131,14 +130,8 @@ fn twill22_liftplan_on_a_sinking_shed() {
     // Sinking shed: the listed shafts go down, taking their ends under the weft. Pick 1 sinks
     // shafts 1, 2: ends 1, 2 under, 3, 4 over: 0011. Each pick sinks the next pair: 1001, 1100,
     // 0110. Eight ends and picks written, two repeats of four.
-    let f = load("twill22.wif");
-    let want = vec![
-        vec![0, 0, 1, 1],
-        vec![1, 0, 0, 1],
-        vec![1, 1, 0, 0],
-        vec![0, 1, 1, 0],
-    ];
-    assert_eq!(f.weave().to_rows(), want);
+    let want = [[0, 0, 1, 1], [1, 0, 0, 1], [1, 1, 0, 0], [0, 1, 1, 0]];
+    let f = woven_as("twill22.wif", want);
     // No sizes and no colours in the draft: the documented defaults (0.31 mm, 0.30 mm thick;
     // the thesis's rho_d 0.4).
     for y in f.warp().threads.iter().chain(&f.weft().threads) {

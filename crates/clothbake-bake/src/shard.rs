@@ -448,19 +448,21 @@ mod tests {
         .unwrap();
         assert_eq!(s, id(2, 4));
         assert!(how.contains("SLURM_ARRAY_TASK_ID=2"), "{how}");
-        let e = env(&[
-            ("SLURM_ARRAY_TASK_ID", "4"),
+        let (count, min, step) = (
             ("SLURM_ARRAY_TASK_COUNT", "4"),
-            ("SLURM_ARRAY_TASK_MIN", "1"),
-        ]);
-        assert_eq!(shard_from_env(&e, None).unwrap().0, id(3, 4));
-        let e = env(&[
-            ("SLURM_ARRAY_TASK_ID", "6"),
-            ("SLURM_ARRAY_TASK_COUNT", "4"),
-            ("SLURM_ARRAY_TASK_MIN", "0"),
+            "SLURM_ARRAY_TASK_MIN",
             ("SLURM_ARRAY_TASK_STEP", "2"),
-        ]);
-        assert_eq!(shard_from_env(&e, None).unwrap().0, id(3, 4));
+        );
+        for vars in [
+            &[("SLURM_ARRAY_TASK_ID", "4"), count, (min, "1")][..],
+            &[("SLURM_ARRAY_TASK_ID", "6"), count, (min, "0"), step],
+        ] {
+            assert_eq!(
+                shard_from_env(&env(vars), None).unwrap().0,
+                id(3, 4),
+                "{vars:?}"
+            );
+        }
         // SLURM wins over Kubernetes; --shards must agree with SLURM.
         let e = env(&[
             ("SLURM_ARRAY_TASK_ID", "1"),
@@ -481,26 +483,27 @@ mod tests {
             .unwrap_err()
             .contains("not below"));
         // Errors.
-        assert!(shard_from_env(&env(&[]), Some(4))
-            .unwrap_err()
-            .contains("neither"));
-        assert!(shard_from_env(&env(&[("SLURM_ARRAY_TASK_ID", "1")]), None)
-            .unwrap_err()
-            .contains("SLURM_ARRAY_TASK_COUNT is not"));
-        let e = env(&[
-            ("SLURM_ARRAY_TASK_ID", "5"),
-            ("SLURM_ARRAY_TASK_COUNT", "4"),
-        ]);
-        assert!(shard_from_env(&e, None)
-            .unwrap_err()
-            .contains("not one of the array's tasks"));
-        let e = env(&[
-            ("SLURM_ARRAY_TASK_ID", "x"),
-            ("SLURM_ARRAY_TASK_COUNT", "4"),
-        ]);
-        assert!(shard_from_env(&e, None)
-            .unwrap_err()
-            .contains("not a whole number"));
+        for (vars, shards, needle) in [
+            (&[][..], Some(4), "neither"),
+            (
+                &[("SLURM_ARRAY_TASK_ID", "1")],
+                None,
+                "SLURM_ARRAY_TASK_COUNT is not",
+            ),
+            (
+                &[("SLURM_ARRAY_TASK_ID", "5"), count],
+                None,
+                "not one of the array's tasks",
+            ),
+            (
+                &[("SLURM_ARRAY_TASK_ID", "x"), count],
+                None,
+                "not a whole number",
+            ),
+        ] {
+            let e = shard_from_env(&env(vars), shards).unwrap_err();
+            assert!(e.contains(needle), "{vars:?}: {e}");
+        }
     }
 
     #[test]

@@ -5,24 +5,10 @@ use clothbake_bake::{bake, direction, BakeOptions, DEFAULT_GRID};
 use clothbake_core::symmetry::symmetries;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, SecondaryOptions, Variant};
 use clothbake_loader::{Grid, Table};
-use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-const SMALL: Grid = Grid {
-    n_theta_i: 4,
-    n_phi_i: 8,
-    n_theta_o: 4,
-    n_phi_o: 8,
-};
-
-fn fabric(name: &str) -> Fabric {
-    Fabric::from_path(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../tables")
-            .join(format!("{name}.json")),
-    )
-    .unwrap()
-}
+mod common;
+use common::{fabric, options, small};
 
 fn bake_on(threads: usize, f: &Fabric, o: &BakeOptions) -> (Table, usize) {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -41,17 +27,17 @@ fn bake_on(threads: usize, f: &Fabric, o: &BakeOptions) -> (Table, usize) {
 fn check_copies(name: &str, bounces: u32) {
     let f = fabric(name);
     let o = BakeOptions {
-        grid: SMALL,
+        grid: small(),
         bounces,
         ..BakeOptions::default()
     };
     let (t, evaluated) = bake_on(2, &f, &o);
     let syms = symmetries(&f);
     assert!(!syms.is_empty(), "{name} should have a symmetry");
-    assert!(evaluated < SMALL.len(), "{name}: no cell was copied");
+    assert!(evaluated < small().len(), "{name}: no cell was copied");
     let m = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Refined);
     let sec = (bounces == 2).then(SecondaryOptions::default);
-    let g = SMALL;
+    let g = small();
     let eval = |ti, pi, to, po| {
         let wi = direction(ti, g.n_theta_i, pi, g.n_phi_i);
         let wo = direction(to, g.n_theta_o, po, g.n_phi_o);
@@ -120,7 +106,7 @@ fn thread_count_does_not_change_the_table() {
     let f = fabric("satin5");
     for bounces in [1, 2] {
         let o = BakeOptions {
-            grid: SMALL,
+            grid: small(),
             bounces,
             ..BakeOptions::default()
         };
@@ -137,31 +123,17 @@ fn thread_count_does_not_change_the_table() {
 #[test]
 fn symmetry_is_used_and_reported() {
     let f = fabric("plain");
-    let (t, evaluated) = bake_on(
-        2,
-        &f,
-        &BakeOptions {
-            grid: SMALL,
-            ..BakeOptions::default()
-        },
-    );
+    let (t, evaluated) = bake_on(2, &f, &options(small()));
     // The plain weave has all three symmetries: a quarter of the (phi_i, phi_o) pairs.
     assert_eq!(t.meta.symmetry, "mirror x, mirror y, rotate 180");
-    assert_eq!(evaluated, SMALL.len() / 4);
+    assert_eq!(evaluated, small().len() / 4);
     // An odd number of azimuth cells leaves only mirror y.
     let odd = Grid {
         n_phi_i: 7,
         n_phi_o: 5,
-        ..SMALL
+        ..small()
     };
-    let (t, evaluated) = bake_on(
-        1,
-        &f,
-        &BakeOptions {
-            grid: odd,
-            ..BakeOptions::default()
-        },
-    );
+    let (t, evaluated) = bake_on(1, &f, &options(odd));
     assert_eq!(t.meta.symmetry, "mirror y");
     assert!(evaluated > odd.len() / 2 && evaluated < odd.len());
     // Metadata: everything a reader needs.
@@ -182,7 +154,7 @@ fn progress_reaches_the_total() {
     let max = AtomicU64::new(0);
     let calls = AtomicU64::new(0);
     let o = BakeOptions {
-        grid: SMALL,
+        grid: small(),
         ..BakeOptions::default()
     };
     bake(
@@ -198,11 +170,11 @@ fn progress_reaches_the_total() {
     // Progress counts evaluated cells: half of them for the twill's rotation symmetry.
     assert_eq!(
         max.load(Ordering::Relaxed),
-        clothbake_bake::evaluations(&f, &SMALL) as u64
+        clothbake_bake::evaluations(&f, &small()) as u64
     );
-    assert_eq!(clothbake_bake::evaluations(&f, &SMALL), SMALL.len() / 2);
+    assert_eq!(clothbake_bake::evaluations(&f, &small()), small().len() / 2);
     assert_eq!(
         calls.load(Ordering::Relaxed),
-        u64::from(SMALL.n_theta_i * SMALL.n_phi_i)
+        u64::from(small().n_theta_i * small().n_phi_i)
     );
 }

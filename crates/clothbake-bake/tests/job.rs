@@ -8,25 +8,18 @@ use clothbake_bake::output::Format;
 use clothbake_bake::shard::{read_part, ShardId};
 use clothbake_bake::{bake, BakeOptions};
 use clothbake_core::Fabric;
-use clothbake_loader::{read_table, Grid};
-use std::path::Path;
+use clothbake_loader::read_table;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+mod common;
+use common::scratch;
+
 fn twill() -> Fabric {
-    Fabric::from_path(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/twill.json"))
-        .unwrap()
+    common::fabric("twill")
 }
 
 fn options() -> BakeOptions {
-    BakeOptions {
-        grid: Grid {
-            n_theta_i: 4,
-            n_phi_i: 8,
-            n_theta_o: 4,
-            n_phi_o: 8,
-        },
-        ..BakeOptions::default()
-    }
+    common::options(common::small())
 }
 
 fn hooks<'a>(
@@ -44,9 +37,7 @@ fn hooks<'a>(
 
 #[test]
 fn cancelled_then_resumed_equals_the_uninterrupted_bake() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("job-resume");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("job-resume");
     let f = twill();
     let out = dir.join("t.bin");
     let mut job = Job::new(&f, options());
@@ -92,9 +83,7 @@ fn cancelled_then_resumed_equals_the_uninterrupted_bake() {
 
 #[test]
 fn shards_of_jobs_merge_into_the_bake() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("job-shards");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("job-shards");
     let f = twill();
     let never = AtomicBool::new(false);
     let mut parts = Vec::new();

@@ -5,18 +5,13 @@ use clothbake_bake::merge::{merge, orbits_of};
 use clothbake_bake::shard::{read_part, shard_rows, write_part, Kind, Part, ShardId};
 use clothbake_bake::{bake, BakeOptions, Baker, Row};
 use clothbake_core::Fabric;
-use clothbake_loader::Grid;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::Mutex;
 
-fn fabric(name: &str) -> Fabric {
-    Fabric::from_path(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../tables/{name}.json")),
-    )
-    .unwrap()
-}
+mod common;
+use common::{fabric, grid, options, scratch};
 
 fn shard(f: &Fabric, o: &BakeOptions, id: ShardId) -> Part {
     let baker = Baker::new(f, o).unwrap();
@@ -43,21 +38,13 @@ fn bits(v: &[f32]) -> Vec<u32> {
 #[test]
 fn merged_shards_equal_the_single_bake() {
     let none = AtomicBool::new(false);
-    for (name, grid) in [
+    for (name, cells) in [
         ("plain", [3, 8, 2, 8]),  // mirror x, mirror y, rotation: orbits of 4
         ("twill", [2, 6, 3, 4]),  // rotation
         ("satin5", [2, 5, 2, 7]), // odd azimuths: mirror y at most
     ] {
         let f = fabric(name);
-        let o = BakeOptions {
-            grid: Grid {
-                n_theta_i: grid[0],
-                n_phi_i: grid[1],
-                n_theta_o: grid[2],
-                n_phi_o: grid[3],
-            },
-            ..BakeOptions::default()
-        };
+        let o = options(grid(cells));
         let single = bake(&f, &o, &|_| {}, &none).unwrap().table;
         for n in [1, 3, 4, 7] {
             let parts: Vec<(PathBuf, Part)> = (0..n)
@@ -76,18 +63,8 @@ fn merged_shards_equal_the_single_bake() {
 #[test]
 fn shard_files_round_trip_and_bad_sets_are_refused() {
     let f = fabric("twill");
-    let o = BakeOptions {
-        grid: Grid {
-            n_theta_i: 2,
-            n_phi_i: 4,
-            n_theta_o: 2,
-            n_phi_o: 4,
-        },
-        ..BakeOptions::default()
-    };
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("merge-round-trip");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let o = options(grid([2, 4, 2, 4]));
+    let dir = scratch("merge-round-trip");
     let mut parts = Vec::new();
     for k in 0..2 {
         let p = shard(&f, &o, ShardId { index: k, count: 2 });

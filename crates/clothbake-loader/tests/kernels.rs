@@ -278,62 +278,39 @@ fn odd_inputs_give_finite_values_and_nan_gives_zero(kernel: SimdPath) {
     }
 }
 
-#[test]
-fn portable_kernel_matches_an_f64_quadrilinear_reference() {
-    matches_an_f64_quadrilinear_reference(SimdPath::Portable);
+/// Each check as two tests: on the portable kernel, and on the AVX2 kernel, which is reported
+/// as ignored, with the reason, on a processor without it (and fails under `CI`). A macro: a
+/// function cannot declare tests.
+macro_rules! on_both_kernels {
+    ($($check:ident: $portable:ident, $avx2:ident;)*) => {$(
+        #[test]
+        fn $portable() {
+            $check(SimdPath::Portable);
+        }
+
+        #[test]
+        #[cfg_attr(
+            missing_avx2,
+            ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
+        )]
+        fn $avx2() {
+            probe::AVX2.require();
+            $check(SimdPath::Avx2);
+        }
+    )*};
 }
 
-#[test]
-fn portable_batches_equal_single_lookups() {
-    batches_equal_single_lookups_and_agree_with_portable(SimdPath::Portable);
-}
-
-#[test]
-fn portable_reciprocal_lookups_are_symmetric() {
-    reciprocal_lookups_agree_with_portable(SimdPath::Portable);
-}
-
-#[test]
-fn portable_odd_inputs_give_finite_values_and_nan_gives_zero() {
-    odd_inputs_give_finite_values_and_nan_gives_zero(SimdPath::Portable);
-}
-
-#[test]
-#[cfg_attr(
-    missing_avx2,
-    ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
-)]
-fn avx2_kernel_matches_an_f64_quadrilinear_reference() {
-    probe::AVX2.require();
-    matches_an_f64_quadrilinear_reference(SimdPath::Avx2);
-}
-
-#[test]
-#[cfg_attr(
-    missing_avx2,
-    ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
-)]
-fn avx2_batches_equal_single_lookups_and_agree_with_the_portable_kernel() {
-    probe::AVX2.require();
-    batches_equal_single_lookups_and_agree_with_portable(SimdPath::Avx2);
-}
-
-#[test]
-#[cfg_attr(
-    missing_avx2,
-    ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
-)]
-fn avx2_reciprocal_lookups_are_symmetric_and_agree_with_the_portable_kernel() {
-    probe::AVX2.require();
-    reciprocal_lookups_agree_with_portable(SimdPath::Avx2);
-}
-
-#[test]
-#[cfg_attr(
-    missing_avx2,
-    ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
-)]
-fn avx2_odd_inputs_give_finite_values_and_nan_gives_zero() {
-    probe::AVX2.require();
-    odd_inputs_give_finite_values_and_nan_gives_zero(SimdPath::Avx2);
+on_both_kernels! {
+    matches_an_f64_quadrilinear_reference:
+        portable_kernel_matches_an_f64_quadrilinear_reference,
+        avx2_kernel_matches_an_f64_quadrilinear_reference;
+    batches_equal_single_lookups_and_agree_with_portable:
+        portable_batches_equal_single_lookups,
+        avx2_batches_equal_single_lookups_and_agree_with_the_portable_kernel;
+    reciprocal_lookups_agree_with_portable:
+        portable_reciprocal_lookups_are_symmetric,
+        avx2_reciprocal_lookups_are_symmetric_and_agree_with_the_portable_kernel;
+    odd_inputs_give_finite_values_and_nan_gives_zero:
+        portable_odd_inputs_give_finite_values_and_nan_gives_zero,
+        avx2_odd_inputs_give_finite_values_and_nan_gives_zero;
 }

@@ -16,6 +16,7 @@
 use crate::shade::Shader;
 use clothbake_core::UnitVec3;
 use clothbake_loader::Grid;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
@@ -137,6 +138,21 @@ fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
 
 type DrawResult<T> = Result<T, String>;
 
+/// Draws the series labels of `chart` in a framed, lightly opaque box at `position`.
+fn legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    position: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font(("sans-serif", 11))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)
+}
+
 fn err<E: std::fmt::Debug>(e: E) -> String {
     format!("{e:?}")
 }
@@ -227,14 +243,7 @@ fn draw_slices<DB: DrawingBackend>(
                 }
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font(("sans-serif", 11))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     }
     Ok(())
 }
@@ -318,14 +327,7 @@ fn draw_hemisphere<DB: DrawingBackend>(
             .map_err(err)?
             .label("mirror direction of wi")
             .legend(|(x, y)| Cross::new((x + 8, y), 4, RED.stroke_width(2)));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .label_font(("sans-serif", 11))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart, SeriesLabelPosition::LowerRight)?;
     }
     // Colour bar.
     let mut bar = ChartBuilder::on(&bar_area)

@@ -5,21 +5,24 @@ use std::process::{Command, Output};
 
 mod common;
 
-use common::{fabric, fails_with, listing, succeeds, text};
+use common::{bake_in, fabric, fails_with, listing, succeeds, text};
 
 fn fresh_dir(name: &str) -> PathBuf {
     common::fresh_dir("bake-cli", name)
 }
 
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_clothbake"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run the clothbake binary")
-}
+use common::run_in;
 
 const SMALL: &str = "4,8,4,8";
+
+/// `clothbake --weave <the shipped twill> --res SMALL <extra...>` (the default mode) in `dir`.
+fn small_twill(dir: &Path, extra: &[&str]) -> Output {
+    let twill = fabric("twill");
+    run_in(
+        dir,
+        &[&["--weave", &twill, "--res", SMALL][..], extra].concat(),
+    )
+}
 
 #[test]
 fn default_mode_writes_a_table_that_info_reads() {
@@ -66,12 +69,7 @@ fn default_mode_writes_a_table_that_info_reads() {
         assert!(info.contains(w), "{w:?} missing in\n{info}");
     }
     // The subcommand spelled out, binary format from --format, quiet.
-    let out = succeeds(&run_in(
-        &d,
-        &[
-            "bake", "--weave", &twill, "--res", SMALL, "--format", "bin", "--quiet",
-        ],
-    ));
+    let out = succeeds(&bake_in(&d, &twill, SMALL, &["--format", "bin", "--quiet"]));
     assert!(out.is_empty(), "{out}");
     assert_eq!(listing(&d), ["twill.bin", "twill.exr"]);
     assert!(succeeds(&run_in(&d, &["info", "twill.bin"])).contains("binary format"));
@@ -100,23 +98,8 @@ fn existing_output_needs_force() {
 fn diff_exit_statuses() {
     let d = fresh_dir("diff");
     let twill = fabric("twill");
-    succeeds(&run_in(
-        &d,
-        &["--weave", &twill, "--res", SMALL, "-o", "a.bin"],
-    ));
-    succeeds(&run_in(
-        &d,
-        &[
-            "--weave",
-            &twill,
-            "--res",
-            SMALL,
-            "-o",
-            "b.bin",
-            "--exponent",
-            "20",
-        ],
-    ));
+    succeeds(&small_twill(&d, &["-o", "a.bin"]));
+    succeeds(&small_twill(&d, &["-o", "b.bin", "--exponent", "20"]));
     succeeds(&run_in(
         &d,
         &["--weave", &twill, "--res", "8,8,4,8", "-o", "c.bin"],
@@ -175,9 +158,8 @@ fn diff_exit_statuses() {
 #[test]
 fn missing_folder_writes_nothing() {
     let d = fresh_dir("missing");
-    let twill = fabric("twill");
     fails_with(
-        &run_in(&d, &["--weave", &twill, "--res", SMALL, "-o", "nope/t.exr"]),
+        &small_twill(&d, &["-o", "nope/t.exr"]),
         2,
         &["nope", "does not exist", "create it"],
     );
@@ -199,9 +181,8 @@ fn unwritable_folder_writes_nothing() {
         eprintln!("skipped: this user can write into read-only folders");
         return;
     }
-    let twill = fabric("twill");
     fails_with(
-        &run_in(&d, &["--weave", &twill, "--res", SMALL, "-o", "ro/t.exr"]),
+        &small_twill(&d, &["-o", "ro/t.exr"]),
         2,
         &[
             "ro/t.exr",
@@ -246,24 +227,11 @@ fn exr_and_binary_tables_agree() {
 #[test]
 fn thread_count_does_not_change_the_file() {
     let d = fresh_dir("threads");
-    let twill = fabric("twill");
     for ext in ["exr", "bin"] {
         let mut files = Vec::new();
         for threads in ["1", "2"] {
             let out = format!("t{threads}.{ext}");
-            succeeds(&run_in(
-                &d,
-                &[
-                    "--weave",
-                    &twill,
-                    "--res",
-                    SMALL,
-                    "--threads",
-                    threads,
-                    "-o",
-                    &out,
-                ],
-            ));
+            succeeds(&small_twill(&d, &["--threads", threads, "-o", &out]));
             files.push(std::fs::read(d.join(&out)).unwrap());
         }
         assert!(files[0] == files[1], "{ext}: the files differ");
@@ -397,11 +365,7 @@ fn interrupt_writes_no_table() {
         .unwrap();
     // Give it time to install its handler and start baking.
     std::thread::sleep(std::time::Duration::from_millis(1500));
-    let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(status.success());
+    common::signal(&child, "INT");
     let out = child.wait_with_output().unwrap();
     fails_with(&out, 130, &[]);
     let err = text(&out.stderr);

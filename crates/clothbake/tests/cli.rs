@@ -41,6 +41,11 @@ fn fails(out: &Output, needles: &[&str]) -> String {
     common::fails_with(out, 2, needles)
 }
 
+/// `clothbake <args...>` fails with exit 2 and one line naming every needle ([`fails`]).
+fn refuses(args: &[&str], needles: &[&str]) -> String {
+    fails(&clothbake(args), needles)
+}
+
 fn rgb(v: &Value, key: &str) -> [f64; 3] {
     let a = v[key]
         .as_array()
@@ -302,15 +307,12 @@ fn bad_options() {
         &eval(&t, &["--wo", "30,180"]),
         &["--wi", "clothbake eval --help"],
     );
-    fails(
-        &clothbake(&["frobnicate"]),
-        &["frobnicate", "clothbake --help"],
-    );
+    refuses(&["frobnicate"], &["frobnicate", "clothbake --help"]);
 }
 
 #[test]
 fn no_command() {
-    fails(&clothbake(&[]), &["no command", "clothbake --weave FILE"]);
+    refuses(&[], &["no command", "clothbake --weave FILE"]);
 }
 
 #[test]
@@ -497,12 +499,9 @@ fn export_writes_an_rgl_file_and_refuses_bad_requests() {
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-export.bsdf");
     let _ = std::fs::remove_file(&out);
     let o = out.to_str().unwrap();
-    fails(
-        &clothbake(&["export", "--weave", w]),
-        &["nothing to export", "--rgl"],
-    );
-    fails(
-        &clothbake(&["export", "--weave", w, "--rgl", o, "--rgl-res", "1,4,4"]),
+    refuses(&["export", "--weave", w], &["nothing to export", "--rgl"]);
+    refuses(
+        &["export", "--weave", w, "--rgl", o, "--rgl-res", "1,4,4"],
         &["theta resolution 1", "16,24,32"],
     );
     let ok = clothbake(&[
@@ -515,15 +514,11 @@ fn export_writes_an_rgl_file_and_refuses_bad_requests() {
         "3,4,5",
         "-q",
     ]);
-    assert!(
-        ok.status.success(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
-    );
+    common::succeeds(&ok);
     let bytes = std::fs::read(&out).unwrap();
     assert_eq!(&bytes[..12], b"tensor_file\0");
-    fails(
-        &clothbake(&["export", "--weave", w, "--rgl", o]),
+    refuses(
+        &["export", "--weave", w, "--rgl", o],
         &["already exists", "--force"],
     );
     std::fs::remove_file(&out).unwrap();
@@ -536,33 +531,24 @@ fn export_from_a_table_and_spectral_export() {
     // --weave and --table are exclusive, and one is needed.
     let w = table("plain");
     let w = w.to_str().unwrap();
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-export-table");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::fresh_dir("cli", "export-table");
     let t = dir.join("plain.bin");
     let t = t.to_str().unwrap();
     let baked = clothbake(&["bake", "--weave", w, "-o", t, "--res", "4,8,4,8", "-q"]);
-    assert!(
-        baked.status.success(),
-        "{}",
-        String::from_utf8_lossy(&baked.stderr)
-    );
+    common::succeeds(&baked);
     let (rgb, spec) = (dir.join("t.bsdf"), dir.join("t_spec.bsdf"));
     let (rgb, spec) = (rgb.to_str().unwrap(), spec.to_str().unwrap());
-    fails(
-        &clothbake(&["export", "--weave", w, "--table", t, "--rgl", rgb]),
+    refuses(
+        &["export", "--weave", w, "--table", t, "--rgl", rgb],
         &["--weave and --table", "either"],
     );
-    fails(
-        &clothbake(&["export", "--rgl", rgb]),
-        &["--weave FILE", "--table"],
-    );
-    fails(
-        &clothbake(&["export", "--table", t, "--rgl", rgb, "--albedo", "0.5"]),
+    refuses(&["export", "--rgl", rgb], &["--weave FILE", "--table"]);
+    refuses(
+        &["export", "--table", t, "--rgl", rgb, "--albedo", "0.5"],
         &["--albedo applies to the model", "--weave"],
     );
-    fails(
-        &clothbake(&["export", "--table", t, "--rgl", rgb, "--bounces", "2"]),
+    refuses(
+        &["export", "--table", t, "--rgl", rgb, "--bounces", "2"],
         &["--bounces applies to the model"],
     );
     for flag in [["--orders", "fast"], ["--sampling", "32,0.2,1.5,exact"]] {
@@ -571,13 +557,13 @@ fn export_from_a_table_and_spectral_export() {
             &[&format!("{} applies to the model", flag[0])],
         );
     }
-    fails(
-        &clothbake(&["export", "--table", t, "--rgl", rgb, "--rgl-spectral", rgb]),
+    refuses(
+        &["export", "--table", t, "--rgl", rgb, "--rgl-spectral", rgb],
         &["same file", "own output path"],
     );
     let missing = dir.join("none.exr");
-    fails(
-        &clothbake(&["export", "--table", missing.to_str().unwrap(), "--rgl", rgb]),
+    refuses(
+        &["export", "--table", missing.to_str().unwrap(), "--rgl", rgb],
         &["none.exr"],
     );
     let ok = clothbake(&[
@@ -591,11 +577,7 @@ fn export_from_a_table_and_spectral_export() {
         "--rgl-res",
         "3,4,5",
     ]);
-    assert!(
-        ok.status.success(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
-    );
+    common::succeeds(&ok);
     let said = String::from_utf8_lossy(&ok.stdout);
     assert!(
         said.contains("(RGB)") && said.contains("(spectral)"),
@@ -630,11 +612,7 @@ fn export_from_a_table_and_spectral_export() {
         "1",
         "-q",
     ]);
-    assert!(
-        ok.status.success(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
-    );
+    common::succeeds(&ok);
     assert!(std::fs::read(&one).unwrap() == spec_bytes);
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -653,11 +631,7 @@ fn eval_reads_a_wif_draft() {
         &draft("denim.wif"),
         &["--wi", "10,0", "--wo", "10,180", "--json"],
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::succeeds(&out);
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     let i_d: Vec<f64> = v["I_d"]
         .as_array()

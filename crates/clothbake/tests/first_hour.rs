@@ -8,13 +8,7 @@ mod common;
 
 use common::{fails_with, fresh_dir, listing, succeeds, text};
 
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_clothbake"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run the clothbake binary")
-}
+use common::run_in;
 
 fn clothbake(args: &[&str]) -> Output {
     run_in(Path::new(env!("CARGO_TARGET_TMPDIR")), args)

@@ -403,6 +403,23 @@ fn use_table(t: Table) {
     }
 }
 
+/// Fuzzes the fabric reader (`Fabric::from_path`) on the shipped `*.<ext>` files: the campaign
+/// `name`, with `tokens` spliced in; no checksum guards these files.
+fn fuzz_fabric_reader(name: &str, ext: &str, tokens: &[&[u8]]) {
+    fuzz(
+        &Reader {
+            name,
+            ext,
+            tokens,
+            crc: false,
+            read: &|p| {
+                let _ = Fabric::from_path(p);
+            },
+        },
+        &files_with(ext),
+    );
+}
+
 #[test]
 fn fuzz_fabric_json() {
     isolated("fabric-json", "json", "fuzz_fabric_json", run_fabric_json);
@@ -425,18 +442,7 @@ fn run_fabric_json() {
         b"\xef\xbb\xbf",
         b"null",
     ];
-    fuzz(
-        &Reader {
-            name: "fabric-json",
-            ext: "json",
-            tokens,
-            crc: false,
-            read: &|p| {
-                let _ = Fabric::from_path(p);
-            },
-        },
-        &files_with("json"),
-    );
+    fuzz_fabric_reader("fabric-json", "json", tokens);
 }
 
 #[test]
@@ -462,18 +468,7 @@ fn run_wif() {
         b"\r\n",
         b"\xff\xfe",
     ];
-    fuzz(
-        &Reader {
-            name: "wif",
-            ext: "wif",
-            tokens,
-            crc: false,
-            read: &|p| {
-                let _ = Fabric::from_path(p);
-            },
-        },
-        &files_with("wif"),
-    );
+    fuzz_fabric_reader("wif", "wif", tokens);
 }
 
 #[test]

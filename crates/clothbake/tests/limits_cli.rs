@@ -8,7 +8,7 @@ use std::process::{Command, Output, Stdio};
 
 mod common;
 
-use common::{cmd, fabric, listing, run_in, succeeds, text};
+use common::{bake_in, cmd, fabric, listing, run_in, succeeds, text};
 
 fn fails_with(out: &Output, needles: &[&str]) -> String {
     common::fails_with(out, 2, needles)
@@ -41,12 +41,7 @@ fn devices_are_never_replaced() {
     let d = fresh_dir("devices");
     let plain = fabric("plain");
     for dev in ["/dev/full", "/dev/null"] {
-        let out = run_in(
-            &d,
-            &[
-                "bake", "--weave", &plain, "--res", RES, "-o", dev, "--force", "-q",
-            ],
-        );
+        let out = bake_in(&d, &plain, RES, &["-o", dev, "--force", "-q"]);
         fails_with(
             &out,
             &[
@@ -60,19 +55,7 @@ fn devices_are_never_replaced() {
     }
     // A link to a device is refused too (rename would replace the link, e.g. /dev/stdout).
     std::os::unix::fs::symlink("/dev/null", d.join("null-link")).unwrap();
-    let out = run_in(
-        &d,
-        &[
-            "bake",
-            "--weave",
-            &plain,
-            "--res",
-            RES,
-            "-o",
-            "null-link",
-            "--force",
-        ],
-    );
+    let out = bake_in(&d, &plain, RES, &["-o", "null-link", "--force"]);
     fails_with(&out, &["null-link", "character device"]);
     assert!(file_type(&d.join("null-link")).is_symlink());
     assert_eq!(listing(&d), ["null-link"]);
@@ -89,12 +72,7 @@ fn a_fifo_is_refused_even_with_force() {
         return;
     }
     let plain = fabric("plain");
-    let out = run_in(
-        &d,
-        &[
-            "bake", "--weave", &plain, "--res", RES, "-o", "pipe", "--force",
-        ],
-    );
+    let out = bake_in(&d, &plain, RES, &["-o", "pipe", "--force"]);
     fails_with(&out, &["pipe: cannot write the table", "FIFO"]);
     assert!(file_type(&d.join("pipe")).is_fifo());
     // Reading one neither blocks nor reads garbage.
@@ -150,20 +128,11 @@ fn an_input_is_never_an_output() {
         "./plain.json",
         "../limits-cli-inputs/plain.json",
     ] {
-        let out = run_in(
+        let out = bake_in(
             &d,
-            &[
-                "bake",
-                "--weave",
-                "plain.json",
-                "--res",
-                RES,
-                "-o",
-                o,
-                "--force",
-                "--format",
-                "exr",
-            ],
+            "plain.json",
+            RES,
+            &["-o", o, "--force", "--format", "exr"],
         );
         fails_with(
             &out,
@@ -178,19 +147,7 @@ fn an_input_is_never_an_output() {
         if !d.join(o).exists() {
             continue;
         }
-        let out = run_in(
-            &d,
-            &[
-                "bake",
-                "--weave",
-                "plain.json",
-                "--res",
-                RES,
-                "-o",
-                o,
-                "--force",
-            ],
-        );
+        let out = bake_in(&d, "plain.json", RES, &["-o", o, "--force"]);
         fails_with(&out, &[o, "an input of this command (plain.json)"]);
     }
     assert_eq!(std::fs::read(d.join("plain.json")).unwrap(), json);
@@ -397,11 +354,7 @@ fn sigterm_stops_a_bake_on_many_threads_promptly() {
     assert!(wait_for_lock(&d, &mut bake), "the bake took no lock");
     std::thread::sleep(std::time::Duration::from_millis(300));
     let sent = std::time::Instant::now();
-    let killed = Command::new("kill")
-        .args(["-TERM", &bake.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
+    common::signal(&bake, "TERM");
     let out = bake.wait_with_output().unwrap();
     // Generous: a loaded machine; before the cap, 100 000 threads ignored it for minutes.
     let took = sent.elapsed();

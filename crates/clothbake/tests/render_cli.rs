@@ -37,6 +37,13 @@ fn succeeds(args: &[&str]) {
     );
 }
 
+/// The arguments `render <args...> --aa 1 --quiet -o <png> --exr <exr>` (one sample a pixel).
+fn render_args<'a>(args: &[&'a str], png: &'a Path, exr: &'a Path) -> Vec<&'a str> {
+    let (png, exr) = (png.to_str().unwrap(), exr.to_str().unwrap());
+    let outputs = ["--aa", "1", "--quiet", "-o", png, "--exr", exr];
+    [&["render"][..], args, &outputs].concat()
+}
+
 /// Exit 2, one line on stderr naming every needle, nothing on stdout.
 fn fails(out: &Output, needles: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
@@ -52,20 +59,7 @@ fn fails(out: &Output, needles: &[&str]) {
 fn render_writes_png_and_exr_of_the_stated_size() {
     let (png_path, exr_path) = (temp("small.png"), temp("small.exr"));
     let w = weave("twill");
-    let args = [
-        "render",
-        "--weave",
-        &w,
-        "--res",
-        "24,16",
-        "--aa",
-        "1",
-        "--quiet",
-        "-o",
-        png_path.to_str().unwrap(),
-        "--exr",
-        exr_path.to_str().unwrap(),
-    ];
+    let args = render_args(&["--weave", &w, "--res", "24,16"], &png_path, &exr_path);
     succeeds(&args);
     let dec = png::Decoder::new(std::io::BufReader::new(
         std::fs::File::open(&png_path).unwrap(),
@@ -207,7 +201,6 @@ fn swatch_pixels_with(
 ) -> Vec<[f32; 3]> {
     let (png_path, exr_path) = (temp(&format!("{name}.png")), temp(&format!("{name}.exr")));
     let mut args = vec![
-        "render",
         "--table",
         table.to_str().unwrap(),
         "--scene",
@@ -216,19 +209,12 @@ fn swatch_pixels_with(
         "0,-30,40",
         "--res",
         "64,48",
-        "--aa",
-        "1",
-        "--quiet",
-        "-o",
-        png_path.to_str().unwrap(),
-        "--exr",
-        exr_path.to_str().unwrap(),
     ];
     if let Some(n) = periods {
         args.extend(["--periods", n]);
     }
     args.extend(extra);
-    succeeds(&args);
+    succeeds(&render_args(&args, &png_path, &exr_path));
     read_rgb(&exr_path, 64)
 }
 

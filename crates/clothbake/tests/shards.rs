@@ -1,12 +1,12 @@
 //! Shards, merge, checkpoint and resume, driving the built binary as separate processes.
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output};
+use std::process::{Child, Output};
 use std::time::{Duration, Instant};
 
 mod common;
 
-use common::{cmd, fabric, listing, run_in, succeeds, text};
+use common::{bake_args, bake_in, cmd, fabric, listing, run_in, succeeds, text};
 
 /// Exit status 2, one line `clothbake: ...` on stderr containing every needle.
 fn fails_with(out: &Output, needles: &[&str]) -> String {
@@ -35,15 +35,7 @@ const RES: &str = "8,16,8,16";
 fn four_shards_two_at_a_time_merge_to_the_single_bake() {
     let d = fresh_dir("four");
     let twill = fabric("twill");
-    let base = [
-        "bake",
-        "--weave",
-        twill.as_str(),
-        "--res",
-        RES,
-        "--threads",
-        "1",
-    ];
+    let base = bake_args(twill.as_str(), RES, &["--threads", "1"]);
     succeeds(&run_in(&d, &[&base[..], &["-o", "single.exr"]].concat()));
     // Four shards as separate processes, two at a time.
     for pair in [[0, 1], [2, 3]] {
@@ -91,19 +83,11 @@ fn four_shards_two_at_a_time_merge_to_the_single_bake() {
     );
     // A shard of another fabric.
     let plain = fabric("plain");
-    succeeds(&run_in(
+    succeeds(&bake_in(
         &d,
-        &[
-            "bake",
-            "--weave",
-            &plain,
-            "--res",
-            RES,
-            "--shard",
-            "2/4",
-            "-o",
-            "plain2.shard",
-        ],
+        &plain,
+        RES,
+        &["--shard", "2/4", "-o", "plain2.shard"],
     ));
     let before_plain = [&before[..], &["plain2.shard".to_string()]].concat();
     let other = [sh[0], sh[1], "plain2.shard", sh[3]];
@@ -226,15 +210,7 @@ fn spatial_bakes_are_the_same_for_any_thread_count_and_shard_split() {
 fn shard_auto_reads_slurm_and_kubernetes() {
     let d = fresh_dir("auto");
     let twill = fabric("twill");
-    let base = [
-        "bake",
-        "--weave",
-        twill.as_str(),
-        "--res",
-        "2,4,2,4",
-        "--shard",
-        "auto",
-    ];
+    let base = bake_args(twill.as_str(), "2,4,2,4", &["--shard", "auto"]);
     // SLURM --array=1-2: task 2 is shard 1/2.
     let out = cmd(&d, &base)
         .env("SLURM_ARRAY_TASK_ID", "2")
@@ -304,23 +280,28 @@ fn wait_for(path: &Path, limit: Duration) -> bool {
     false
 }
 
-/// A bake SIGKILLed mid-way and resumed equals an uninterrupted one, bit for bit.
-#[cfg(unix)]
-#[test]
-fn killed_bake_resumes_to_the_same_table() {
-    let d = fresh_dir("resume");
-    let twill = fabric("twill");
-    // The ray tracer (per-cell seeds): about 1.5 s of one core on this grid.
-    let base = [
+/// The options of a bake of `fabric` on RES slow enough to interrupt: the ray tracer (per-cell
+/// seeds), about 1.5 s of one core.
+fn slow_bake(fabric: &str) -> [&str; 8] {
+    [
         "--weave",
-        twill.as_str(),
+        fabric,
         "--res",
         RES,
         "--method",
         "raytrace",
         "--samples",
         "600",
-    ];
+    ]
+}
+
+/// A bake SIGKILLed mid-way and resumed equals an uninterrupted one, bit for bit.
+#[cfg(unix)]
+#[test]
+fn killed_bake_resumes_to_the_same_table() {
+    let d = fresh_dir("resume");
+    let twill = fabric("twill");
+    let base = slow_bake(&twill);
     let t = ["-o", "t.bin"];
     let mut child = cmd(
         &d,
@@ -384,20 +365,11 @@ fn interrupted_shard_resumes() {
     let d = fresh_dir("sigint");
     let twill = fabric("twill");
     let base = [
-        "bake",
-        "--weave",
-        twill.as_str(),
-        "--res",
-        RES,
-        "--method",
-        "raytrace",
-        "--samples",
-        "600",
-        "--shard",
-        "1/2",
-        "--threads",
-        "1",
-    ];
+        &["bake"][..],
+        &slow_bake(&twill),
+        &["--shard", "1/2", "--threads", "1"],
+    ]
+    .concat();
     let every = ["--checkpoint-every", "0"];
     let child = cmd(&d, &[&base[..], &["-o", "a.shard"], &every[..]].concat())
         .spawn()
@@ -406,11 +378,7 @@ fn interrupted_shard_resumes() {
         &d.join("a.shard.checkpoint"),
         Duration::from_secs(60)
     ));
-    let ok = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(ok.success());
+    common::signal(&child, "INT");
     let out = child.wait_with_output().unwrap();
     let err = text(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{err}");

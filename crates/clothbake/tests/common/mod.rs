@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Child, Command, Output, Stdio};
 
 /// The absolute path of the shipped fabric `tables/<name>.json`.
 pub fn fabric(name: &str) -> String {
@@ -83,4 +83,24 @@ pub fn cmd(dir: &Path, args: &[&str]) -> Command {
 /// Runs [`cmd`] to its end.
 pub fn run_in(dir: &Path, args: &[&str]) -> Output {
     cmd(dir, args).output().expect("run the clothbake binary")
+}
+
+/// Sends the signal `sig` (`"INT"`, `"TERM"`, ...) to `child` with `kill`, which must succeed.
+pub fn signal(child: &Child, sig: &str) {
+    let sent = Command::new("kill")
+        .arg(format!("-{sig}"))
+        .arg(child.id().to_string())
+        .status()
+        .expect("run kill");
+    assert!(sent.success(), "kill -{sig} {}", child.id());
+}
+
+/// The arguments `bake --weave <fabric> --res <res> <extra...>`.
+pub fn bake_args<'a>(fabric: &'a str, res: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    [&["bake", "--weave", fabric, "--res", res][..], extra].concat()
+}
+
+/// Runs `clothbake bake --weave <fabric> --res <res> <extra...>` in `dir` to its end.
+pub fn bake_in(dir: &Path, fabric: &str, res: &str, extra: &[&str]) -> Output {
+    run_in(dir, &bake_args(fabric, res, extra))
 }
