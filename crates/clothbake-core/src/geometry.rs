@@ -179,12 +179,7 @@ mod tests {
     use super::*;
 
     fn twill() -> Fabric {
-        Fabric::from_json_str(
-            r#"{"pattern": [[1,1,0],[0,1,1],[1,0,1]],
-                "warp": {"radius": 1.5, "spacing": 3.1}, "weft": {"radius": 1.5, "spacing": 3.1}}"#,
-            "t",
-        )
-        .unwrap()
+        crate::fabric::thesis_twill()
     }
 
     #[test]
