@@ -799,6 +799,17 @@ fn material(cx: &Ctx<'_>, name: &str, m: Option<&MaterialFile>) -> Result<Materi
     Ok(out)
 }
 
+/// The thesis's 2/1 twill (Fig. 4.7: radius 1.5, spacing 3.1), for the crate's unit tests.
+#[cfg(test)]
+pub(crate) fn thesis_twill() -> Fabric {
+    Fabric::from_json_str(
+        r#"{"pattern": [[1,1,0],[0,1,1],[1,0,1]],
+            "warp": {"radius": 1.5, "spacing": 3.1}, "weft": {"radius": 1.5, "spacing": 3.1}}"#,
+        "t",
+    )
+    .unwrap()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -917,15 +928,4 @@ mod tests {
         let e = err(&t.replace("[0.2,", "[-0.2,"));
         assert_eq!(e.field, "weft.thread_albedo[0]");
     }
-}
-
-/// The thesis's 2/1 twill (Fig. 4.7: radius 1.5, spacing 3.1), for the crate's unit tests.
-#[cfg(test)]
-pub(crate) fn thesis_twill() -> Fabric {
-    Fabric::from_json_str(
-        r#"{"pattern": [[1,1,0],[0,1,1],[1,0,1]],
-            "warp": {"radius": 1.5, "spacing": 3.1}, "weft": {"radius": 1.5, "spacing": 3.1}}"#,
-        "t",
-    )
-    .unwrap()
 }
