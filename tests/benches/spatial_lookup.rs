@@ -33,6 +33,12 @@ fn spatial_lookup(c: &mut Criterion) {
         ..Options::default()
     };
     let brdf = Brdf::from_stored(stored, options).expect("valid table");
+    eprintln!(
+        "memory: {} MiB in all, {} MiB the classes; kernel {:?}",
+        brdf.memory_bytes() >> 20,
+        brdf.spatial().map_or(0, |s| s.memory_bytes()) >> 20,
+        brdf.simd_path()
+    );
     let (wi, wo): (Vec<[f32; 3]>, Vec<[f32; 3]>) = random_pairs(N, 7)
         .iter()
         .map(|&(a, b)| (to_f32(a), to_f32(b)))
@@ -58,6 +64,15 @@ fn spatial_lookup(c: &mut Criterion) {
             })
         });
     }
+    // One cell: every lookup reads the same class pair's node table (the working set of an
+    // averaged lookup), to tell the cost of spreading over the classes' tables.
+    g.bench_function("spatial/eval_at_point_one_cell", |b| {
+        let mut k = 0;
+        b.iter(|| {
+            k = (k + 1) & (N - 1);
+            black_box(brdf.eval_at(black_box(wi[k]), black_box(wo[k]), 0.1, 0.1, 0.0))
+        })
+    });
     g.bench_function("spatial/coverage_at_point", |b| {
         let mut k = 0;
         b.iter(|| {

@@ -150,7 +150,9 @@ impl Spatial {
     fn locate(edges: &[f64], t: f64) -> usize {
         let e0 = edges[0];
         let t = if t.is_finite() { t } else { 0.0 };
-        let x = e0 + (t - e0).rem_euclid(1.0);
+        // Wrapped into [e0, e0 + 1) by floor (no library call on the lookup's path).
+        let d = t - e0;
+        let x = e0 + (d - d.floor());
         let n = edges.len() - 1;
         edges
             .partition_point(|&e| e <= x)
@@ -165,7 +167,7 @@ impl Spatial {
         let n = edges.len() - 1;
         let mut k = Spatial::locate(edges, t0);
         // The unwrapped start of cell k at or before t0.
-        let mut start = edges[k] + ((t0 - edges[k]).div_euclid(1.0));
+        let mut start = edges[k] + (t0 - edges[k]).floor();
         while start < t1 && out.len() <= n {
             let w = edges[k + 1] - edges[k];
             let end = start + w;
@@ -376,12 +378,10 @@ impl SpatialLookup {
         if width >= 1.0 || !(u.is_finite() && v.is_finite()) {
             return None;
         }
-        if angles(wi).is_none() {
+        let seen = |w: [f32; 3]| !w.iter().any(|x| x.is_nan()) && above_horizon(w);
+        if !(seen(wi) && seen(wo)) {
             return Some([0.0; 3]);
         }
-        let Some(o) = angles(wo) else {
-            return Some([0.0; 3]);
-        };
         if width.is_nan() || width <= 0.0 {
             // A point: its cell's f_r, rho_d D + S (its coverage cancels; where the class is
             // not seen, D and S are 0).
@@ -391,6 +391,9 @@ impl SpatialLookup {
             let [d, s] = self.class_f(simd, l.cell_class[c] as usize, wi, wo);
             return Some(l.cell_albedo[c].map(|a| (a * d + s).max(0.0)));
         }
+        let Some(o) = angles(wo) else {
+            return Some([0.0; 3]);
+        };
         let seen = self.seen(u, v, width);
         let (mut num, mut den) = ([0.0f32; 3], 0.0f32);
         for (k, (&share, a)) in seen.share.iter().zip(&seen.albedo).enumerate() {
