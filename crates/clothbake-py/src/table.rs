@@ -1,7 +1,7 @@
 //! `clothbake.Table`: a baked BRDF table with the loader's interpolated lookup
 //! (`clothbake_loader::Brdf`) and importance sampling.
 
-use crate::vectors::{check_unit, rows, same_len, to_array, to_array1, unit_rows};
+use crate::vectors::{check_unit, rows, same_len, to_array, to_array1, unit_rows, unit_rows_f32};
 use clothbake_loader::{
     write_binary, write_exr, Brdf, Memory, Options, Precision, StoredTable, TableError,
 };
@@ -141,14 +141,22 @@ impl PyTable {
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let a = unit_rows("wi", wi)?;
-        let b = unit_rows("wo", wo)?;
-        same_len(("wi", a.rows.len()), ("wo", b.rows.len()))?;
-        let (wi32, wo32) = (narrow(&a.rows), narrow(&b.rows));
-        let mut out = vec![[0f32; 3]; wi32.len()];
-        py.detach(|| self.brdf.eval_batch(&wi32, &wo32, &mut out))
+        // Read once into single precision; the result is written in place into the flat
+        // buffer the numpy array takes over (no copies besides the inputs' narrowing).
+        let (wi32, single_i) = unit_rows_f32("wi", wi)?;
+        let (wo32, single_o) = unit_rows_f32("wo", wo)?;
+        same_len(("wi", wi32.len()), ("wo", wo32.len()))?;
+        let mut flat = vec![0f32; 3 * wi32.len()];
+        let (out, _) = flat.as_chunks_mut::<3>();
+        py.detach(|| self.brdf.eval_batch(&wi32, &wo32, out))
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        to_array(py, &out, a.single && b.single)
+        let n = wi32.len();
+        let a = PyArray1::from_vec(py, flat);
+        if single_i && single_o {
+            Ok(a.into_any())
+        } else {
+            Ok(a.reshape([n, 3])?.into_any())
+        }
     }
 
     /// f_r at points of the weave period through a footprint (docs/spatial.md): `uv` (N, 2)

@@ -72,6 +72,59 @@ pub fn unit_rows(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<Rows<3>> {
     Ok(r)
 }
 
+/// Reads `(N, 3)` unit vectors straight into single precision, checked as [`unit_rows`] checks
+/// them, in one pass over a contiguous float32 or float64 array (the lookups' fast path: no
+/// intermediate copies); anything else goes through [`unit_rows`].
+pub fn unit_rows_f32(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<(Vec<[f32; 3]>, bool)> {
+    fn read<T: Copy + Into<f64>>(name: &str, flat: &[T]) -> PyResult<Vec<[f32; 3]>> {
+        // |w| in [1 - t, 1 + t] as |w|^2 in [(1 - t)^2, (1 + t)^2]: no square root a row
+        // (NaN fails the test too); check_unit words the error.
+        let (lo, hi) = (
+            (1.0 - UNIT_TOLERANCE).powi(2),
+            (1.0 + UNIT_TOLERANCE).powi(2),
+        );
+        let mut out = Vec::with_capacity(flat.len() / 3);
+        for (i, c) in flat.chunks_exact(3).enumerate() {
+            let w: [f64; 3] = [c[0].into(), c[1].into(), c[2].into()];
+            let n2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+            if !(lo..=hi).contains(&n2) {
+                check_unit(name, i, w)?;
+            }
+            out.push(w.map(|x| x as f32));
+        }
+        Ok(out)
+    }
+    let shape = obj
+        .cast::<numpy::PyUntypedArray>()
+        .ok()
+        .map(|a| a.shape().to_vec());
+    let single = match shape.as_deref() {
+        Some([3]) => true,
+        Some([_, 3]) => false,
+        _ => {
+            let r = unit_rows(name, obj)?;
+            return Ok((
+                r.rows.iter().map(|w| w.map(|x| x as f32)).collect(),
+                r.single,
+            ));
+        }
+    };
+    if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
+        if let Ok(flat) = a.readonly().as_slice() {
+            return Ok((read(name, flat)?, single));
+        }
+    } else if let Ok(a) = obj.cast::<PyArrayDyn<f32>>() {
+        if let Ok(flat) = a.readonly().as_slice() {
+            return Ok((read(name, flat)?, single));
+        }
+    }
+    let r = unit_rows(name, obj)?;
+    Ok((
+        r.rows.iter().map(|w| w.map(|x| x as f32)).collect(),
+        r.single,
+    ))
+}
+
 /// Checks one direction (row `i` of argument `name`).
 pub fn check_unit(name: &str, i: usize, w: [f64; 3]) -> PyResult<()> {
     let len = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();

@@ -398,3 +398,20 @@ def test_messages_name_python_arguments_not_flags(tmp_path, twill_path):
     with pytest.raises(ValueError) as e:
         clothbake.bake(fab, res=res, output=tmp_path / "x.shard", shard="4")
     assert 'shard="0/4"' in str(e.value) and "--" not in str(e.value), e.value
+
+
+def test_table_eval_reads_any_layout_alike(twill_path):
+    """Table.eval's fast path (contiguous float32/float64 read in place) and its general path
+    (views, lists) give the same lookups."""
+    t = clothbake.bake(clothbake.Fabric(twill_path), res=(4, 8, 4, 8))
+    rng = np.random.default_rng(5)
+    wi, wo = hemisphere(64, rng), hemisphere(64, rng)
+    f = t.eval(wi, wo)
+    # A strided view (every other row of a bigger array) and Python lists.
+    big = np.repeat(wi, 2, axis=0)[::2]
+    assert not big.flags["C_CONTIGUOUS"]
+    np.testing.assert_array_equal(t.eval(big, wo), f)
+    np.testing.assert_array_equal(t.eval(wi.tolist(), wo.tolist()), f)
+    # float32 input: the same directions rounded, as the lookup takes them anyway.
+    np.testing.assert_array_equal(t.eval(wi.astype(np.float32), wo.astype(np.float32)), f)
+    assert t.eval(wi[0], wo[0]).shape == (3,)
