@@ -288,6 +288,30 @@ impl Nodes {
         ]))
     }
 
+    /// Asks the processor to bring the runs of a lookup at `base` into the caches (a hint with
+    /// no effect on any value): the first and last lane of each of the 8 runs, so that a run
+    /// across two cache lines is fetched whole. Bases out of range are skipped.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub(crate) fn prefetch<V>(&self, v: &[V], base: [usize; 2]) {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        match v.len().checked_sub(self.extent) {
+            Some(last) if base[0] <= last && base[1] <= last => {}
+            _ => return,
+        }
+        let [s_ti, _, s_to] = self.strides;
+        let p = v.as_ptr();
+        for b in base {
+            for at in [b, b + s_to, b + s_ti, b + s_ti + s_to] {
+                for lane in [at, at + 7] {
+                    // SAFETY: as in `with_runs`, every run of 8 from these starts lies inside
+                    // `v`; a prefetch reads nothing the program sees.
+                    unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(lane).cast::<i8>()) }
+                }
+            }
+        }
+    }
+
     /// The corner of a lookup at angles `[theta_i, phi_i, theta_o, phi_o]`, radians (phi in
     /// `[-pi, 2 pi)`), with the rules of the lookup module: see [`polar_axis`] and
     /// [`azimuth_axis`].
