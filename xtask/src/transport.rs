@@ -410,12 +410,7 @@ fn validation(root: &Path) -> String {
         let m = Multiple::new(&f, FacetModel::Huo, &DEFAULT_GRID, ALL_BOUNCES);
         let model = AnalyticModel::new(&f, FacetModel::Huo);
         let rt = RayTracer::new(&f, FacetModel::Huo);
-        let opts = PathOptions {
-            max_bounces: 64,
-            kernel: Kernel::Radiometric,
-            roulette_from: 65,
-            first_order: 1,
-        };
+        let opts = PathOptions::brute_force();
         let rows: Vec<[f64; 5]> = pairs
             .par_iter()
             .enumerate()

@@ -7,7 +7,7 @@
 use clothbake_bake::sweep::DEFAULT_GRID;
 use clothbake_bake::transport::Multiple;
 use clothbake_core::rng::Rng;
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, Kernel, PathOptions, RayTracer};
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, PathOptions, RayTracer};
 use clothbake_core::{UnitVec3, ALL_BOUNCES};
 use clothbake_loader::Grid;
 use rayon::prelude::*;
@@ -48,12 +48,7 @@ fn compare(name: &str, paths_node: usize, paths_brute: usize, control: bool) -> 
     }
     let model = AnalyticModel::new(&f, FacetModel::Huo);
     let rt = RayTracer::new(&f, FacetModel::Huo);
-    let opts = PathOptions {
-        max_bounces: 64,
-        kernel: Kernel::Radiometric,
-        roulette_from: 65,
-        first_order: 1,
-    };
+    let opts = PathOptions::brute_force();
     random_pairs(50, 70.0, 2026)
         .par_iter()
         .enumerate()

@@ -40,6 +40,19 @@ pub struct PathOptions {
     pub first_order: usize,
 }
 
+impl PathOptions {
+    /// The brute-force reference of the full-transport validation: 64 bounces, radiometric
+    /// kernel, no Russian roulette (every order gathered).
+    pub fn brute_force() -> PathOptions {
+        PathOptions {
+            max_bounces: 64,
+            kernel: Kernel::Radiometric,
+            roulette_from: 65,
+            first_order: 1,
+        }
+    }
+}
+
 impl Default for PathOptions {
     fn default() -> Self {
         PathOptions {
