@@ -73,6 +73,15 @@ fn spatial_lookup(c: &mut Criterion) {
             black_box(brdf.eval_at(black_box(wi[k]), black_box(wo[k]), 0.1, 0.1, 0.0))
         })
     });
+    // A whole period: eval_at answers the averaged table (the wrapper's cost alone).
+    g.bench_function("spatial/eval_at_whole_period", |b| {
+        let mut k = 0;
+        b.iter(|| {
+            k = (k + 1) & (N - 1);
+            let (u, v) = uv[k];
+            black_box(brdf.eval_at(black_box(wi[k]), black_box(wo[k]), u, v, 1.0))
+        })
+    });
     g.bench_function("spatial/coverage_at_point", |b| {
         let mut k = 0;
         b.iter(|| {

@@ -222,6 +222,7 @@ impl Brdf {
     /// coverage-weighted mean of its cells' f_r over the square, and its averaged f_r
     /// ([`Brdf::eval`]) once `width` reaches 1; an averaged table always answers
     /// [`Brdf::eval`].
+    #[inline]
     pub fn eval_at(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64, width: f64) -> [f32; 3] {
         self.spatial
             .as_ref()

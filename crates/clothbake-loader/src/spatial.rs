@@ -314,6 +314,7 @@ impl SpatialLookup {
 
     /// Class `k`'s (D, S) at the directions, interpolated as the averaged table is (16 nodes,
     /// pole rows), by `simd`'s kernel.
+    #[inline]
     fn class_f(&self, simd: SimdPath, k: usize, wi: [f32; 3], wo: [f32; 3]) -> [f32; 2] {
         let nodes = &self.pairs[k / 2];
         let f = match (&nodes.values, simd) {
@@ -365,7 +366,9 @@ impl SpatialLookup {
 
     /// f_r through the footprint: the mean of the covered cells' f_r, each weighted by its
     /// covered share times its coverage. `None` for a footprint of a whole period or more
-    /// (the averaged table answers), `Some(0)` below the horizon.
+    /// (the averaged table answers), `Some(0)` below the horizon. Inline: the checks and a
+    /// point's lookup; footprints out of line.
+    #[inline]
     pub fn eval_at(
         &self,
         simd: SimdPath,
@@ -391,8 +394,23 @@ impl SpatialLookup {
             let [d, s] = self.class_f(simd, l.cell_class[c] as usize, wi, wo);
             return Some(l.cell_albedo[c].map(|a| (a * d + s).max(0.0)));
         }
+        Some(self.eval_footprint(simd, wi, wo, u, v, width))
+    }
+
+    /// [`SpatialLookup::eval_at`] of a footprint of side `width` in (0, 1), both directions
+    /// above the horizon.
+    #[inline(never)]
+    fn eval_footprint(
+        &self,
+        simd: SimdPath,
+        wi: [f32; 3],
+        wo: [f32; 3],
+        u: f64,
+        v: f64,
+        width: f64,
+    ) -> [f32; 3] {
         let Some(o) = angles(wo) else {
-            return Some([0.0; 3]);
+            return [0.0; 3];
         };
         let seen = self.seen(u, v, width);
         let (mut num, mut den) = ([0.0f32; 3], 0.0f32);
@@ -410,11 +428,11 @@ impl SpatialLookup {
             }
             den += vis * share;
         }
-        Some(if den > 0.0 {
+        if den > 0.0 {
             num.map(|n| (n / den).max(0.0))
         } else {
             [0.0; 3]
-        })
+        }
     }
 
     /// The footprint's coverage: the share of its projected area in which the eye meets yarn
