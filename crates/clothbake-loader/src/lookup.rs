@@ -39,7 +39,7 @@ use crate::table::{Grid, Metadata, Precision, Table};
 
 /// True when a pair has a value: both directions above the horizon, no component NaN.
 #[inline(always)]
-fn has_value(wi: [f32; 3], wo: [f32; 3]) -> bool {
+pub(crate) fn has_value(wi: [f32; 3], wo: [f32; 3]) -> bool {
     let nan = wi.iter().chain(&wo).any(|x| x.is_nan());
     !nan && above_horizon(wi) && above_horizon(wo)
 }

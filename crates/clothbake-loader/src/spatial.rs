@@ -17,7 +17,7 @@ use crate::angles::{above_horizon, theta_phi};
 #[cfg(target_arch = "x86_64")]
 use crate::avx2;
 use crate::error::TableError;
-use crate::lookup::{pad4, SimdPath};
+use crate::lookup::{has_value, pad4, SimdPath};
 use crate::nodes::{Nodes, Values};
 use crate::stored::Samples;
 use crate::table::Grid;
@@ -144,6 +144,14 @@ impl Spatial {
             return bad("every visible area of a spatial table is finite and >= 0".to_string());
         }
         Ok(())
+    }
+
+    /// The cell (warp column, weft row) holding point (u, v) of the period, wrapped.
+    fn cell_at(&self, u: f64, v: f64) -> (usize, usize) {
+        (
+            Spatial::locate(&self.u_edges, u),
+            Spatial::locate(&self.v_edges, v),
+        )
     }
 
     /// The cell column (or row) of `edges` holding fraction `t` of the period, wrapped.
@@ -381,16 +389,15 @@ impl SpatialLookup {
         if width >= 1.0 || !(u.is_finite() && v.is_finite()) {
             return None;
         }
-        let seen = |w: [f32; 3]| !w.iter().any(|x| x.is_nan()) && above_horizon(w);
-        if !(seen(wi) && seen(wo)) {
+        if !has_value(wi, wo) {
             return Some([0.0; 3]);
         }
         if width.is_nan() || width <= 0.0 {
             // A point: its cell's f_r, rho_d D + S (its coverage cancels; where the class is
             // not seen, D and S are 0).
             let l = &self.layout;
-            let (nx, _) = l.dims();
-            let c = Spatial::locate(&l.v_edges, v) * nx + Spatial::locate(&l.u_edges, u);
+            let (i, j) = l.cell_at(u, v);
+            let c = j * l.dims().0 + i;
             let [d, s] = self.class_f(simd, l.cell_class[c] as usize, wi, wo);
             return Some(l.cell_albedo[c].map(|a| (a * d + s).max(0.0)));
         }
@@ -480,10 +487,7 @@ impl SpatialLookup {
             }
             out
         } else {
-            let (i, j) = (
-                Spatial::locate(&l.u_edges, u),
-                Spatial::locate(&l.v_edges, v),
-            );
+            let (i, j) = l.cell_at(u, v);
             vec![(j * nx + i, 1.0, cell_area(i, j))]
         }
     }

@@ -1,7 +1,7 @@
 //! `clothbake.Fabric`: a validated fabric description and its BRDF from the analytic model
 //! (thesis ch. 3-4, ch. 5 with two bounces) or the ray-traced ground truth.
 
-use crate::vectors::{check_unit, rows, same_len, to_array, to_array1, unit_rows};
+use crate::vectors::{check_unit, period_rows, same_len, to_array, to_array1, unit_rows};
 use clothbake_core::{
     intensity_to_brdf, AnalyticModel, Fabric, FacetModel, LocalReflection, PeriodPoint, RayTracer,
     Reflection, SecondaryOptions, Transport, UnitVec3, Vec3, ALL_BOUNCES,
@@ -176,20 +176,12 @@ impl PyFabric {
                         "uv: points of the period are evaluated by the analytic model only; drop uv or use method=\"analytic\"",
                     ));
                 }
-                let r = rows::<2>("uv", obj)?;
-                same_len(("wi", wi.rows.len()), ("uv", r.rows.len()))?;
+                let r = period_rows(obj, wi.rows.len())?;
                 let pts = r
                     .rows
                     .iter()
-                    .enumerate()
-                    .map(|(i, &[u, v])| {
-                        PeriodPoint::new(u, v).ok_or_else(|| {
-                            PyValueError::new_err(format!(
-                                "uv: row {i} is ({u}, {v}); give finite period fractions"
-                            ))
-                        })
-                    })
-                    .collect::<PyResult<Vec<_>>>()?;
+                    .map(|&[u, v]| PeriodPoint::new(u, v).expect("period_rows: finite"))
+                    .collect::<Vec<_>>();
                 Some(pts)
             }
         };

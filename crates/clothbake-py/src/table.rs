@@ -1,7 +1,9 @@
 //! `clothbake.Table`: a baked BRDF table with the loader's interpolated lookup
 //! (`clothbake_loader::Brdf`) and importance sampling.
 
-use crate::vectors::{check_unit, rows, same_len, to_array, to_array1, unit_rows, unit_rows_f32};
+use crate::vectors::{
+    check_unit, period_rows, rows, same_len, to_array, to_array1, unit_rows, unit_rows_f32,
+};
 use clothbake_loader::{
     write_binary, write_exr, Brdf, Memory, Options, Precision, StoredTable, TableError,
 };
@@ -175,19 +177,8 @@ impl PyTable {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let a = unit_rows("wi", wi)?;
         let b = unit_rows("wo", wo)?;
-        let p = rows::<2>("uv", uv)?;
         same_len(("wi", a.rows.len()), ("wo", b.rows.len()))?;
-        same_len(("wi", a.rows.len()), ("uv", p.rows.len()))?;
-        if let Some((i, [u, v])) = p
-            .rows
-            .iter()
-            .enumerate()
-            .find(|(_, r)| !(r[0].is_finite() && r[1].is_finite()))
-        {
-            return Err(PyValueError::new_err(format!(
-                "uv: row {i} is ({u}, {v}); give finite period fractions"
-            )));
-        }
+        let p = period_rows(uv, a.rows.len())?;
         if !(width.is_finite() && width >= 0.0) {
             return Err(PyValueError::new_err(format!(
                 "width: {width} is not a footprint; give the square's side in periods, >= 0"

@@ -125,6 +125,24 @@ pub fn unit_rows_f32(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<(Vec<[f32; 
     ))
 }
 
+/// Reads `uv`, points of the weave period as `(N, 2)` (or `(2,)`) period fractions, one per row
+/// of `wi` (`n` rows); a row that is not finite is an error naming it.
+pub fn period_rows(obj: &Bound<'_, PyAny>, n: usize) -> PyResult<Rows<2>> {
+    let r = rows::<2>("uv", obj)?;
+    same_len(("wi", n), ("uv", r.rows.len()))?;
+    if let Some((i, [u, v])) = r
+        .rows
+        .iter()
+        .enumerate()
+        .find(|(_, p)| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        return Err(PyValueError::new_err(format!(
+            "uv: row {i} is ({u}, {v}); give finite period fractions"
+        )));
+    }
+    Ok(r)
+}
+
 /// Checks one direction (row `i` of argument `name`).
 pub fn check_unit(name: &str, i: usize, w: [f64; 3]) -> PyResult<()> {
     let len = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
