@@ -1,17 +1,18 @@
 //! Checkpoints of a running bake: the finished rows, saved atomically every so often.
 //!
 //! A [`Checkpointer`] collects the rows a sweep finishes ([`Checkpointer::record`], from the
-//! worker threads). When `interval` has passed since the last save, the worker that finished a
-//! row writes every finished row to the checkpoint file (a [`Part`] of kind checkpoint, through
+//! worker threads) in the bake's one buffer ([`Assembly`]). When `interval` has passed since
+//! the last save, the worker that finished a row writes every finished row, gathered from the
+//! buffer one row at a time, to the checkpoint file (a [`crate::shard::Part`] of kind checkpoint, through
 //! the loader's atomic write: the file is always a complete earlier checkpoint or a complete
 //! new one). [`Checkpointer::save`] writes at once (Ctrl-C, SIGTERM). `--resume` reads it back
 //! and bakes only the rows it lacks; as rows are pure functions of the inputs, the table is
 //! bit-identical to an uninterrupted bake.
 
-use crate::shard::{write_part, Kind, Part, ShardId};
+use crate::assembly::Assembly;
+use crate::shard::{Kind, ShardId};
 use crate::sweep::Row;
 use clothbake_loader::{Metadata, TableError};
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -26,46 +27,46 @@ pub fn checkpoint_path(output: &Path) -> PathBuf {
     output.with_file_name(name)
 }
 
-/// Collects finished rows and saves them periodically.
+/// Collects finished rows in the bake's [`Assembly`] and saves them periodically.
 pub struct Checkpointer {
     path: Option<PathBuf>,
     interval: Duration,
     shard: Option<ShardId>,
     meta: Metadata,
-    done: Mutex<BTreeMap<usize, Row>>,
+    done: Assembly,
     last: Mutex<Instant>,
     writing: Mutex<()>,
 }
 
 impl Checkpointer {
-    /// A checkpointer writing to `path` every `interval`, starting from the rows `resumed`
-    /// (empty for a fresh bake).
+    /// A checkpointer writing to `path` every `interval` the rows done in `assembly` (those
+    /// of a resumed checkpoint already in it, none for a fresh bake).
     pub fn new(
         path: PathBuf,
         interval: Duration,
         shard: Option<ShardId>,
         meta: Metadata,
-        resumed: BTreeMap<usize, Row>,
+        assembly: Assembly,
     ) -> Checkpointer {
         Checkpointer {
             path: Some(path),
             interval,
             shard,
             meta,
-            done: Mutex::new(resumed),
+            done: assembly,
             last: Mutex::new(Instant::now()),
             writing: Mutex::new(()),
         }
     }
 
     /// A checkpointer that only collects the rows (a bake in memory): it writes nothing.
-    pub fn in_memory(meta: Metadata, resumed: BTreeMap<usize, Row>) -> Checkpointer {
+    pub fn in_memory(meta: Metadata, assembly: Assembly) -> Checkpointer {
         Checkpointer {
             path: None,
             interval: Duration::MAX,
             shard: None,
             meta,
-            done: Mutex::new(resumed),
+            done: assembly,
             last: Mutex::new(Instant::now()),
             writing: Mutex::new(()),
         }
@@ -74,10 +75,8 @@ impl Checkpointer {
     /// Stores a finished row; writes a checkpoint when one is due (and no other thread is
     /// writing one). Returns the write's error, if any; the bake can go on without it.
     pub fn record(&self, row: usize, values: Row) -> Result<(), TableError> {
-        self.done
-            .lock()
-            .expect("no panic while held")
-            .insert(row, values);
+        self.done.put(row, &values);
+        drop(values);
         let due = {
             let mut last = self.last.lock().expect("no panic while held");
             if last.elapsed() >= self.interval {
@@ -107,24 +106,17 @@ impl Checkpointer {
         let Some(path) = &self.path else {
             return Ok(0);
         };
-        let rows = self.done.lock().expect("no panic while held").clone();
-        if rows.is_empty() {
+        if self.done.done_rows().is_empty() {
             return Ok(0);
         }
-        let n = rows.len();
-        let part = Part {
-            kind: Kind::Checkpoint,
-            shard: self.shard,
-            meta: self.meta.clone(),
-            rows,
-        };
-        write_part(path, &part, true)?;
-        Ok(n)
+        // The rows done when it starts; rows finished meanwhile wait for the next one.
+        self.done
+            .write_part(path, Kind::Checkpoint, self.shard, &self.meta, true)
     }
 
-    /// The finished rows.
-    pub fn into_rows(self) -> BTreeMap<usize, Row> {
-        self.done.into_inner().expect("no panic while held")
+    /// The rows done (the bake's values).
+    pub fn into_assembly(self) -> Assembly {
+        self.done
     }
 }
 

@@ -10,13 +10,14 @@
 //! library prints nothing. Runs on the current rayon pool: the result does not depend on its
 //! size, on the shard split or on resuming.
 
+use crate::assembly::Assembly;
 use crate::checkpoint::{checkpoint_path, Checkpointer, DEFAULT_INTERVAL};
 use crate::lock::{LockError, OutputLock};
 use crate::memory::{self, Kept};
 use crate::merge::orbits_of;
 use crate::output::{preflight, write_table, Format};
 use crate::settings::Naming;
-use crate::shard::{read_part, shard_rows, write_part, Kind, Part, ShardId};
+use crate::shard::{read_part, shard_rows, Kind, ShardId};
 use crate::sweep::{check_options, BakeError, BakeOptions, Baker, Row};
 use clothbake_core::Fabric;
 use clothbake_loader::{Metadata, Table, TableError};
@@ -356,15 +357,21 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
         let m = shown.fetch_max(n, Ordering::Relaxed).max(n);
         (hooks.progress)(done_before as u64 + m, total);
     };
+    // The one buffer of the output's values: the resumed rows first (each dropped once
+    // copied), then the sweep's.
+    let assembly = Assembly::new(orbits, rows.clone());
+    for (r, vals) in resumed {
+        assembly.put(r, &vals);
+    }
     let ck = match &ck_path {
         Some(p) => Checkpointer::new(
             p.clone(),
             job.checkpoint_every,
             shard,
             baker.metadata().clone(),
-            resumed,
+            assembly,
         ),
-        None => Checkpointer::in_memory(baker.metadata().clone(), resumed),
+        None => Checkpointer::in_memory(baker.metadata().clone(), assembly),
     };
     let warned = AtomicBool::new(false);
     let sink = |row: usize, vals: Row| {
@@ -395,31 +402,30 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
         }
         Err(e) => return Err(bake_error(e)),
     }
-    let done = ck.into_rows();
+    let done = ck.into_assembly();
     let evaluated: usize = done
-        .keys()
+        .done_rows()
+        .iter()
         .map(|&r| orbits.row_evaluations(r))
         .sum::<usize>()
         / orbits.stride();
     let g = job.options.grid;
     let table = match &job.target {
         Target::Shard { path, id } => {
-            let part = Part {
-                kind: Kind::Shard,
-                shard: Some(*id),
-                meta: baker.metadata().clone(),
-                rows: done,
-            };
-            write_part(path, &part, job.overwrite)?;
+            done.write_part(
+                path,
+                Kind::Shard,
+                Some(*id),
+                baker.metadata(),
+                job.overwrite,
+            )?;
             None
         }
         target => {
-            // The rows are dropped before the table is written (see `memory`).
-            let table = {
-                let all: Vec<Row> = done.into_values().collect();
-                check_values(&all, &baker, job)?;
-                baker.table(&all).map_err(bake_error)?
-            };
+            // The buffer becomes the table's values: the writers stream from them.
+            check_values(&done, &baker, job)?;
+            let table = Table::new(baker.metadata().clone(), done.into_values())
+                .map_err(|e| JobError::Invalid(e.to_string()))?;
             if let Target::Table { path, format } = target {
                 write_table(path, &table, *format, job.overwrite)?;
             }
@@ -484,7 +490,7 @@ pub fn check_memory(
     } else {
         3
     };
-    let need = (memory::peak_bytes(&g, baked, kept) / 3)
+    let need = (memory::peak_bytes(&g, baked, kept, job.resume) / 3)
         .saturating_mul(scale)
         .saturating_add(extra);
     match available {
@@ -510,8 +516,9 @@ pub fn check_memory(
 
 /// Refuses rows holding a value that is not finite or negative, naming the fabric file and
 /// the cell's directions (a table file would be refused on reading anyway).
-fn check_values(rows: &[Row], baker: &Baker, job: &Job<'_>) -> Result<(), JobError> {
-    for (row, values) in rows.iter().enumerate() {
+fn check_values(done: &Assembly, baker: &Baker, job: &Job<'_>) -> Result<(), JobError> {
+    for row in done.rows() {
+        let values = done.row(row).expect("every row is done");
         if let Some(k) = values
             .iter()
             .flatten()

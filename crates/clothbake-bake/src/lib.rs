@@ -2,7 +2,7 @@
 //!
 //! [`sweep`] evaluates the (theta_i, phi_i, theta_o, phi_o) grid of a fabric in parallel rows
 //! through the model's BSDF and returns the table (its items are re-exported here: [`bake`],
-//! [`BakeOptions`], [`Baker`]); [`shard`], [`merge`] and [`checkpoint`] split a bake into
+//! [`BakeOptions`], [`Baker`]), the rows landing in the table's one buffer ([`assembly`]); [`shard`], [`merge`] and [`checkpoint`] split a bake into
 //! shards, assemble them and resume an interrupted one (docs/cluster.md); [`job`] runs a whole
 //! bake (checkpoints, resume, shard or table file, cancellation) for the CLI and Python, under
 //! the output's [`lock`] and after the [`memory`] check;
@@ -14,6 +14,7 @@
 //! Python package call the same functions.
 
 pub mod albedo;
+pub mod assembly;
 pub mod checkpoint;
 pub mod compare;
 pub mod golden;

@@ -3,10 +3,11 @@
 //! Every shard must come from the same fabric, options, grid and tool version (this one: the
 //! symmetry copies are made here), and the shards must cover the rows exactly once: each index
 //! 0..N-1 given once, each holding exactly the rows [`crate::shard::split`] assigns to it. The
-//! assembly is [`Orbits::assemble`], the single bake's own, so the table is bit-identical.
+//! assembly is the single bake's own ([`Assembly`]), so the table is bit-identical.
 
+use crate::assembly::Assembly;
 use crate::shard::{describe_rows, shard_rows, Kind, Part, PartError, ShardId};
-use crate::sweep::{symmetry_name, tool_name, usable_symmetries, Orbits, Row};
+use crate::sweep::{symmetry_name, tool_name, usable_symmetries, Orbits};
 use clothbake_core::Fabric;
 use clothbake_loader::{Metadata, Table};
 use std::collections::BTreeMap;
@@ -166,7 +167,7 @@ pub fn merge(parts: &[(PathBuf, Part)]) -> Result<Table, PartError> {
             ));
         }
     }
-    let mut rows: Vec<Row> = vec![Vec::new(); orbits.rows()];
+    let all = Assembly::new(&orbits, 0..orbits.rows());
     for index in 0..count {
         let id = ShardId { index, count };
         let expect = shard_rows(&orbits, id);
@@ -195,9 +196,9 @@ pub fn merge(parts: &[(PathBuf, Part)]) -> Result<Table, PartError> {
             ));
         }
         for (&r, vals) in &part.rows {
-            rows[r] = vals.clone();
+            all.put(r, vals);
         }
     }
-    Table::new(first.meta.clone(), orbits.assemble(&rows))
+    Table::new(first.meta.clone(), all.into_values())
         .map_err(|m| e(p0, m.to_string(), "bake the shards again"))
 }

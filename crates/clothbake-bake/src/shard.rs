@@ -15,7 +15,7 @@
 
 use crate::settings::Naming;
 use crate::sweep::{row_cell, Orbits, Row};
-use clothbake_loader::container::{read_container, write_container_chunks, ContainerKind};
+use clothbake_loader::container::{read_container, write_container_counted, ContainerKind};
 use clothbake_loader::{Grid, Metadata, TableError};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -263,18 +263,56 @@ fn ranges(rows: impl Iterator<Item = usize>) -> Vec<[usize; 2]> {
 /// Writes `part` to `path` atomically (temp file, fsync, rename) as a container file of kind
 /// `shard` or `checkpoint`, refusing an existing file unless `overwrite`.
 pub fn write_part(path: &Path, part: &Part, overwrite: bool) -> Result<(), TableError> {
+    let rows: Vec<usize> = part.rows.keys().copied().collect();
+    let count: usize = part.rows.values().map(|r| 3 * r.len()).sum();
+    let chunks = part.rows.values().map(|r| r.as_flattened());
+    write_rows(
+        path,
+        part.kind,
+        part.shard,
+        &part.meta,
+        &rows,
+        count as u64,
+        chunks,
+        overwrite,
+    )
+}
+
+/// Writes a shard or checkpoint file of `rows` (increasing) whose values, `count` in all,
+/// `chunks` gives row by row (see [`write_part`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn write_rows<I>(
+    path: &Path,
+    kind: Kind,
+    shard: Option<ShardId>,
+    meta: &Metadata,
+    rows: &[usize],
+    count: u64,
+    chunks: I,
+    overwrite: bool,
+) -> Result<(), TableError>
+where
+    I: IntoIterator,
+    I::Item: AsRef<[f32]>,
+{
     let header = Header {
-        shard: part.shard,
-        rows: ranges(part.rows.keys().copied()),
-        metadata: part.meta.clone(),
+        shard,
+        rows: ranges(rows.iter().copied()),
+        metadata: meta.clone(),
     };
     let header = serde_json::to_value(&header).map_err(|e| TableError::Unwritable {
         path: path.to_path_buf(),
-        what: container_kind(part.kind).tag().into(),
+        what: container_kind(kind).tag().into(),
         reason: format!("the header cannot be written as JSON ({e})"),
     })?;
-    let chunks = part.rows.values().map(|r| r.as_flattened());
-    write_container_chunks(path, container_kind(part.kind), &header, chunks, overwrite)
+    write_container_counted(
+        path,
+        container_kind(kind),
+        &header,
+        count,
+        chunks,
+        overwrite,
+    )
 }
 
 fn container_kind(kind: Kind) -> ContainerKind {

@@ -299,7 +299,8 @@ pub fn row_cell(g: &Grid, row: usize) -> (u32, u32) {
 #[derive(Clone, Debug)]
 pub struct Orbits {
     grid: Grid,
-    reps: Vec<(usize, usize)>,
+    /// Shared: a [`crate::assembly::Assembly`] keeps a copy of the orbits.
+    reps: Arc<[(u32, u32)]>,
     /// Canonical phi_o cells per phi_i cell.
     per_phi_i: Vec<usize>,
     /// Row entries per evaluated cell: 1, or a spatial bake's [`crate::spatial::stride`].
@@ -312,20 +313,23 @@ impl Orbits {
     /// The orbits of `syms` (usable on `g`, see [`usable_symmetries`]).
     pub fn new(g: &Grid, syms: &[Symmetry]) -> Orbits {
         let (npi, npo) = (g.n_phi_i as usize, g.n_phi_o as usize);
-        let reps: Vec<(usize, usize)> = (0..npi)
+        let reps: Vec<(u32, u32)> = (0..npi)
             .flat_map(|pi| (0..npo).map(move |po| (pi, po)))
-            .map(|(pi, po)| representative(pi, po, syms, g))
+            .map(|(pi, po)| {
+                let (ri, ro) = representative(pi, po, syms, g);
+                (ri as u32, ro as u32)
+            })
             .collect();
         let per_phi_i = (0..npi)
             .map(|pi| {
                 (0..npo)
-                    .filter(|&po| reps[pi * npo + po] == (pi, po))
+                    .filter(|&po| reps[pi * npo + po] == (pi as u32, po as u32))
                     .count()
             })
             .collect();
         Orbits {
             grid: *g,
-            reps,
+            reps: reps.into(),
             per_phi_i,
             stride: 1,
             classes: 0,
@@ -359,11 +363,28 @@ impl Orbits {
 
     /// The representative of (pi, po).
     pub fn rep(&self, pi: usize, po: usize) -> (usize, usize) {
-        self.reps[pi * self.grid.n_phi_o as usize + po]
+        let (ri, ro) = self.reps[pi * self.grid.n_phi_o as usize + po];
+        (ri as usize, ro as usize)
     }
 
     fn canonical(&self, pi: usize, po: usize) -> bool {
         self.rep(pi, po) == (pi, po)
+    }
+
+    /// Whether cell (pi, po) of every (theta_i, theta_o) is evaluated (its orbit's
+    /// representative) rather than copied.
+    pub fn is_canonical(&self, pi: usize, po: usize) -> bool {
+        self.canonical(pi, po)
+    }
+
+    /// Cells of a (theta_i, phi_i) row: n_theta_o * n_phi_o.
+    pub fn cells_per_row(&self) -> usize {
+        self.grid.n_theta_o as usize * self.grid.n_phi_o as usize
+    }
+
+    /// A spatial bake's classes (0 otherwise).
+    pub fn classes(&self) -> usize {
+        self.classes
     }
 
     /// Entries of `row`'s [`Row`]: the cells it evaluates times [`Orbits::stride`].
@@ -394,7 +415,9 @@ impl Orbits {
 
     /// The table's values (RGB interleaved, cell order) from every row's canonical values:
     /// canonical cells first, then the copies from their representatives, which may lie in
-    /// another row. `rows[r]` must hold [`Orbits::row_evaluations`]`(r)` values.
+    /// another row. `rows[r]` must hold [`Orbits::row_evaluations`]`(r)` values. The
+    /// straightforward assembly of [`bake`], which the tests hold the job's one buffer
+    /// ([`crate::assembly::Assembly`]) against.
     pub fn assemble(&self, rows: &[Row]) -> Vec<f32> {
         let g = self.grid;
         let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);

@@ -124,6 +124,26 @@ where
     I: IntoIterator<Item = &'a [f32]>,
     I::IntoIter: Clone,
 {
+    let chunks = chunks.into_iter();
+    let count: u64 = chunks.clone().map(|c| c.len() as u64).sum();
+    write_container_counted(path, kind, header, count, chunks, overwrite)
+}
+
+/// [`write_container_chunks`] with the number of values known beforehand: the chunks are
+/// iterated once, so each may be made as it is written (gathered from a larger buffer). An
+/// error (and no file) when they hold another number of values than `count`.
+pub fn write_container_counted<I>(
+    path: &Path,
+    kind: ContainerKind,
+    header: &serde_json::Value,
+    count: u64,
+    chunks: I,
+    overwrite: bool,
+) -> Result<(), TableError>
+where
+    I: IntoIterator,
+    I::Item: AsRef<[f32]>,
+{
     let unwritable = |reason: String| TableError::Unwritable {
         path: path.to_path_buf(),
         what: kind.tag().into(),
@@ -142,8 +162,6 @@ where
             header.len()
         )));
     }
-    let chunks = chunks.into_iter();
-    let count: u64 = chunks.clone().map(|c| c.len() as u64).sum();
     let mut tag = [0u8; KIND_LEN];
     tag[..kind.tag().len()].copy_from_slice(kind.tag().as_bytes());
     write_atomic_as(path, kind.tag(), overwrite, |out| {
@@ -154,8 +172,19 @@ where
         w.write_all(&(header.len() as u64).to_le_bytes())?;
         w.write_all(&count.to_le_bytes())?;
         w.write_all(&header)?;
+        let mut written = 0u64;
         for chunk in chunks {
+            let chunk = chunk.as_ref();
+            written += chunk.len() as u64;
+            if written > count {
+                break;
+            }
             w.write_f32s(chunk)?;
+        }
+        if written != count {
+            return Err(std::io::Error::other(format!(
+                "{written} values were given for a count of {count} (a bug in the caller)"
+            )));
         }
         w.finish()
     })

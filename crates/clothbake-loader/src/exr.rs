@@ -93,49 +93,11 @@ const EXR_DEEP: u32 = 0x800;
 /// library writes them) so the same table always gives the same bytes. Reordering attributes
 /// keeps the header's length, so the offset table after it stays valid.
 fn sort_exr_attributes(bytes: &mut [u8]) -> bool {
-    if bytes.len() < 8 || bytes[..4] != EXR_MAGIC {
+    let Some((attrs, header_end)) = header_attributes(bytes) else {
         return false;
-    }
-    let flags = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
-    if flags & (EXR_MULTIPART | EXR_DEEP) != 0 {
-        return false;
-    }
+    };
     let start = 8;
-    let mut pos = start;
-    let mut attrs: Vec<(usize, usize, usize)> = Vec::new(); // (start, name end, end)
-    let cstr_end = |from: usize| bytes[from..].iter().position(|&b| b == 0).map(|i| from + i);
-    loop {
-        let Some(name_end) = cstr_end(pos) else {
-            return false;
-        };
-        if name_end == pos {
-            break; // the empty name that ends the header
-        }
-        let Some(type_end) = cstr_end(name_end + 1) else {
-            return false;
-        };
-        let size_at = type_end + 1;
-        if size_at + 4 > bytes.len() {
-            return false;
-        }
-        let size = i32::from_le_bytes([
-            bytes[size_at],
-            bytes[size_at + 1],
-            bytes[size_at + 2],
-            bytes[size_at + 3],
-        ]);
-        let Ok(size) = usize::try_from(size) else {
-            return false;
-        };
-        let end = size_at + 4 + size;
-        if end > bytes.len() {
-            return false;
-        }
-        attrs.push((pos, name_end, end));
-        pos = end;
-    }
-    let header_end = pos;
-    let mut sorted: Vec<&(usize, usize, usize)> = attrs.iter().collect();
+    let mut sorted: Vec<&AttributeSpan> = attrs.iter().collect();
     sorted.sort_by(|a, b| bytes[a.0..a.1].cmp(&bytes[b.0..b.1]));
     let mut out = Vec::with_capacity(header_end - start);
     for &&(s, _, e) in &sorted {
@@ -143,6 +105,102 @@ fn sort_exr_attributes(bytes: &mut [u8]) -> bool {
     }
     bytes[start..header_end].copy_from_slice(&out);
     true
+}
+
+/// Where an EXR header attribute lies: its start, the end of its name, its end.
+type AttributeSpan = (usize, usize, usize);
+
+/// The attributes of a single-part EXR header at the start of `bytes` and the offset of the
+/// header's terminating zero byte; `None` when `bytes` holds no complete, well-formed
+/// single-part header.
+fn header_attributes(bytes: &[u8]) -> Option<(Vec<AttributeSpan>, usize)> {
+    if bytes.len() < 8 || bytes[..4] != EXR_MAGIC {
+        return None;
+    }
+    let flags = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
+    if flags & (EXR_MULTIPART | EXR_DEEP) != 0 {
+        return None;
+    }
+    let mut pos = 8;
+    let mut attrs: Vec<AttributeSpan> = Vec::new();
+    let cstr_end = |from: usize| {
+        bytes
+            .get(from..)?
+            .iter()
+            .position(|&b| b == 0)
+            .map(|i| from + i)
+    };
+    loop {
+        let name_end = cstr_end(pos)?;
+        if name_end == pos {
+            return Some((attrs, pos)); // the empty name that ends the header
+        }
+        let type_end = cstr_end(name_end + 1)?;
+        let size_at = type_end + 1;
+        let size = bytes.get(size_at..size_at + 4)?;
+        let size = i32::from_le_bytes([size[0], size[1], size[2], size[3]]);
+        let end = size_at + 4 + usize::try_from(size).ok()?;
+        if end > bytes.len() {
+            return None;
+        }
+        attrs.push((pos, name_end, end));
+        pos = end;
+    }
+}
+
+/// A writer that holds back what is written until it holds a whole EXR header, sorts that
+/// header's attributes ([`sort_exr_attributes`]) and from then on passes everything through:
+/// the encoder streams its blocks to the file, and the file's bytes are reproducible.
+struct SortedHeader<W: Write + io::Seek> {
+    inner: W,
+    /// The bytes written before the header was complete (`None` once passed on).
+    pending: Option<Vec<u8>>,
+}
+
+impl<W: Write + io::Seek> SortedHeader<W> {
+    fn new(inner: W) -> Self {
+        SortedHeader {
+            inner,
+            pending: Some(Vec::new()),
+        }
+    }
+
+    /// Passes the held bytes on, sorted when they hold a whole header.
+    fn release(&mut self) -> io::Result<()> {
+        if let Some(mut held) = self.pending.take() {
+            sort_exr_attributes(&mut held);
+            self.inner.write_all(&held)?;
+        }
+        Ok(())
+    }
+}
+
+impl<W: Write + io::Seek> Write for SortedHeader<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        match &mut self.pending {
+            None => self.inner.write(buf),
+            Some(held) => {
+                held.extend_from_slice(buf);
+                // The header ends with a zero byte: only then can it be whole.
+                if buf.contains(&0) && header_attributes(held).is_some() {
+                    self.release()?;
+                }
+                Ok(buf.len())
+            }
+        }
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.release()?;
+        self.inner.flush()
+    }
+}
+
+impl<W: Write + io::Seek> io::Seek for SortedHeader<W> {
+    fn seek(&mut self, pos: io::SeekFrom) -> io::Result<u64> {
+        self.release()?;
+        self.inner.seek(pos)
+    }
 }
 
 #[cfg(test)]
@@ -162,6 +220,11 @@ mod sort_tests {
 
 mod exr_io {
     use super::*;
+    use exr::block::lines::LineRefMut;
+    use exr::image::write::samples::{SamplesWriter, WritableSamples};
+    use exr::math::RoundingMode;
+    use exr::meta::attribute::{LevelMode, SampleType};
+    use exr::meta::header::Header;
     use exr::prelude::{
         AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image, Layer,
         LayerAttributes, ReadChannels, ReadLayers, SmallVec, Text, WritableImage,
@@ -194,23 +257,6 @@ mod exr_io {
         let (width, height) = (width as usize, height as usize);
 
         let names = channel_names(table.meta.spatial.as_ref().map_or(0, |s| s.classes));
-        let n = grid.len();
-        // Channel ch, row-major over the 2-D layout.
-        let plane = |ch: usize| -> Vec<f32> {
-            let mut out = Vec::with_capacity(width * height);
-            for ti in 0..grid.n_theta_i {
-                for to in 0..grid.n_theta_o {
-                    for pi in 0..grid.n_phi_i {
-                        for po in 0..grid.n_phi_o {
-                            let c = grid.index(ti, pi, to, po);
-                            out.push(table.values[value_index(ch, c, n)]);
-                        }
-                    }
-                }
-            }
-            out
-        };
-        let planes: Vec<Vec<f32>> = (0..names.len()).map(plane).collect();
         if precision == Precision::F16 {
             let max = half::f16::MAX.to_f32();
             if let Some(v) = table.values.iter().find(|v| v.abs() > max) {
@@ -219,27 +265,26 @@ mod exr_io {
                 )));
             }
         }
-        let stored = |p: &[f32]| -> Vec<f32> {
-            match precision {
-                Precision::F32 => p.to_vec(),
-                Precision::F16 => p.iter().map(|&v| half::f16::from_f32(v).to_f32()).collect(),
-            }
-        };
+        // The channels read the table's values where they lie, line by line, as the encoder
+        // asks for them: no copy of the table.
+        let planes: Vec<PlaneView<'_>> = (0..names.len())
+            .map(|ch| PlaneView {
+                values: &table.values,
+                grid,
+                ch,
+                precision,
+            })
+            .collect();
         let meta_json = table.meta.to_ascii_json();
-        let kept: Vec<Vec<f32>> = planes.iter().map(|p| stored(p)).collect();
-        let crc = planes_crc(
+        let crc = values_crc(
             meta_json.as_bytes(),
-            &kept.iter().map(|p| Plane::F32(p)).collect::<Vec<_>>(),
+            width * height,
+            names.len(),
+            |ch, i| planes[ch].stored(i),
         );
-        let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+        let mut channels: SmallVec<[AnyChannel<PlaneView<'_>>; 4]> = SmallVec::new();
         for (name, p) in names.iter().zip(planes) {
-            let samples = match precision {
-                Precision::F32 => FlatSamples::F32(p),
-                Precision::F16 => {
-                    FlatSamples::F16(p.into_iter().map(half::f16::from_f32).collect())
-                }
-            };
-            channels.push(AnyChannel::new(name.as_str(), samples));
+            channels.push(AnyChannel::new(name.as_str(), p));
         }
 
         let mut attributes = LayerAttributes {
@@ -270,14 +315,80 @@ mod exr_io {
             AnyChannels::sort(channels),
         );
         let image = Image::from_layer(layer);
-        let mut bytes = Vec::new();
-        image
-            .write()
-            .non_parallel()
-            .to_buffered(Cursor::new(&mut bytes))
-            .map_err(|e| unwritable(format!("OpenEXR encoder: {e}")))?;
-        sort_exr_attributes(&mut bytes);
-        write_atomic_as(path, "table", overwrite, |out| out.write_all(&bytes))
+        // Block by block into the file (the encoder seeks back for its offset table).
+        write_atomic_as(path, "table", overwrite, |out| {
+            let mut w = SortedHeader::new(out);
+            image
+                .write()
+                .non_parallel()
+                .to_buffered(&mut w)
+                .map_err(|e| match e {
+                    exr::error::Error::Io(io) => io,
+                    e => io::Error::other(format!("OpenEXR encoder: {e}")),
+                })?;
+            w.flush()
+        })
+    }
+
+    /// One channel of a table's values as the encoder sees it: pixel `i` of the row-major
+    /// image (see [`write_exr`]) read from the interleaved values, rounded to `precision`.
+    #[derive(Clone, Copy)]
+    struct PlaneView<'a> {
+        values: &'a [f32],
+        grid: Grid,
+        ch: usize,
+        precision: Precision,
+    }
+
+    impl PlaneView<'_> {
+        /// The value of pixel `(x, y)`.
+        fn at(&self, x: usize, y: usize) -> f32 {
+            let g = &self.grid;
+            let (npo, nto) = (g.n_phi_o as usize, g.n_theta_o as usize);
+            let (ti, to, pi, po) = (y / nto, y % nto, x / npo, x % npo);
+            let c = ((ti * g.n_phi_i as usize + pi) * nto + to) * npo + po;
+            self.values[value_index(self.ch, c, g.len())]
+        }
+
+        /// The value of pixel `i` as stored (rounded to the precision), widened to f32.
+        fn stored(&self, i: usize) -> f32 {
+            let w = self.grid.exr_width() as usize;
+            let v = self.at(i % w, i / w);
+            match self.precision {
+                Precision::F32 => v,
+                Precision::F16 => half::f16::from_f32(v).to_f32(),
+            }
+        }
+    }
+
+    impl<'a> WritableSamples<'_> for PlaneView<'a> {
+        fn sample_type(&self) -> SampleType {
+            match self.precision {
+                Precision::F16 => SampleType::F16,
+                Precision::F32 => SampleType::F32,
+            }
+        }
+
+        fn infer_level_modes(&self) -> (LevelMode, RoundingMode) {
+            (LevelMode::Singular, RoundingMode::Down)
+        }
+
+        type Writer = PlaneView<'a>;
+
+        fn create_samples_writer(&self, _: &Header) -> Self::Writer {
+            *self
+        }
+    }
+
+    impl SamplesWriter for PlaneView<'_> {
+        fn extract_line(&self, line: LineRefMut<'_>) {
+            let (x0, y) = (line.location.position.x(), line.location.position.y());
+            match self.precision {
+                Precision::F32 => line.write_samples(|i| self.at(x0 + i, y)),
+                Precision::F16 => line.write_samples(|i| half::f16::from_f32(self.at(x0 + i, y))),
+            }
+            .expect("a line's bytes have the line's length");
+        }
     }
 
     /// Maps an exr error; a file that ends early is reported as truncated.
@@ -519,7 +630,10 @@ mod exr_io {
                 )));
             };
             if let Some(stored) = attrs.get(&Text::from(ATTR_CRC32)).and_then(attribute_text) {
-                let computed = planes_crc(&meta_json_bytes, &planes);
+                let computed =
+                    values_crc(&meta_json_bytes, planes[0].len(), planes.len(), |ch, i| {
+                        planes[ch].get(i)
+                    });
                 if u32::from_str_radix(stored.trim(), 16).ok() != Some(computed) {
                     return Err(TableError::Checksum {
                         path: path.to_path_buf(),
@@ -588,19 +702,23 @@ mod exr_io {
         }
     }
 
-    /// The [`ATTR_CRC32`] checksum of a metadata text and the row-major planes (in
-    /// [`channel_names`] order), pixel by pixel, widened to f32 chunk by chunk (no full f32
-    /// copy).
-    fn planes_crc(meta_json: &[u8], planes: &[Plane<'_>]) -> u32 {
+    /// The [`ATTR_CRC32`] checksum of a metadata text and `pixels` pixels of `channels`
+    /// row-major planes (in [`channel_names`] order), pixel by pixel, sample `(ch, i)` widened
+    /// to f32 by `sample`, chunk by chunk (no full copy).
+    fn values_crc(
+        meta_json: &[u8],
+        pixels: usize,
+        channels: usize,
+        sample: impl Fn(usize, usize) -> f32,
+    ) -> u32 {
         let mut hasher = crc32fast::Hasher::new();
         hasher.update(meta_json);
-        let mut bytes = Vec::with_capacity(CHUNK_VALUES * 4 * planes.len());
-        let n = planes[0].len();
-        for start in (0..n).step_by(CHUNK_VALUES) {
+        let mut bytes = Vec::with_capacity(CHUNK_VALUES * 4 * channels);
+        for start in (0..pixels).step_by(CHUNK_VALUES) {
             bytes.clear();
-            for i in start..n.min(start + CHUNK_VALUES) {
-                for p in planes {
-                    bytes.extend_from_slice(&p.get(i).to_le_bytes());
+            for i in start..pixels.min(start + CHUNK_VALUES) {
+                for ch in 0..channels {
+                    bytes.extend_from_slice(&sample(ch, i).to_le_bytes());
                 }
             }
             hasher.update(&bytes);

@@ -31,8 +31,8 @@ pub use atomic::{check_target, write_atomic_as};
 pub use binary::{read_binary, write_binary};
 pub use clothbake_bsdf::{Bsdf, BsdfSample, UnitVec3};
 pub use container::{
-    read_container, write_container, write_container_chunks, Container, ContainerKind,
-    BINARY_MAGIC, CONTAINER_VERSION,
+    read_container, write_container, write_container_chunks, write_container_counted, Container,
+    ContainerKind, BINARY_MAGIC, CONTAINER_VERSION,
 };
 pub use error::TableError;
 pub use exr::{read_exr, read_exr_stored, write_exr, EXR_MAGIC};

@@ -447,7 +447,7 @@ fn a_grid_that_does_not_fit_in_memory_is_refused_up_front() {
                 "--shard K/N",
             ],
         );
-        // The estimate is at least the values twice over.
+        // The estimate is at least the values.
         let need: f64 = e
             .split("needs about ")
             .nth(1)
