@@ -15,7 +15,7 @@
 use std::arch::x86_64::*;
 
 use crate::angles::HORIZON_COS;
-use crate::nodes::{next_column, Lane, Nodes, SpanLanes};
+use crate::nodes::{column_offset, next_column, Lane, Nodes, SpanLanes};
 
 /// True when this processor runs the kernel.
 pub(crate) fn available() -> bool {
@@ -209,7 +209,7 @@ unsafe fn corner(nodes: &Nodes, pos: __m128) -> Corner {
     let [s_ti, s_pi, s_to] = nodes.strides;
     let mut l = [0i32; 4];
     _mm_storeu_si128(l.as_mut_ptr() as *mut __m128i, lo); // 4 i32, unaligned
-    let common = l[0] as usize * s_ti + l[2] as usize * s_to + 4 * l[3] as usize;
+    let common = l[0] as usize * s_ti + l[2] as usize * s_to + column_offset(l[3] as usize);
     let base = [
         common + l[1] as usize * s_pi,
         common + next_column(l[1] as u32, n[1]) as usize * s_pi,
@@ -507,7 +507,8 @@ mod tests {
             n_theta_o: 90,
             n_phi_o: 360,
         };
-        let nodes = Nodes::new(&g, &|_, _, _, _| [1.0; 3], false);
+        // The positions need the lookup's constants only.
+        let nodes = Nodes::empty(&g);
         let n = [g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o];
         // A grid over the hemisphere (and lengths other than 1: only directions matter),
         // with the axes, the pole and the horizon.

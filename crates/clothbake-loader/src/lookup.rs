@@ -18,8 +18,9 @@
 //!
 //! The pole nodes are precomputed at load time: the values are stored in a padded copy with
 //! one extra polar row (the pole) on each polar axis, 4 lanes a node and a copied wrap column
-//! on the `phi_o` axis (`crate::nodes`), so every lookup is the same branch-free gather of 8
-//! runs of two adjacent nodes. The code is chosen once per [`Brdf`] ([`SimdPath`]): AVX2 + FMA +
+//! on the `phi_o` axis, in overlapping tiles of one cache line (`crate::nodes`), so every
+//! lookup is the same branch-free gather of 8 runs of two adjacent nodes, from 4 cache lines
+//! (f16). The code is chosen once per [`Brdf`] ([`SimdPath`]): AVX2 + FMA +
 //! F16C when the processor has them, else portable Rust.
 
 use std::fmt;
