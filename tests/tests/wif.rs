@@ -64,23 +64,36 @@ fn denim_is_the_warp_faced_3_1_twill() {
     }
     // Published sRGB decodings: 240 -> 0.8714, 110 -> 0.1559.
     assert!((white[0] - 0.8714).abs() < 1e-4 && (indigo[2] - 0.1559).abs() < 1e-4);
-    // Spacing 0.031 cm and thickness 0.030 cm: 0.31 mm centre to centre, radius 0.15 mm.
-    for g in [&f.warp(), &f.weft()] {
+    // Warp Spacing 0.03528 cm, Thickness 0.0343 cm: 0.3528 mm centre to centre, radius
+    // 0.1715 mm; weft 0.04536 and 0.0287 cm: 0.4536 mm, radius 0.1435 mm.
+    for (g, s, r) in [(f.warp(), 0.3528, 0.1715), (f.weft(), 0.4536, 0.1435)] {
         for y in &g.threads {
-            assert!(close(y.spacing, 0.31) && close(y.radius, 0.15), "{y:?}");
+            assert!(close(y.spacing, s) && close(y.radius, r), "{y:?}");
             assert_eq!(y.albedo, None);
         }
+        // [PRIVATE CLOTHBAKE MATERIAL]: Specular=0.04, Exponent=6 for both groups.
+        assert_eq!((g.material.specular, g.material.exponent), (0.04, 6.0));
     }
 }
 
 #[test]
-fn denim_reflects_like_the_json_twill_of_the_same_proportions() {
-    // twill31.json: radius 1.5, spacing 3.1, the ratio of denim.wif's 0.15 mm and 0.31 mm; only
-    // ratios matter, so with denim's material the two give the same reflection.
+fn denim_reflects_like_the_json_twill_of_its_sizes() {
+    // twill31.json (the same point paper) given the draft's sizes in mm by hand (warp 0.3528
+    // apart, radius 0.1715; weft 0.4536, radius 0.1435) and the draft's material: the two give
+    // the same reflection.
     let wif = load("denim.wif");
     let json = load("twill31.json")
         .with_groups(
-            |g, y| y.material = wif.group(g).material,
+            |g, y| {
+                let (s, r) = match g {
+                    Group::Warp => (0.3528, 0.1715),
+                    Group::Weft => (0.4536, 0.1435),
+                };
+                for t in &mut y.threads {
+                    (t.spacing, t.radius) = (s, r);
+                }
+                y.material = wif.group(g).material;
+            },
             &clothbake_core::PlainNaming("twill31"),
         )
         .unwrap();
@@ -159,8 +172,8 @@ fn options_set_the_sizes_whether_the_draft_gives_them_or_not() {
         radius: Some(0.1),
         spacing: Some(0.25),
     };
-    // twill22.wif gives no sizes, denim.wif gives both (0.15 mm radius at 0.31 mm): the
-    // options win in both.
+    // twill22.wif gives no sizes, denim.wif gives both (e.g. the warp's 0.1715 mm radius at
+    // 0.3528 mm): the options win in both.
     for name in ["twill22.wif", "denim.wif"] {
         let text = std::fs::read_to_string(tables().join(name)).unwrap();
         let f = parse(&text, name, &o).unwrap();
@@ -179,15 +192,17 @@ fn options_set_the_sizes_whether_the_draft_gives_them_or_not() {
         spacing: None,
     };
     let f = parse(&text, "denim.wif", &o).unwrap();
-    assert!(close(f.warp().threads[0].radius, 0.1) && close(f.warp().threads[0].spacing, 0.31));
-    // A radius over half the spacing packs the yarns as a draft's thickness would.
+    assert!(close(f.warp().threads[0].radius, 0.1) && close(f.warp().threads[0].spacing, 0.3528));
+    // A radius over half the spacing packs the yarns as a draft's thickness would: the warp's
+    // to half its 0.3528 mm; the weft's 0.4536 mm leaves room for 0.2.
     let o = WifOptions {
         radius: Some(0.2),
         spacing: None,
     };
     let f = parse(&text, "denim.wif", &o).unwrap();
+    assert!(close(f.weft().threads[0].radius, 0.2));
     assert!(
-        close(f.warp().threads[0].radius, 0.155),
+        close(f.warp().threads[0].radius, 0.1764),
         "{:?}",
         f.warp().threads[0]
     );

@@ -17,6 +17,11 @@
 //!   across the swatch (`render --periods 16`, right); tables baked with `--spatial` on a
 //!   16 x 32 x 16 x 32 grid, direct reflection.
 //!
+//! * `plot-slices.png`, `plot-hemisphere.png`, `plot-polar.png` (`plots`): `clothbake plot`'s
+//!   three kinds with the model: the twill's slices (the defaults: theta_i 0, 30, 60, 75 in the
+//!   planes phi_i 0, 45, 90), its hemisphere map for wi (40, 90), and the silk charmeuse's polar
+//!   plot for wi (45, 90) at theta_o 20, 45, 70.
+//!
 //! All but `up-close.png` are rendered with the model directly (`clothbake render --weave`: exact, no table
 //! interpolation; the direct-reflection scenes would render as fast from a table). Tone mapping: clamp + sRGB, one exposure per
 //! figure (Fig. 4.5 and 5.17 share exposure 1, V itself, so the inter-reflection's brightening shows;
@@ -193,7 +198,65 @@ fn up_close(root: &Path, dir: &Path, width: u32, height: u32) {
     eprintln!("up-close: {:.1} s", start.elapsed().as_secs_f64());
 }
 
-/// Renders the figures named in `only` (`fig4-5`, `disks` for figs 5.10-5.11, `fig5-17`), or
+/// `clothbake plot`'s three kinds, drawn with the model.
+fn plots(root: &Path, dir: &Path) {
+    use clothbake_render::plot::{self, Plot, Source};
+    let start = Instant::now();
+    let model = |file: &str| {
+        let f = Fabric::from_path(&root.join("tables").join(file)).unwrap();
+        let s = Shader::model(
+            &f,
+            FacetModel::Huo,
+            Variant::Refined,
+            None,
+            Component::Total,
+        );
+        s.unwrap()
+    };
+    let (twill, silk) = (model("twill.json"), model("silk-charmeuse.json"));
+    let named = |name: &str, shader| {
+        [Source {
+            name: format!("model {name}"),
+            shader,
+        }]
+    };
+    let figures = [
+        (
+            "plot-slices.png",
+            Plot::Slices {
+                theta_i: vec![0.0, 30.0, 60.0, 75.0],
+                phi_i: vec![0.0, 45.0, 90.0],
+            },
+            named("twill.json", &twill),
+        ),
+        (
+            "plot-hemisphere.png",
+            Plot::Hemisphere {
+                theta_i: 40.0,
+                phi_i: 90.0,
+            },
+            named("twill.json", &twill),
+        ),
+        (
+            "plot-polar.png",
+            Plot::Polar {
+                theta_i: 45.0,
+                phi_i: 90.0,
+                theta_o: vec![20.0, 45.0, 70.0],
+            },
+            named("silk-charmeuse.json", &silk),
+        ),
+    ];
+    for (name, p, sources) in &figures {
+        let path = dir.join(name);
+        plot::write(&path, p, sources, true).unwrap_or_else(|e| panic!("{e}"));
+        eprintln!("wrote {}", path.display());
+    }
+    eprintln!("plots: {:.1} s", start.elapsed().as_secs_f64());
+}
+
+/// Renders the figures named in `only` (`fig4-5`, `disks` for figs 5.10-5.11, `fig5-17`,
+/// `up-close`, `plots`), or
 /// every figure when `only` is empty, into `docs/figures/`.
 pub fn run(root: &Path, only: &[String]) {
     let dir = root.join("docs/figures");
@@ -210,5 +273,8 @@ pub fn run(root: &Path, only: &[String]) {
     }
     if wanted("up-close") {
         up_close(root, &dir, 480, 270);
+    }
+    if wanted("plots") {
+        plots(root, &dir);
     }
 }

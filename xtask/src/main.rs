@@ -9,8 +9,8 @@
 //! * `transport`: full light transport (every bounce, path-traced on the micro-geometry): the
 //!   perpendicular share of I_2 and the orders past the second per shipped fabric, the furnace
 //!   test and the orders at n = 1, into `docs/transport.md` (between its `transport` markers).
-//! * `figures`: the thesis's rendered scenes (Figs 4.5, 5.10, 5.11, 5.17) and the weave up
-//!   close (`up-close`) into `docs/figures/`.
+//! * `figures`: the thesis's rendered scenes (Figs 4.5, 5.10, 5.11, 5.17), the weave up
+//!   close (`up-close`) and `clothbake plot`'s three kinds (`plots`) into `docs/figures/`.
 //! * `validate-spatial`: the model per crossing cell against the truth sorted into the same
 //!   cells, written to `docs/validation-spatial.md`.
 //! * `validate`: holds the analytic model against the ray-traced ground truth for every shipped
@@ -70,7 +70,7 @@ fn main() {
         "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
+                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
             );
             std::process::exit(2);
         }

@@ -779,8 +779,11 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
             Ok((1.0, "mm".to_string()))
         }
     };
-    let (warp, warp_note) = group("WARP", &warp[..px], &unit("WARP")?);
-    let (weft, weft_note) = group("WEFT", &weft[..py], &unit("WEFT")?);
+    let facets = facet_material(&d)?;
+    let (mut warp, warp_note) = group("WARP", &warp[..px], &unit("WARP")?);
+    let (mut weft, weft_note) = group("WEFT", &weft[..py], &unit("WEFT")?);
+    facets.apply("WARP", &mut warp.material);
+    facets.apply("WEFT", &mut weft.material);
     let fabric = Fabric::new(name, weave, warp, weft, &WifNaming(file)).map_err(|e| WifError {
         file: e.file,
         section: String::new(),
@@ -789,6 +792,83 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
         fix: e.fix,
     })?;
     Ok(fabric.with_notes(warp_note.into_iter().chain(weft_note).collect()))
+}
+
+/// The private section a draft may carry its facet material in (docs/wif.md): WIF has no
+/// field for rho_s and n, and other programs ignore `PRIVATE` sections.
+pub const MATERIAL_SECTION: &str = "PRIVATE CLOTHBAKE MATERIAL";
+
+/// The keys of [`MATERIAL_SECTION`]: both groups, then the warp, then the weft (a group's own
+/// key wins over the key for both).
+const MATERIAL_KEYS: [&str; 6] = [
+    "Specular",
+    "Exponent",
+    "Warp Specular",
+    "Warp Exponent",
+    "Weft Specular",
+    "Weft Exponent",
+];
+
+/// What a draft's [`MATERIAL_SECTION`] gives, in [`MATERIAL_KEYS`] order.
+#[derive(Default)]
+struct FacetMaterial([Option<f64>; 6]);
+
+impl FacetMaterial {
+    /// Sets rho_s and n of group `g` (`WARP`, `WEFT`) where the section gives them.
+    fn apply(&self, g: &str, m: &mut Material) {
+        let own = if g == "WARP" { 2 } else { 4 };
+        if let Some(x) = self.0[own].or(self.0[0]) {
+            m.specular = x;
+        }
+        if let Some(x) = self.0[own + 1].or(self.0[1]) {
+            m.exponent = x;
+        }
+    }
+}
+
+/// Reads [`MATERIAL_SECTION`]: rho_s in [0, 1], n >= 0, no other key (a misspelt key would
+/// otherwise be silently ignored).
+fn facet_material(d: &Draft<'_>) -> Result<FacetMaterial, WifError> {
+    let mut out = FacetMaterial::default();
+    let Some(s) = d.section(MATERIAL_SECTION) else {
+        return Ok(out);
+    };
+    for e in &s.entries {
+        let Some(k) = MATERIAL_KEYS
+            .iter()
+            .position(|k| k.eq_ignore_ascii_case(e.key.trim()))
+        else {
+            return Err(d.err(
+                MATERIAL_SECTION,
+                Some(e.line),
+                format!("key `{}` is not one clothbake reads", clip(&e.key)),
+                format!("use {} (docs/wif.md)", MATERIAL_KEYS.join(", ")),
+            ));
+        };
+        let x = bare(&e.value).parse::<f64>().ok().filter(|x| x.is_finite());
+        let (ok, what, fix) = if k % 2 == 0 {
+            (
+                x.filter(|x| (0.0..=1.0).contains(x)),
+                "outside [0, 1]",
+                "give the specular coefficient rho_s between 0 and 1, e.g. 0.05",
+            )
+        } else {
+            (
+                x.filter(|x| *x >= 0.0),
+                "not a number >= 0",
+                "give a non-negative specular exponent n, e.g. 10",
+            )
+        };
+        out.0[k] = Some(ok.ok_or_else(|| {
+            d.err(
+                MATERIAL_SECTION,
+                Some(e.line),
+                format!("{} is {what}", e.shown()),
+                fix,
+            )
+        })?);
+    }
+    Ok(out)
 }
 
 /// Names a draft's fields by the WIF section and key they come from.
@@ -1233,6 +1313,85 @@ mod tests {
 
         let e = parse("[DRAFT]\n1=1\n", "x.wif", &WifOptions::default()).unwrap_err();
         assert!(e.problem.contains("no [WIF] section"), "{e}");
+    }
+
+    #[test]
+    fn the_private_section_sets_the_facet_material() {
+        let ok = |section: &str| {
+            parse(
+                &draft(&format!("{PLAIN}{section}")),
+                "t.wif",
+                &WifOptions::default(),
+            )
+            .unwrap()
+        };
+        // Absent: the thesis's rho_s 0.3 and n 10 for both groups.
+        let f = ok("");
+        assert_eq!(
+            (f.warp().material.specular, f.weft().material.exponent),
+            (0.3, 10.0)
+        );
+        // Both groups, then one group's own key winning; keys case-insensitive.
+        let f = ok("[PRIVATE CLOTHBAKE MATERIAL]
+Specular=0.05
+exponent=4 ; broad
+Weft Specular=0.5
+");
+        let (w, f_) = (f.warp().material, f.weft().material);
+        assert_eq!(
+            (w.specular, w.exponent, f_.specular, f_.exponent),
+            (0.05, 4.0, 0.5, 4.0)
+        );
+        // The albedo stays the colours' (none here: the default).
+        assert_eq!(w.albedo, Material::default().albedo);
+        // Switched off in [CONTENTS]: ignored. Another program's private section: ignored.
+        let f = ok("[PRIVATE CLOTHBAKE MATERIAL]
+Specular=0.05
+[PRIVATE OTHER]
+Specular=x
+");
+        assert_eq!(f.warp().material.specular, 0.05);
+        let body = format!(
+            "[CONTENTS]
+PRIVATE CLOTHBAKE MATERIAL=false
+{PLAIN}[PRIVATE CLOTHBAKE MATERIAL]
+Specular=0.05
+"
+        );
+        let f = parse(&draft(&body), "t.wif", &WifOptions::default()).unwrap();
+        assert_eq!(f.warp().material.specular, 0.3);
+    }
+
+    #[test]
+    fn the_private_section_refuses_what_it_cannot_use() {
+        // [PRIVATE CLOTHBAKE MATERIAL] is line 19 of the draft, its first key line 20.
+        let at = |key: &str| {
+            err(&format!(
+                "{PLAIN}[PRIVATE CLOTHBAKE MATERIAL]
+{key}
+"
+            ))
+        };
+        let e = at("Specular=1.5");
+        assert_eq!(
+            e.to_string(),
+            "t.wif: [PRIVATE CLOTHBAKE MATERIAL] line 20: Specular=1.5 is outside [0, 1]; \
+             give the specular coefficient rho_s between 0 and 1, e.g. 0.05"
+        );
+        for bad in ["Warp Specular=-0.1", "Specular=nan", "Specular="] {
+            assert!(at(bad).problem.contains("is outside [0, 1]"), "{bad}");
+        }
+        for bad in ["Exponent=-1", "Weft Exponent=inf", "Exponent=ten"] {
+            assert!(at(bad).problem.contains("is not a number >= 0"), "{bad}");
+        }
+        let e = at("Specularity=0.1");
+        assert_eq!(e.line, Some(20));
+        assert!(
+            e.problem
+                .contains("key `Specularity` is not one clothbake reads"),
+            "{e}"
+        );
+        assert!(e.fix.contains("Warp Specular"), "{e}");
     }
 
     #[test]

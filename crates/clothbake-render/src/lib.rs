@@ -11,6 +11,7 @@ pub mod plot;
 pub mod scene;
 pub mod shade;
 pub mod tonemap;
+pub mod typeset;
 
 use camera::Camera;
 use clothbake_core::Footprint;

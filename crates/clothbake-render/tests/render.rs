@@ -379,6 +379,14 @@ fn plots_draw_text_axes_and_both_sources() {
             },
             "hemi",
         ),
+        (
+            Plot::Polar {
+                theta_i: 45.0,
+                phi_i: 90.0,
+                theta_o: vec![20.0, 60.0],
+            },
+            "polar",
+        ),
     ] {
         let svg = temp(&format!("plot-{name}.svg"));
         let png_path = temp(&format!("plot-{name}.png"));
@@ -406,6 +414,19 @@ fn plots_draw_text_axes_and_both_sources() {
             "{name}: dark {dark}, colour {colour}"
         );
     }
+    // The polar curve's values are the BRDF at (theta_o, phi_o).
+    let c = plot::azimuth_curve(&sa, 45.0, 90.0, 60.0);
+    assert_eq!(c.len(), 360);
+    let wi = UnitVec3::from_degrees(45.0, 90.0);
+    for &(p, v) in c.iter().step_by(37) {
+        assert!((v - mean3(sa.f_r(wi, UnitVec3::from_degrees(60.0, p)))).abs() < 1e-6);
+    }
+    // The twill's f_r depends on the outgoing azimuth (the anisotropy the plot shows): its
+    // polar curve is not a circle.
+    let (lo, hi) = c
+        .iter()
+        .fold((f64::MAX, 0f64), |(l, h), &(_, v)| (l.min(v), h.max(v)));
+    assert!(hi > 1.1 * lo, "{lo} {hi}");
     assert!(plot::write(
         &temp("plot.jpg"),
         &Plot::Hemisphere {

@@ -1154,6 +1154,8 @@ pub enum PlotKind {
     Slices,
     /// f_r over the outgoing hemisphere for one wi.
     Hemisphere,
+    /// The anisotropy: f_r against the outgoing azimuth, one curve per theta_o, for one wi.
+    Polar,
 }
 
 /// `clothbake plot`.
@@ -1163,7 +1165,8 @@ pub enum PlotKind {
                   compared in one plot (the second dashed, or beside the first). Values: f_r in 1/sr, \
                   mean of R, G, B. Slices: x is theta_o in the plane of incidence, negative on the \
                   light's side (phi_o = phi_i), positive on the mirror side (phi_o = phi_i + 180). \
-                  Hemisphere: x = theta_o cos phi_o, y = theta_o sin phi_o (degrees). See docs/render.md."
+                  Hemisphere: x = theta_o cos phi_o, y = theta_o sin phi_o (degrees). Polar: radius f_r, \
+                  angle phi_o, one curve per --theta-o. See docs/render.md."
 )]
 pub struct PlotArgs {
     /// The BRDFs: --weave FILE and/or --table FILE, two sources at most.
@@ -1182,7 +1185,11 @@ pub struct PlotArgs {
     #[arg(long, value_name = "LIST", value_parser = parse_angle_list, value_delimiter = ',', allow_hyphen_values = true, default_value = "0,45,90")]
     pub phi_i: Vec<f64>,
 
-    /// Hemisphere: the direction toward the light, THETA,PHI in degrees.
+    /// Polar: outgoing polar angles, degrees (one curve each).
+    #[arg(long, value_name = "LIST", value_parser = parse_theta_list, value_delimiter = ',', default_value = "20,45,70")]
+    pub theta_o: Vec<f64>,
+
+    /// Hemisphere and polar: the direction toward the light, THETA,PHI in degrees.
     #[arg(long, value_name = "THETA,PHI", value_parser = parse_direction, allow_hyphen_values = true, default_value = "45,0")]
     pub wi: Direction,
 

@@ -28,7 +28,7 @@ macro_rules! shipped {
 }
 
 /// Every fabric file of `tables/` (a test checks the folder holds no other).
-pub const SHIPPED: [Shipped; 9] = shipped![
+pub const SHIPPED: [Shipped; 13] = shipped![
     "plain.json",
     "basket.json",
     "twill.json",
@@ -38,6 +38,10 @@ pub const SHIPPED: [Shipped; 9] = shipped![
     "denim.wif",
     "gingham.wif",
     "twill22.wif",
+    "cotton-poplin.json",
+    "wool-twill.json",
+    "silk-charmeuse.json",
+    "polyester-taffeta.json",
 ];
 
 impl Shipped {

@@ -288,16 +288,24 @@ pub fn run_plot(a: &PlotArgs) -> Result<String, CliError> {
             theta_i: a.theta_i.clone(),
             phi_i: a.phi_i.clone(),
         },
-        PlotKind::Hemisphere => {
+        PlotKind::Hemisphere | PlotKind::Polar => {
             if !a.wi.above_horizon() {
                 return Err(CliError::new(
                     "--wi is at the horizon, where nothing is lit",
                     "give theta below 90, e.g. --wi 45,0",
                 ));
             }
-            Plot::Hemisphere {
-                theta_i: a.wi.theta,
-                phi_i: a.wi.phi,
+            if a.kind == PlotKind::Hemisphere {
+                Plot::Hemisphere {
+                    theta_i: a.wi.theta,
+                    phi_i: a.wi.phi,
+                }
+            } else {
+                Plot::Polar {
+                    theta_i: a.wi.theta,
+                    phi_i: a.wi.phi,
+                    theta_o: a.theta_o.clone(),
+                }
             }
         }
     };

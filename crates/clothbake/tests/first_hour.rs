@@ -67,7 +67,7 @@ fn fabrics_lists_every_file_of_tables() {
             assert!(line.ends_with(summary.trim()), "{line} / {summary}");
         }
     }
-    assert_eq!(seen, 9, "{out}");
+    assert_eq!(seen, 13, "{out}");
     // gingham.wif writes two colour repeats of 16 threads; its period is 8 x 8 (its comment).
     let gingham = out.lines().find(|l| l.starts_with("gingham")).unwrap();
     assert!(gingham.contains("8 x 8") && gingham.contains("A red and white gingham"));

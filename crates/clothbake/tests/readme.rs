@@ -1,10 +1,13 @@
-//! The README's shell examples run in order in a fresh folder, as a new user would run them
-//! from a fresh clone: every line of every ```sh or ```bash block of README.md, with the built
-//! `clothbake` first on PATH and `tables/` of the repository beside them (read only).
+//! The shell examples of README.md and of every docs/*.md run in order in a fresh folder, as a
+//! new user would run them from a fresh clone: every line of every ```sh or ```bash block of
+//! the file, with the built `clothbake` first on PATH and `tables/` of the repository beside
+//! them (read only). One test per file, each in its own folder.
 //!
-//! Conventions of README.md that this test relies on:
+//! Conventions of the documents that this test relies on:
 //! * A block right after the line `<!-- readme-test: skip (why) -->` is not run: blocks that
-//!   install, build or run the test suite (`cargo install`, `cargo xtask test`, `pip install`).
+//!   install, build or run the test suite (`cargo install`, `cargo xtask test`, `pip install`)
+//!   or need what a test cannot have (a SLURM or Kubernetes cluster, GNU parallel); the reason
+//!   is in the marker.
 //! * `cargo run --release -p clothbake -- ARGS` runs as `clothbake ARGS` (the binary under test).
 //! * Any other `cargo`, `pip` or `python` line in a block that is run fails this test: mark its
 //!   block instead.
@@ -85,8 +88,8 @@ fn commands(readme: &str) -> Vec<Line> {
     out
 }
 
-/// The command as the test runs it; a setup command (one the README must mark) panics.
-fn as_run(l: &Line) -> String {
+/// The command as the test runs it; a setup command (one `doc` must mark) panics.
+fn as_run(doc: &str, l: &Line) -> String {
     if let Some(rest) = l
         .command
         .strip_prefix("cargo run --release -p clothbake -- ")
@@ -96,7 +99,7 @@ fn as_run(l: &Line) -> String {
     let first = l.command.split_whitespace().next().unwrap_or_default();
     assert!(
         !matches!(first, "cargo" | "pip" | "pip3" | "python" | "python3"),
-        "README.md line {}: `{}` builds, installs or runs Python; put \
+        "{doc} line {}: `{}` builds, installs or runs Python; put \
          `<!-- readme-test: skip (why) -->` before its block",
         l.number,
         l.command
@@ -104,12 +107,17 @@ fn as_run(l: &Line) -> String {
     l.command.clone()
 }
 
-#[test]
-fn readme_shell_blocks_run_in_order_in_a_fresh_folder() {
-    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
-    let lines = commands(&readme);
-    assert!(lines.len() >= 20, "only {} commands found", lines.len());
-    let dir = common::fresh_dir("readme", "run");
+/// Runs the shell blocks of `doc` (relative to the repository root) in order in a fresh
+/// folder, which it returns; at least `least` commands must be found.
+fn run_blocks(doc: &str, least: usize) -> PathBuf {
+    let text = std::fs::read_to_string(repo().join(doc)).unwrap();
+    let lines = commands(&text);
+    assert!(
+        lines.len() >= least,
+        "{doc}: only {} commands found",
+        lines.len()
+    );
+    let dir = common::fresh_dir("docs", &doc.replace(['/', '.'], "-"));
     std::os::unix::fs::symlink(repo().join("tables"), dir.join("tables")).unwrap();
     let bin = Path::new(env!("CARGO_BIN_EXE_clothbake")).parent().unwrap();
     let path = format!(
@@ -119,7 +127,7 @@ fn readme_shell_blocks_run_in_order_in_a_fresh_folder() {
     );
     let start = Instant::now();
     for l in &lines {
-        let cmd = as_run(l);
+        let cmd = as_run(doc, l);
         let t = Instant::now();
         let out = Command::new("bash")
             .args(["-c", &cmd])
@@ -131,26 +139,98 @@ fn readme_shell_blocks_run_in_order_in_a_fresh_folder() {
         let allowed = code == Some(0) || (code == Some(1) && cmd.starts_with("clothbake diff "));
         assert!(
             allowed,
-            "README.md line {}: `{cmd}` exited {:?}\nstdout: {}\nstderr: {}",
+            "{doc} line {}: `{cmd}` exited {:?}\nstdout: {}\nstderr: {}",
             l.number,
             code,
             common::text(&out.stdout),
             common::text(&out.stderr)
         );
         eprintln!(
-            "{:6.2} s  line {}: {cmd}",
+            "{:6.2} s  {doc} line {}: {cmd}",
             t.elapsed().as_secs_f64(),
             l.number
         );
     }
     eprintln!(
-        "{} commands in {:.1} s",
+        "{doc}: {} commands in {:.1} s",
         lines.len(),
         start.elapsed().as_secs_f64()
     );
+    dir
+}
+
+#[test]
+fn readme_shell_blocks_run_in_order_in_a_fresh_folder() {
+    let dir = run_blocks("README.md", 20);
     // What the README says the first command does.
     assert!(dir.join("twill.exr").is_file());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// One test per document: its blocks in order in a fresh folder.
+macro_rules! doc_test {
+    ($($name:ident: $doc:literal, $least:literal;)*) => {$(
+        #[test]
+        fn $name() {
+            let dir = run_blocks($doc, $least);
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+    )*};
+}
+
+doc_test! {
+    docs_baking: "docs/baking.md", 5;
+    docs_cluster: "docs/cluster.md", 4;
+    docs_export: "docs/export.md", 6;
+    docs_fabric_format: "docs/fabric-format.md", 1;
+    docs_render: "docs/render.md", 9;
+    docs_transport: "docs/transport.md", 1;
+    docs_wif: "docs/wif.md", 3;
+}
+
+/// The documents whose blocks all need what a test cannot have, each with the reason its
+/// markers give; the test below keeps this list and docs/ in step.
+const NOTHING_TO_RUN: [&str; 2] = ["docs/loader.md", "docs/python.md"];
+
+#[test]
+fn every_document_with_shell_blocks_is_run_or_listed() {
+    let tested = [
+        "docs/baking.md",
+        "docs/cluster.md",
+        "docs/export.md",
+        "docs/fabric-format.md",
+        "docs/render.md",
+        "docs/transport.md",
+        "docs/wif.md",
+    ];
+    let mut with_blocks = Vec::new();
+    for e in std::fs::read_dir(repo().join("docs")).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "md") {
+            let text = std::fs::read_to_string(&p).unwrap();
+            if text.contains("```sh") || text.contains("```bash") {
+                let doc = format!("docs/{}", p.file_name().unwrap().to_string_lossy());
+                let runs = !commands(&text).is_empty();
+                with_blocks.push((doc, runs));
+            }
+        }
+    }
+    with_blocks.sort();
+    for (doc, runs) in &with_blocks {
+        if *runs {
+            assert!(tested.contains(&doc.as_str()), "{doc}: add it to doc_test!");
+        } else {
+            assert!(
+                NOTHING_TO_RUN.contains(&doc.as_str()),
+                "{doc}: list it in NOTHING_TO_RUN"
+            );
+        }
+    }
+    assert_eq!(
+        with_blocks.len(),
+        tested.len() + NOTHING_TO_RUN.len(),
+        "{with_blocks:?}"
+    );
 }
 
 #[test]
@@ -160,7 +240,7 @@ fn blocks_and_markers_are_read_as_documented() {
               ```python\nprint(1)\n```\n```bash\ncargo run --release -p clothbake -- --weave t\n```\n";
     let got: Vec<(usize, String)> = commands(md)
         .into_iter()
-        .map(|l| (l.number, as_run(&l)))
+        .map(|l| (l.number, as_run("t.md", &l)))
         .collect();
     assert_eq!(
         got,
@@ -171,7 +251,7 @@ fn blocks_and_markers_are_read_as_documented() {
         ]
     );
     let unmarked = commands("```sh\npip install .\n```\n");
-    let e = std::panic::catch_unwind(|| as_run(&unmarked[0])).unwrap_err();
+    let e = std::panic::catch_unwind(|| as_run("t.md", &unmarked[0])).unwrap_err();
     let msg = e.downcast_ref::<String>().unwrap();
     assert!(
         msg.contains("line 2") && msg.contains("readme-test: skip"),

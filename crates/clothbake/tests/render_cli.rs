@@ -182,8 +182,45 @@ fn plot_writes_png_and_svg() {
         "-o",
         s.to_str().unwrap(),
     ]);
-    assert!(std::fs::read_to_string(&s).unwrap().contains("theta_i 30"));
+    assert!(std::fs::read_to_string(&s).unwrap().contains("θᵢ = 30°"));
     assert!(std::fs::metadata(&p).unwrap().len() > 1000);
+}
+
+#[test]
+fn plot_polar_writes_its_png_and_refuses_bad_angles() {
+    let p = temp("polar.png");
+    let w = weave("satin5");
+    succeeds(&[
+        "plot",
+        "--kind",
+        "polar",
+        "--weave",
+        &w,
+        "--wi",
+        "50,90",
+        "--theta-o",
+        "30,60",
+        "-o",
+        p.to_str().unwrap(),
+        "--force",
+    ]);
+    let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&p).unwrap()));
+    let info = dec.read_info().unwrap().info().clone();
+    // A disk and its key beside it.
+    assert_eq!((info.width, info.height), (900, 660));
+    let q = temp("polar-bad.png");
+    let q = q.to_str().unwrap();
+    let args = |extra: &[&str]| {
+        let mut a = vec!["plot", "--kind", "polar", "--weave", &w, "-o", q];
+        a.extend(extra);
+        clothbake(&a)
+    };
+    fails(
+        &args(&["--theta-o", "30,95"]),
+        &["--theta-o", "outside [0, 90)"],
+    );
+    fails(&args(&["--wi", "90,0"]), &["--wi", "horizon"]);
+    assert!(!Path::new(q).exists());
 }
 
 /// Renders `table` on the swatch (64 x 48, one sample a pixel), with `--periods` when given,
