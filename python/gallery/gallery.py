@@ -42,8 +42,8 @@ class Settings:
         self.width, self.height = (160, 120) if quick else (1024, 768)
         # Samples a pixel: scenes with the native `measured` BSDF only, and scenes with the
         # clothbake plugin (about 3 times slower a sample: evaluated wavefronts).
-        self.spp = 4 if quick else 64
-        self.spp_plugin = 4 if quick else 32
+        self.spp = 4 if quick else 32
+        self.spp_plugin = 4 if quick else 16
         self.pass_spp = 4 if quick else 8
         self.res = "8,16,8,16" if quick else "32,64,32,64"
         self.spatial_res = "4,8,4,8" if quick else "16,32,16,32"
@@ -79,7 +79,11 @@ class Baker:
             for block in iter(lambda: f.read(1 << 20), b""):
                 h.update(block)
         self.binary = h.hexdigest()
-        self.seconds = 0.0
+        self.seconds = 0.0  # baking done by this run
+        # How long each cached file took to make, so that the cost is known on reruns.
+        self.times_path = self.dir / "times.json"
+        self.times = json.loads(self.times_path.read_text()) if self.times_path.exists() else {}
+        self.used = set()
 
     def _key(self, fabric, args):
         h = hashlib.sha256(self.binary.encode())
@@ -88,6 +92,7 @@ class Baker:
         return h.hexdigest()[:16]
 
     def _run(self, args, out):
+        self.used.add(out.name)
         if out.exists():
             return out
         t = time.time()
@@ -95,9 +100,16 @@ class Baker:
         subprocess.run([self.exe, *[str(a).replace("{OUT}", str(tmp)) for a in args]],
                        check=True)
         tmp.rename(out)
-        self.seconds += time.time() - t
-        print(f"  baked {out.name} in {time.time() - t:.1f} s", flush=True)
+        dt = time.time() - t
+        self.seconds += dt
+        self.times[out.name] = round(dt, 1)
+        self.times_path.write_text(json.dumps(self.times, indent=1))
+        print(f"  baked {out.name} in {dt:.1f} s", flush=True)
         return out
+
+    def cost(self):
+        """Seconds it took to make the files this run used (cached ones included)."""
+        return sum(self.times.get(n, 0.0) for n in self.used)
 
     def table(self, name, fabric, res, *extra):
         """The table of ``fabric`` (EXR, f32) on the grid ``res`` with extra bake options."""
@@ -121,30 +133,27 @@ class Picture:
         self.left, self.right, self.labels = left, right, labels
 
 
-def plan(settings, baker, only):
-    """The pictures, their tables baked (cached)."""
+def plan(settings, baker):
+    """Every picture, its tables baked (cached)."""
     s = settings
     pics = []
-    want = lambda n: not only or any(n.startswith(o) for o in only)
     for name, path in fabrics():
-        if want(f"{name}-far"):
-            table = baker.table(name, path, s.res)
-            rgl = baker.rgl(name, path, table, s.rgl_res)
-            pics.append(Picture(
-                f"{name}-far", f"`{path.name}` draped over a ball: its averaged table "
-                f"({s.res} cells) through Mitsuba's native `measured` BSDF "
-                "(`clothbake export --rgl`).", "far", scene.measured(rgl)))
-        if want(f"{name}-close"):
-            table = baker.table(name + "-spatial", path, s.spatial_res, "--spatial")
-            pics.append(Picture(
-                f"{name}-close", f"`{path.name}` up close: its spatially varying table "
-                f"(`bake --spatial`, {s.spatial_res} cells per crossing cell) through the "
-                f"clothbake plugin with `periods` = {scene.PERIODS:g} weave periods per UV unit "
-                f"(about {scene.PERIODS / (2 * scene.drape.HALF_SIDE):.0f} per unit of length, "
-                "the ball's radius being 1).", "close",
-                scene.plugin(table, periods=scene.PERIODS)))
+        table = baker.table(name, path, s.res)
+        rgl = baker.rgl(name, path, table, s.rgl_res)
+        pics.append(Picture(
+            f"{name}-far", f"`{path.name}` draped over a ball: its averaged table "
+            f"({s.res} cells) through Mitsuba's native `measured` BSDF "
+            "(`clothbake export --rgl`).", "far", scene.measured(rgl)))
+        table = baker.table(name + "-spatial", path, s.spatial_res, "--spatial")
+        pics.append(Picture(
+            f"{name}-close", f"`{path.name}` up close: its spatially varying table "
+            f"(`bake --spatial` on the {s.spatial_res} grid) through the "
+            f"clothbake plugin with `periods` = {scene.PERIODS:g} weave periods per UV unit "
+            f"(about {scene.PERIODS / (2 * scene.drape.HALF_SIDE):.0f} per unit of length, "
+            "the ball's radius being 1).", "close",
+            scene.plugin(table, periods=scene.PERIODS)))
     fab = dict(fabrics())
-    if want(f"{BOUNCES_FABRIC}-direct-vs-all-bounces") and BOUNCES_FABRIC in fab:
+    if BOUNCES_FABRIC in fab:
         path = fab[BOUNCES_FABRIC]
         one = baker.table(BOUNCES_FABRIC + "-b1", path, s.all_res)
         every = baker.table(BOUNCES_FABRIC + "-ball", path, s.all_res, "--bounces", "all")
@@ -155,7 +164,7 @@ def plan(settings, baker, only):
             "(baking every bounce takes about 5 minutes at the default grid), through the "
             "plugin.", "far", scene.plugin(one), scene.plugin(every),
             ("--bounces 1", "--bounces all")))
-    if want(f"{MODEL_FABRIC}-model-vs-table") and MODEL_FABRIC in fab:
+    if MODEL_FABRIC in fab:
         path = fab[MODEL_FABRIC]
         table = baker.table(MODEL_FABRIC, path, s.res)
         pics.append(Picture(
@@ -163,7 +172,7 @@ def plan(settings, baker, only):
             f"`{path.name}`, left: the analytic model evaluated per shading point (plugin "
             f"`weave=`); right: its table ({s.res} cells, plugin `table=`).", "far",
             scene.plugin_model(path), scene.plugin(table), ("model", "table")))
-    if want(f"{MEASURED_FABRIC}-plugin-vs-measured") and MEASURED_FABRIC in fab:
+    if MEASURED_FABRIC in fab:
         path = fab[MEASURED_FABRIC]
         table = baker.table(MEASURED_FABRIC, path, s.res)
         rgl = baker.rgl(MEASURED_FABRIC, path, table, s.rgl_res)
@@ -189,7 +198,7 @@ def write_png(mi, img8, path):
     mi.Bitmap(np.ascontiguousarray(img8), mi.Bitmap.PixelFormat.RGB).write(str(path))
 
 
-def write_readme(out, pics, results, settings, light, total):
+def write_readme(out, pics, results, settings, light, bake_seconds):
     lines = [
         "# Gallery",
         "",
@@ -208,12 +217,18 @@ def write_readme(out, pics, results, settings, light, total):
         "(`python/gallery/tonemap.py`). Split pictures show two renders of one scene, the left "
         "half of one and the right half of the other.",
         "",
-        f"Cost: {total['render']:.0f} s of rendering and {total['bake']:.0f} s of baking "
-        f"on the 2-core development machine for {len(results)} pictures (cached tables "
-        "are not baked again).",
+        f"Cost: {sum(results[p.name]['seconds'] for p in pics if p.name in results) / 60:.0f} "
+        f"minutes of rendering for the {len(pics)} pictures and {bake_seconds / 60:.0f} "
+        "minutes of baking their tables (cached under target/gallery: a rerun only renders), "
+        "on the 2-core development machine while other jobs shared it (`cargo xtask gallery "
+        "--only NAME` renders some again).",
         "",
     ]
     for pic in pics:
+        if pic.name not in results:
+            lines += [f"## {pic.name}", "", "(not rendered yet: `cargo xtask gallery --only "
+                      f"{pic.name}`)", ""]
+            continue
         r = results[pic.name]
         lines += [f"## {pic.name}", "", f"![{pic.name}]({pic.name}.png)", "",
                   f"{pic.caption} Rendered in {r['seconds']:.0f} s.", ""]
@@ -252,14 +267,19 @@ def main(argv=None):
     cache = pathlib.Path(a.cache)
     baker = Baker(a.clothbake, cache)
     only = [o for o in (a.only or "").split(",") if o]
-    pics = plan(settings, baker, only)
+    every = plan(settings, baker)
+    pics = [p for p in every if not only or any(p.name.startswith(o) for o in only)]
     if a.bake_only:
         print(f"gallery: tables for {len(pics)} pictures in {baker.dir} ({baker.seconds:.0f} s)")
         return 0
     mesh = scene.cloth_mesh(cache, 65 if a.quick else 257)
     emitter = scene.environment(a.envmap)
     exposure = a.exposure or (None if a.envmap else scene.SKY_EXPOSURE)
+    manifest = out / "gallery.json"
     results = {}
+    if manifest.exists() and not a.quick:
+        # Earlier runs' pictures (a run with --only renders some of them again).
+        results = json.loads(manifest.read_text()).get("pictures", {})
     t_all = time.time()
     for pic in pics:
         t = time.time()
@@ -284,12 +304,13 @@ def main(argv=None):
                              "width": img.shape[1], "height": img.shape[0]}
         print(f"{pic.name}.png: {time.time() - t:.0f} s", flush=True)
     total = {"render": time.time() - t_all, "bake": baker.seconds}
+    results = {p.name: results[p.name] for p in every if p.name in results}
     light = (f"the environment `{pathlib.Path(a.envmap).name}`" if a.envmap else
              "Mitsuba's `sunsky` (Hosek-Wilkie sky and sun, turbidity "
              f"{scene.TURBIDITY:g}, the sun {scene.SUN_ELEVATION:g} degrees above the horizon)")
-    (out / "gallery.json").write_text(json.dumps({"pictures": results, "total": total}, indent=1))
-    if not a.quick and not only:
-        write_readme(out, pics, results, settings, light, total)
+    manifest.write_text(json.dumps({"pictures": results}, indent=1) + "\n")
+    if not a.quick:
+        write_readme(out, every, results, settings, light, baker.cost())
     print(f"gallery: {len(pics)} pictures in {out} ({total['render']:.0f} s rendering, "
           f"{total['bake']:.0f} s baking)")
     return 0

@@ -10,10 +10,10 @@ import numpy as np
 import drape
 
 # Weave periods per UV unit in the close-ups: the cloth's side (UV 0 to 1) is 4.8 ball radii.
-PERIODS = 160.0
+PERIODS = 120.0
 TURBIDITY = 3.0
-SUN_ELEVATION = 40.0  # degrees above the horizon
-SUN_AZIMUTH = 235.0  # degrees from +x toward +y: the sun behind the camera's left shoulder
+SUN_ELEVATION = 35.0  # degrees above the horizon
+SUN_AZIMUTH = 245.0  # degrees from +x toward +y: the sun to the left of the camera
 # The exposures of the sky's pictures, per view: a sunlit white cloth near the curve's
 # shoulder (the close view sees only sunlit cloth, the far view mostly the floor).
 SKY_EXPOSURE = {"far": 3.0, "close": 1.6}
@@ -55,8 +55,8 @@ def environment(envmap):
     up = mi.ScalarTransform4f().rotate([1, 0, 0], 90)
     if envmap:
         return {"type": "envmap", "filename": str(envmap), "to_world": up}
-    return {"type": "sunsky", "sun_direction": sun_direction(), "turbidity": TURBIDITY,
-            "to_world": up}
+    # sunsky's zenith is +Z and its sun direction is in world space.
+    return {"type": "sunsky", "sun_direction": sun_direction(), "turbidity": TURBIDITY}
 
 
 VIEWS = {
@@ -80,7 +80,7 @@ def build(mi, view, cloth_bsdf, mesh, emitter, settings, half=None):
                      "crop_height": settings.height})
     return mi.load_dict({
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": 8},
+        "integrator": {"type": "path", "max_depth": 5},
         "sensor": {
             "type": "perspective", "fov": fov, "fov_axis": "x",
             "to_world": mi.ScalarTransform4f().look_at(origin=origin, target=target, up=[0, 0, 1]),

@@ -22,9 +22,14 @@ fn fail(msg: &str) -> ! {
 /// The task: see the module documentation. `args` go to gallery.py.
 pub fn run(root: &Path, args: &[String]) {
     let venv = venv(root);
+    let path = path_with(&venv.join("bin"));
     println!("==> cargo build --release -p clothbake -p clothbake-py");
+    // With the environment's python first, as `cargo xtask test` builds (PyO3's build
+    // configuration follows the python on PATH: the same one, no rebuild between the two).
     let status = Command::new(cargo())
         .current_dir(root)
+        .env("PATH", &path)
+        .env("VIRTUAL_ENV", &venv)
         .args([
             "build",
             "--release",
@@ -54,9 +59,10 @@ pub fn run(root: &Path, args: &[String]) {
     });
     let mut cmd = Command::new("nice");
     cmd.current_dir(root)
-        .env("PATH", path_with(&venv.join("bin")))
+        .env("PATH", &path)
         .env("VIRTUAL_ENV", &venv)
         .env("PYTHONPATH", &staged)
+        .env("PYTHONDONTWRITEBYTECODE", "1")
         .env("DRJIT_LIBLLVM_PATH", &llvm)
         .args(["-n", "10"])
         .arg(venv.join("bin/python3"))
