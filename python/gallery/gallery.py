@@ -12,7 +12,7 @@ Scene (scene.py): a square cloth draped over a ball on a floor (drape.py), lit b
 ``sunsky`` (a physical sky with a sun) or a lat-long EXR (``--envmap``), path traced
 (``path``: multiple importance sampling of the emitter and the BSDF's own sampling; shadows
 and light bouncing between cloth, ball and floor), then exposure and the ACES tone curve
-(tonemap.py). Tables are baked with the ``clothbake`` binary and cached under ``--cache``,
+(tonemap.py), written as indexed-colour PNGs (png.py). Tables are baked with the ``clothbake`` binary and cached under ``--cache``,
 keyed by the fabric file, the bake options and the binary, so a rerun renders only.
 """
 
@@ -30,6 +30,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 
+import png  # noqa: E402
 import scene  # noqa: E402
 import tonemap  # noqa: E402
 
@@ -194,8 +195,9 @@ def split(left, right):
     return out
 
 
-def write_png(mi, img8, path):
-    mi.Bitmap(np.ascontiguousarray(img8), mi.Bitmap.PixelFormat.RGB).write(str(path))
+def write_png(img8, path):
+    """The 8-bit sRGB picture as an indexed-colour PNG (png.py: half the size of RGB)."""
+    png.write(path, np.ascontiguousarray(img8))
 
 
 def write_readme(out, pics, results, settings, light, bake_seconds):
@@ -214,7 +216,9 @@ def write_readme(out, pics, results, settings, light, bake_seconds):
         f"far, {scene.SKY_EXPOSURE['close']:g} close: the same for every fabric, so that "
         "fabrics compare), then the ACES filmic curve as fitted by Narkowicz (2015), "
         "`x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)`, and the sRGB transfer function "
-        "(`python/gallery/tonemap.py`). Split pictures show two renders of one scene, the left "
+        "(`python/gallery/tonemap.py`); the PNGs are 8-bit indexed colour, a 256-colour palette "
+        "fitted to each picture (`python/gallery/png.py`: half the size of 8-bit RGB, under one "
+        "level of error per channel on average). Split pictures show two renders of one scene, the left "
         "half of one and the right half of the other.",
         "",
         f"Cost: {sum(results[p.name]['seconds'] for p in pics if p.name in results) / 60:.0f} "
@@ -296,7 +300,7 @@ def main(argv=None):
             img = split(render(pic.left, "left"), render(pic.right, "right"))
         e = exposure[pic.view] if isinstance(exposure, dict) else exposure
         e = e or tonemap.auto_exposure(img)
-        write_png(mi, tonemap.to_8bit(img, e), out / f"{pic.name}.png")
+        write_png(tonemap.to_8bit(img, e), out / f"{pic.name}.png")
         cloth = img.mean(axis=(0, 1))
         results[pic.name] = {"seconds": round(time.time() - t, 1),
                              "mean": [round(float(x), 5) for x in cloth],
