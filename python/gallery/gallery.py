@@ -12,8 +12,9 @@ Scene (scene.py): a square cloth draped over a ball on a floor (drape.py), lit b
 ``sunsky`` (a physical sky with a sun) or a lat-long EXR (``--envmap``), path traced
 (``path``: multiple importance sampling of the emitter and the BSDF's own sampling; shadows
 and light bouncing between cloth, ball and floor), then exposure and the ACES tone curve
-(tonemap.py), written as indexed-colour PNGs (png.py). Tables are baked with the ``clothbake`` binary and cached under ``--cache``,
-keyed by the fabric file, the bake options and the binary, so a rerun renders only.
+(tonemap.py), written as indexed-colour PNGs (png.py). Tables are baked with the
+``clothbake`` binary and cached under ``--cache``, keyed by the fabric file, the bake options
+and the binary, so a rerun renders only.
 """
 
 import argparse
