@@ -1,12 +1,23 @@
-//! Probes the optional dependencies of these tests (Python packages, SLURM) and sets
+//! Probes the optional dependencies of these tests (Python packages, Mitsuba's llvm variant, SLURM) and sets
 //! `missing_<name>` for each one absent, so that the tests needing it show as ignored, with the
 //! reason, instead of passing without running (and fail under `CI`); see the shared probes in
 //! crates/clothbake-loader/build/probe.rs.
 
 include!("../crates/clothbake-loader/build/probe.rs");
+include!("llvm_probe.rs");
 
 fn main() {
     println!("cargo::rerun-if-changed=build.rs");
     println!("cargo::rerun-if-changed=../crates/clothbake-loader/build/probe.rs");
-    emit(&[PYTHON, NUMPY, MITSUBA, OPENEXR, SLURM, PKG_CONFIG]);
+    println!("cargo::rerun-if-changed=llvm_probe.rs");
+    println!("cargo::rerun-if-env-changed=DRJIT_LIBLLVM_PATH");
+    emit(&[
+        PYTHON,
+        NUMPY,
+        MITSUBA,
+        MITSUBA_LLVM,
+        OPENEXR,
+        SLURM,
+        PKG_CONFIG,
+    ]);
 }

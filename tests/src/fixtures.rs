@@ -119,6 +119,23 @@ pub fn release_build(packages: &[&str]) -> PathBuf {
         .join("release")
 }
 
+/// Stages the `clothbake` Python package in `dir` as a wheel would install it: `dir/clothbake`
+/// holds the package's Python files (crates/clothbake-py/python/clothbake) and the extension
+/// module `lib` (`lib_native.so` of a release build) as `_native.abi3.so`. Put `dir` on
+/// PYTHONPATH to import it.
+pub fn stage_python_package(lib: &Path, dir: &Path) -> std::io::Result<()> {
+    let pkg = dir.join("clothbake");
+    std::fs::create_dir_all(&pkg)?;
+    for entry in std::fs::read_dir(root().join("crates/clothbake-py/python/clothbake"))? {
+        let p = entry?.path();
+        if p.is_file() {
+            std::fs::copy(&p, pkg.join(p.file_name().unwrap_or_default()))?;
+        }
+    }
+    std::fs::copy(lib, pkg.join("_native.abi3.so"))?;
+    Ok(())
+}
+
 /// The shipped twill (`tables/twill.json`) with the albedo (0.6, 0.3, 0.12) on both groups, so
 /// that the three channels differ.
 pub fn coloured_twill() -> Fabric {

@@ -9,4 +9,5 @@ pub mod fixtures;
 /// fail with a clear message when they run without theirs (under `CI`, or with `--ignored`).
 pub mod probe {
     include!("../../crates/clothbake-loader/build/probe.rs");
+    include!("../llvm_probe.rs");
 }

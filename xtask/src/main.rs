@@ -11,6 +11,9 @@
 //!   test and the orders at n = 1, into `docs/transport.md` (between its `transport` markers).
 //! * `figures`: the thesis's rendered scenes (Figs 4.5, 5.10, 5.11, 5.17), the weave up
 //!   close (`up-close`) and `clothbake plot`'s three kinds (`plots`) into `docs/figures/`.
+//! * `gallery [--quick] [--envmap FILE.exr]`: pictures of every shipped fabric rendered by
+//!   Mitsuba 3 (draped over a ball under a sky, path traced) into `docs/gallery/` (see
+//!   `gallery.rs`).
 //! * `validate-spatial`: the model per crossing cell against the truth sorted into the same
 //!   cells, written to `docs/validation-spatial.md`.
 //! * `validate`: holds the analytic model against the ray-traced ground truth for every shipped
@@ -30,6 +33,7 @@ use clothbake_bake::golden::{bake_golden, golden_path, shipped_fabrics};
 use clothbake_bake::{bake, BakeOptions};
 mod ch5;
 mod figures;
+mod gallery;
 mod install_capi;
 mod ir_accuracy;
 mod spatial;
@@ -61,6 +65,7 @@ fn main() {
         "ch5" => ch5::run(&root()),
         "transport" => transport::run(&root(), std::env::args().nth(2).as_deref()),
         "figures" => figures::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
+        "gallery" => gallery::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
         "golden" => golden(),
         "bench-bake" => bench_bake(std::env::args().skip(2).any(|a| a == "--bounces-2")),
         "loader-accuracy" => loader_accuracy(),
@@ -70,7 +75,7 @@ fn main() {
         "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
+                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots] | gallery [--quick] [--envmap FILE.exr] [--only NAME,...] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
             );
             std::process::exit(2);
         }

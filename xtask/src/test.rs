@@ -3,9 +3,12 @@
 //! `python3 -m venv`), installs numpy, pytest, OpenEXR and mitsuba into it (the first time takes
 //! minutes), then runs `cargo fmt --all -- --check`, `cargo clippy --workspace --all-targets --
 //! -D warnings` and `cargo test --workspace [ARGS]` with the environment's `bin` first on PATH
-//! and VIRTUAL_ENV set, so that the Python, Mitsuba and OpenEXR tests run. SLURM is not a pip
-//! package: `.ci/run` installs it with apt and then runs this with `CI=true`.
+//! and VIRTUAL_ENV set, so that the Python, Mitsuba and OpenEXR tests run, and with
+//! DRJIT_LIBLLVM_PATH set (when unset) to a libLLVM >= 17 if one is found, for Mitsuba's llvm
+//! variant. SLURM and LLVM are not pip packages: `.ci/run` installs them with apt and then runs
+//! this with `CI=true`.
 
+use clothbake_tests::probe::{libllvm, LLVM_MIN};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -30,7 +33,7 @@ fn fail(msg: &str) -> ! {
 }
 
 /// The virtual environment, created when absent; returns its folder.
-fn venv(root: &Path) -> PathBuf {
+pub fn venv(root: &Path) -> PathBuf {
     let dir = root.join(".venv");
     let python = dir.join("bin/python3");
     if !python.exists() {
@@ -76,7 +79,7 @@ fn venv(root: &Path) -> PathBuf {
 }
 
 /// PATH with `bin` first.
-fn path_with(bin: &Path) -> OsString {
+pub fn path_with(bin: &Path) -> OsString {
     let mut dirs = vec![bin.to_path_buf()];
     if let Some(p) = std::env::var_os("PATH") {
         dirs.extend(std::env::split_paths(&p));
@@ -84,11 +87,25 @@ fn path_with(bin: &Path) -> OsString {
     std::env::join_paths(dirs).unwrap_or_else(|e| fail(&format!("cannot build PATH: {e}")))
 }
 
+/// The cargo running this task (`CARGO`), or `cargo`.
+pub fn cargo() -> OsString {
+    std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into())
+}
+
 /// The task: see the module documentation. `args` go to `cargo test` after `--workspace`.
 pub fn run_all(root: &Path, args: &[String]) {
     let venv = venv(root);
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let cargo = cargo();
     let path = path_with(&venv.join("bin"));
+    // Mitsuba's llvm variant (its tests and the gallery's) needs a libLLVM >= 17.
+    let llvm = libllvm();
+    match &llvm {
+        Some(p) => println!("==> DRJIT_LIBLLVM_PATH={}", p.display()),
+        None => println!(
+            "==> no libLLVM >= {LLVM_MIN} found (apt-get install libllvm19): the tests of \
+             Mitsuba's llvm variant will be ignored (and fail under CI)"
+        ),
+    }
     let cargo_cmd = |a: &[&str]| {
         let mut c = Command::new(&cargo);
         c.current_dir(root)
@@ -96,6 +113,9 @@ pub fn run_all(root: &Path, args: &[String]) {
             .env("VIRTUAL_ENV", &venv)
             .env_remove("PYTHONHOME")
             .args(a);
+        if let Some(p) = &llvm {
+            c.env("DRJIT_LIBLLVM_PATH", p);
+        }
         c
     };
     run(

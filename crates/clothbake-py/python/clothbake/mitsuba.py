@@ -20,8 +20,15 @@ evaluated as its front mirrored through the cloth's plane (z negated for both di
 the same weave, seen from the other side. With ``two_sided=False`` the back is black. Light
 and eye on opposite sides give zero (no transmission).
 
-Scalar RGB variants only (``scalar_rgb``): the plugin calls the native module once per
-lookup, on Python floats.
+Variants: ``scalar_rgb`` (the plugin calls the native module once per lookup, on Python
+floats) and ``llvm_ad_rgb`` (whole wavefronts: each method converts the lanes Mitsuba hands
+it to numpy and makes one batch call, ``Table.eval``, ``Table.eval_at``, ``Table.sample``,
+``Table.pdf`` or ``Fabric.eval``). A Python BSDF can only see concrete arrays, so in an llvm
+variant ``register()`` switches Dr.Jit's symbolic loops and calls off
+(``dr.JitFlag.SymbolicLoops``, ``dr.JitFlag.SymbolicCalls``): the integrator then runs its
+bounces as evaluated wavefronts. Turning them on again later makes the plugin raise. The llvm
+variants need an LLVM of version 17 or later (``DRJIT_LIBLLVM_PATH``, e.g.
+``/usr/lib/x86_64-linux-gnu/libLLVM-19.so``).
 """
 
 import math
@@ -31,51 +38,82 @@ from . import Fabric, Table
 _REGISTERED = False
 
 
+class Cloth:
+    """The plugin's parameters, checked: ``table`` (a Table) or ``fabric`` (a Fabric) with
+    ``facet``, ``two_sided``, ``periods`` (or None) and ``source`` (the file named)."""
+
+    def __init__(self, props):
+        has_table, has_weave = "table" in props, "weave" in props
+        if has_table == has_weave:
+            raise ValueError(
+                "clothbake BSDF: give exactly one of table= (a baked .exr/.bin table) "
+                "or weave= (a fabric .json file)"
+            )
+        self.table = Table.open(str(props["table"])) if has_table else None
+        self.fabric = Fabric(str(props["weave"])) if has_weave else None
+        self.facet = str(props.get("facet", "huo"))
+        self.two_sided = bool(props.get("two_sided", True))
+        self.periods = float(props["periods"]) if "periods" in props else None
+        if self.periods is not None and (self.table is None or not self.periods > 0.0):
+            raise ValueError(
+                "clothbake BSDF: periods= (weave periods per UV unit, > 0) goes with table= "
+                "(a table baked with spatial=True shows the weave)"
+            )
+        self.source = str(props["table"] if has_table else props["weave"])
+
+    def flags(self, mi):
+        """Glossy reflection, front side (and back side when two-sided)."""
+        flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
+        if self.two_sided:
+            flags = flags | mi.BSDFFlags.BackSide
+        return flags
+
+
 def _variant_check(mi):
+    """True for a JIT (llvm) variant, False for a scalar one; raises for the others."""
     v = mi.variant()
-    if v is None or not v.startswith("scalar_") or "rgb" not in v:
-        raise RuntimeError(
-            f"clothbake.mitsuba: variant {v!r} is not supported; call "
-            "mitsuba.set_variant('scalar_rgb') before register()"
-        )
+    if v is not None and v.endswith("_rgb") and not v.endswith("polarized_rgb"):
+        if v.startswith("scalar_"):
+            return False
+        if v.startswith("llvm_"):
+            return True
+    raise RuntimeError(
+        f"clothbake.mitsuba: variant {v!r} is not supported; call "
+        "mitsuba.set_variant('scalar_rgb') or mitsuba.set_variant('llvm_ad_rgb') before "
+        "register()"
+    )
 
 
 def register():
-    """Registers the BSDF plugin ``clothbake`` with Mitsuba 3 (idempotent). Call it after
-    ``mitsuba.set_variant("scalar_rgb")``."""
+    """Registers the BSDF plugin ``clothbake`` with Mitsuba 3 (for the current variant; call
+    it again after switching variants). Call it after ``mitsuba.set_variant("scalar_rgb")``
+    or ``mitsuba.set_variant("llvm_ad_rgb")``; in the llvm variant it turns Dr.Jit's symbolic
+    loops and calls off (see the module's documentation)."""
     global _REGISTERED
     import drjit as dr
     import mitsuba as mi
 
-    _variant_check(mi)
+    if _variant_check(mi):
+        dr.set_flag(dr.JitFlag.SymbolicLoops, False)
+        dr.set_flag(dr.JitFlag.SymbolicCalls, False)
+        if _REGISTERED != mi.variant():
+            from ._wavefront import wavefront_class
+
+            cls = wavefront_class(mi, dr, Cloth)
+            mi.register_bsdf("clothbake", lambda props: cls(props))
+            _REGISTERED = mi.variant()
+        return
 
     class ClothBSDF(mi.BSDF):
         """Woven cloth from clothbake: a baked table or the analytic model."""
 
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
-            has_table, has_weave = "table" in props, "weave" in props
-            if has_table == has_weave:
-                raise ValueError(
-                    "clothbake BSDF: give exactly one of table= (a baked .exr/.bin table) "
-                    "or weave= (a fabric .json file)"
-                )
-            self._table = Table.open(str(props["table"])) if has_table else None
-            self._fabric = Fabric(str(props["weave"])) if has_weave else None
-            self._facet = str(props.get("facet", "huo"))
-            self._two_sided = bool(props.get("two_sided", True))
-            self._periods = float(props["periods"]) if "periods" in props else None
-            if self._periods is not None and (self._table is None or not self._periods > 0.0):
-                raise ValueError(
-                    "clothbake BSDF: periods= (weave periods per UV unit, > 0) goes with table= "
-                    "(a table baked with spatial=True shows the weave)"
-                )
-            self._source = str(props["table"] if has_table else props["weave"])
-            flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
-            if self._two_sided:
-                flags = flags | mi.BSDFFlags.BackSide
-            self.m_components = [flags]
-            self.m_flags = flags
+            c = Cloth(props)
+            self._table, self._fabric, self._facet = c.table, c.fabric, c.facet
+            self._two_sided, self._periods, self._source = c.two_sided, c.periods, c.source
+            self.m_components = [c.flags(mi)]
+            self.m_flags = c.flags(mi)
 
         # -- frames --------------------------------------------------------------------
         def _cloth_frame(self, si):
@@ -183,9 +221,9 @@ def register():
             return (f"ClothBSDF[source={self._source!r}, two_sided={self._two_sided}, "
                     f"periods={self._periods}]")
 
-    if not _REGISTERED:
+    if _REGISTERED != mi.variant():
         mi.register_bsdf("clothbake", lambda props: ClothBSDF(props))
-        _REGISTERED = True
+        _REGISTERED = mi.variant()
 
 
 def _unit(v):
