@@ -963,8 +963,11 @@ impl AnalyticModel {
             if let Some((l_vi, kd, ks)) = t.lit {
                 let w = l_vi * u.seg.radius / s_v;
                 let [d, s, _] = intensity_to_brdf([w * kd, w * ks, 0.0], wi);
-                o.diffuse = d;
-                o.specular = s;
+                // Each is a non-negative quantity; near the horizon a lit arc of almost no
+                // length leaves rounding of either sign (-1.2e-28 seen on the taffeta at
+                // 87 degrees), which a table may not hold.
+                o.diffuse = d.max(0.0);
+                o.specular = s.max(0.0);
             }
         }
     }

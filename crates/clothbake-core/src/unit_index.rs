@@ -8,12 +8,16 @@
 //! (`2 tol <= CELL`) lie in the same grid cell or, for a component within `2 tol` of a cell
 //! border, in the neighbouring one. A look-up visits every such cell and keeps the earliest
 //! unit that agrees, so the units, their order and their counts are exactly those of the linear
-//! search.
+//! search. Below [`LINEAR`] units the search is linear (most periods stay below it).
 
 use std::collections::HashMap;
 
 /// Grid step of the hash, per key component.
 const CELL: f64 = 1e-6;
+
+/// Up to this many units a look-up scans the keys (cheaper than hashing them for the small
+/// periods of most fabrics); the hash is built when the units reach this number.
+const LINEAR: usize = 32;
 
 /// Beyond this many grid cells to visit (a key with many components on cell borders), a
 /// look-up scans every key instead: the same answer, found linearly.
@@ -53,6 +57,20 @@ impl UnitIndex {
     /// The first unit whose key agrees with `key`, or `None` after adding `key` as a new unit
     /// (numbered in order of creation from 0).
     pub fn find_or_insert(&mut self, key: Vec<f64>) -> Option<usize> {
+        if self.keys.len() < LINEAR {
+            let found = (0..self.keys.len()).find(|&i| self.same(&self.keys[i], &key));
+            if found.is_none() {
+                self.keys.push(key);
+                if self.keys.len() == LINEAR {
+                    // Every key in its home cell, ids in order of creation.
+                    for (i, k) in self.keys.iter().enumerate() {
+                        let home: Vec<i64> = k.iter().map(|&x| cell(x)).collect();
+                        self.cells.entry(home).or_default().push(i);
+                    }
+                }
+            }
+            return found;
+        }
         let home: Vec<i64> = key.iter().map(|&x| cell(x)).collect();
         // Every cell a key within `tol` of this one can lie in, per component: y in
         // (x - tol, x + tol) implies cell(x - 2 tol) <= cell(y) <= cell(x + 2 tol), rounding
@@ -168,12 +186,17 @@ mod tests {
 
     #[test]
     fn keys_with_many_border_components_fall_back_to_the_scan() {
-        // 12 components on cell borders: 4096 cells to visit, more than MAX_PROBES.
+        // 12 components on cell borders: 4096 cells to visit, more than MAX_PROBES. First
+        // LINEAR other units, so that the hash is in use.
         let mut index = UnitIndex::new(1e-9);
+        for k in 0..LINEAR {
+            assert_eq!(index.find_or_insert(vec![k as f64; 12]), None);
+        }
         let a = vec![0.5e-6; 12];
         let b: Vec<f64> = a.iter().map(|x| x + 0.5e-9).collect();
         assert_eq!(index.find_or_insert(a), None);
-        assert_eq!(index.find_or_insert(b), Some(0));
+        assert_eq!(index.find_or_insert(b), Some(LINEAR));
         assert_eq!(index.find_or_insert(vec![0.5e-6; 11]), None);
+        assert_eq!(index.find_or_insert(vec![3.0; 12]), Some(3));
     }
 }

@@ -389,19 +389,44 @@ impl SpatialLookup {
         if width >= 1.0 || !(u.is_finite() && v.is_finite()) {
             return None;
         }
+        if width.is_nan() || width <= 0.0 {
+            // A point. The AVX2 kernel tells the horizon and NaN itself (D = S = 0 then, and
+            // albedos are finite); the portable blend does not.
+            return Some(match simd {
+                // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C
+                // (the table's `SimdPath`, as in `class_f`).
+                #[cfg(target_arch = "x86_64")]
+                SimdPath::Avx2 => unsafe { self.point_avx2(wi, wo, u, v) },
+                _ if has_value(wi, wo) => self.point(simd, wi, wo, u, v),
+                _ => [0.0; 3],
+            });
+        }
         if !has_value(wi, wo) {
             return Some([0.0; 3]);
         }
-        if width.is_nan() || width <= 0.0 {
-            // A point: its cell's f_r, rho_d D + S (its coverage cancels; where the class is
-            // not seen, D and S are 0).
-            let l = &self.layout;
-            let (i, j) = l.cell_at(u, v);
-            let c = j * l.dims().0 + i;
-            let [d, s] = self.class_f(simd, l.cell_class[c] as usize, wi, wo);
-            return Some(l.cell_albedo[c].map(|a| (a * d + s).max(0.0)));
-        }
         Some(self.eval_footprint(simd, wi, wo, u, v, width))
+    }
+
+    /// A point's f_r: its cell's `rho_d D + S` (its coverage cancels; where the class is not
+    /// seen, D and S are 0).
+    #[inline(always)]
+    fn point(&self, simd: SimdPath, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
+        let l = &self.layout;
+        let (i, j) = l.cell_at(u, v);
+        let c = j * l.dims().0 + i;
+        let [d, s] = self.class_f(simd, l.cell_class[c] as usize, wi, wo);
+        l.cell_albedo[c].map(|a| (a * d + s).max(0.0))
+    }
+
+    /// [`SpatialLookup::point`] compiled for AVX2 (the cell's `floor` one instruction, the
+    /// kernel inline).
+    ///
+    /// # Safety
+    /// The processor must have AVX2, FMA and F16C.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,f16c")]
+    unsafe fn point_avx2(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
+        self.point(SimdPath::Avx2, wi, wo, u, v)
     }
 
     /// [`SpatialLookup::eval_at`] of a footprint of side `width` in (0, 1), both directions

@@ -73,7 +73,7 @@ impl Samples {
                 .iter()
                 .position(|h| !is_physical(h.to_f32()))
                 .map(|i| (i, v[i].to_f32())),
-            Samples::F32(v) => v.iter().position(|x| !is_physical(*x)).map(|i| (i, v[i])),
+            Samples::F32(v) => crate::table::first_unphysical(v).map(|i| (i, v[i])),
         }
     }
 }

@@ -28,6 +28,23 @@ pub(crate) fn is_physical(v: f32) -> bool {
     (0.0..=MAX_VALUE).contains(&v)
 }
 
+/// The index of the first value of `values` that is not [`is_physical`], if any. Blocks are
+/// checked whole (no early exit inside one, so the check vectorises), the block that fails
+/// searched again.
+pub(crate) fn first_unphysical(values: &[f32]) -> Option<usize> {
+    const BLOCK: usize = 1024;
+    values
+        .chunks(BLOCK)
+        .position(|b| !b.iter().fold(true, |ok, &v| ok & is_physical(v)))
+        .map(|k| {
+            let at = k * BLOCK;
+            at + values[at..]
+                .iter()
+                .position(|&v| !is_physical(v))
+                .expect("the failing block holds the value")
+        })
+}
+
 /// The 4-D grid of incident and outgoing directions, cell-centred, in degrees.
 ///
 /// Polar angles cover [0, 90] degrees from +Z, azimuths [0, 360) degrees from +X toward +Y.
@@ -294,7 +311,7 @@ impl Table {
 
     /// Checks what [`Table::new`] checks; the writers call it, as the fields are public.
     pub fn validate(&self) -> Result<(), TableError> {
-        let bad = self.values.iter().position(|v| !is_physical(*v));
+        let bad = first_unphysical(&self.values);
         check_values(
             &self.meta,
             self.values.len(),
@@ -395,5 +412,30 @@ pub(crate) fn check_format_version(
             reads: FORMAT_VERSION,
         }),
         _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_unphysical_value_is_found_wherever_it_lies() {
+        let n = 5000;
+        let plain = |v: &[f32]| v.iter().position(|&x| !is_physical(x));
+        assert_eq!(first_unphysical(&[]), None);
+        assert_eq!(first_unphysical(&vec![0.5; n]), None);
+        for at in [0, 1, 1023, 1024, 1025, 2047, 4095, 4096, n - 1] {
+            for bad in [f32::NAN, -1e-30, f32::INFINITY, 2e30, -0.0 - 1.0] {
+                let mut v = vec![0.5f32; n];
+                v[at] = bad;
+                // A second bad value later must not be the one found.
+                v[n - 1] = f32::NAN;
+                assert_eq!(first_unphysical(&v), plain(&v), "{bad} at {at}");
+                assert_eq!(first_unphysical(&v), Some(at), "{bad} at {at}");
+            }
+        }
+        // Edge values that are physical.
+        assert_eq!(first_unphysical(&[0.0, -0.0, MAX_VALUE]), None);
     }
 }
