@@ -280,6 +280,7 @@ impl CellIndex {
 
     /// The period copy (tx, ty) an unwrapped cell belongs to, the ray origin `o` moved into the
     /// base period by that copy's offset, and the ids of the prims listed in the cell.
+    #[inline]
     pub(crate) fn visit(&self, cell: &CellVisit, o: Vec3) -> ((i64, i64), Vec3, &[u32]) {
         let (tx, ty) = (cell.ix.div_euclid(self.nx), cell.iy.div_euclid(self.ny));
         let c = (cell.iy.rem_euclid(self.ny) * self.nx + cell.ix.rem_euclid(self.nx)) as usize;

@@ -29,10 +29,20 @@ pub struct Shading {
     pub specular: f64,
 }
 
-/// `x^n` for `x >= 0`: repeated multiplication for whole `n`, `powf` otherwise.
+/// `x^n` for `x >= 0`: square-and-multiply for whole `n` (inline, where `powi` is a library
+/// call for an `n` known only at run time), `powf` otherwise.
+#[inline]
 fn power(x: f64, n: f64) -> f64 {
     if n.fract() == 0.0 && (0.0..=1024.0).contains(&n) {
-        x.powi(n as i32)
+        let (mut base, mut k, mut acc) = (x, n as u32, 1.0);
+        while k > 0 {
+            if k & 1 == 1 {
+                acc *= base;
+            }
+            base *= base;
+            k >>= 1;
+        }
+        acc
     } else {
         x.powf(n)
     }
@@ -71,6 +81,19 @@ impl Terms {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn whole_powers_agree_with_powf() {
+        for n in 0..=64u32 {
+            for x in [0.0, 1e-3, 0.37, 0.999, 1.0, 1.7] {
+                let (got, want) = (power(x, f64::from(n)), x.powf(f64::from(n)));
+                assert!((got - want).abs() <= 1e-14 * want, "{x}^{n}: {got} vs {want}");
+            }
+        }
+        assert_eq!(power(0.3, 1.0), 0.3);
+        assert_eq!(power(0.0, 0.0), 1.0);
+        assert_eq!(power(0.5, 2.5), 0.5f64.powf(2.5));
+    }
     use crate::facet::{Facet, FacetModel};
     use crate::rng::Rng;
     use crate::vec3::UnitVec3;
