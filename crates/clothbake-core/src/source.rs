@@ -86,9 +86,10 @@ fn read_text_file(path: &Path, file: &str, wif: bool) -> Result<Vec<u8>, FabricE
             "check the path (e.g. tables/twill.json)",
         )
     };
-    // Checked before opening: opening a FIFO blocks until something writes to it.
+    // Checked before opening, then again on what was opened: the path may be replaced in
+    // between, so it is opened without blocking (a FIFO's open would wait for a writer).
     check(&std::fs::metadata(path).map_err(cannot)?)?;
-    let f = std::fs::File::open(path).map_err(cannot)?;
+    let f = open_nonblocking(path).map_err(cannot)?;
     check(&f.metadata().map_err(cannot)?)?;
     let mut bytes = Vec::new();
     f.take(MAX_FILE_BYTES + 1)
@@ -122,6 +123,19 @@ fn read_text_file(path: &Path, file: &str, wif: bool) -> Result<Vec<u8>, FabricE
         ));
     }
     Ok(bytes)
+}
+
+/// Opens `path` for reading; on Unix with `O_NONBLOCK`, so that a FIFO put in place of a
+/// checked regular file cannot block the open (the flag changes nothing for regular files).
+fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
+    let mut opts = std::fs::OpenOptions::new();
+    opts.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        opts.custom_flags(libc::O_NONBLOCK);
+    }
+    opts.open(path)
 }
 
 fn too_large(file: &str, len: u64) -> FabricError {
@@ -223,5 +237,28 @@ mod tests {
         .unwrap();
         assert_eq!(Fabric::from_path(&wif).unwrap().weave(), plain.weave());
         std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// The open after the check cannot block: a FIFO (what a path swapped after its check could
+    /// be) opens at once with no writer, and the check on the opened file then refuses it.
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_in_place_of_the_checked_file_does_not_block_the_open() {
+        use std::os::unix::fs::FileTypeExt;
+        let fifo = dir("fifo").join("swapped.json");
+        let _ = std::fs::remove_file(&fifo);
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: `c` is a valid NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let (tx, rx) = std::sync::mpsc::channel();
+        let p = fifo.clone();
+        std::thread::spawn(move || {
+            let _ = tx.send(open_nonblocking(&p).map(|f| f.metadata().unwrap().file_type()));
+        });
+        let opened = rx
+            .recv_timeout(std::time::Duration::from_secs(10))
+            .expect("the open of a FIFO blocked");
+        assert!(opened.unwrap().is_fifo());
+        assert!(problem(&fifo).contains("is a FIFO (named pipe), not a regular file"));
     }
 }

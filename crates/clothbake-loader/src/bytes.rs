@@ -143,7 +143,25 @@ pub(crate) fn open_regular(path: &Path, noun: &str) -> Result<std::fs::File, Tab
     if let Some(kind) = crate::atomic::special_kind(&meta.file_type()) {
         return Err(not(kind));
     }
-    std::fs::File::open(path).map_err(|e| TableError::io(path, format!("open the {noun}"), e))
+    // Opened without blocking (the path may have been replaced by a FIFO since it was
+    // checked; `O_NONBLOCK` changes nothing for a regular file), then checked again.
+    let mut opts = std::fs::OpenOptions::new();
+    opts.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        opts.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = opts
+        .open(path)
+        .map_err(|e| TableError::io(path, format!("open the {noun}"), e))?;
+    let meta = file
+        .metadata()
+        .map_err(|e| TableError::io(path, format!("open the {noun}"), e))?;
+    if let Some(kind) = crate::atomic::special_kind(&meta.file_type()) {
+        return Err(not(kind));
+    }
+    Ok(file)
 }
 
 /// Opens `path` for reading ([`open_regular`]) and measures it; an empty file is refused.

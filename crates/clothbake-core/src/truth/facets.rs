@@ -87,7 +87,10 @@ mod tests {
         for n in 0..=64u32 {
             for x in [0.0, 1e-3, 0.37, 0.999, 1.0, 1.7] {
                 let (got, want) = (power(x, f64::from(n)), x.powf(f64::from(n)));
-                assert!((got - want).abs() <= 1e-14 * want, "{x}^{n}: {got} vs {want}");
+                assert!(
+                    (got - want).abs() <= 1e-14 * want,
+                    "{x}^{n}: {got} vs {want}"
+                );
             }
         }
         assert_eq!(power(0.3, 1.0), 0.3);
