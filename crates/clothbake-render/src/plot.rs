@@ -205,6 +205,43 @@ fn register_font() {
     });
 }
 
+/// Most curves one plot holds (`theta_i` of slices, `theta_o` of polar plots): past these the
+/// palette's colours repeat twice over and the curves cannot be told apart.
+pub const MAX_CURVES: usize = 12;
+
+/// Most panels (`phi_i` of slices) one plot holds: each is 500 pixels wide.
+pub const MAX_PANELS: usize = 8;
+
+/// A list of a [`Plot`] with more entries than the plot holds.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TooMany {
+    /// The list: `"theta_i"`, `"phi_i"` or `"theta_o"`.
+    pub list: &'static str,
+    /// Its length.
+    pub len: usize,
+    /// The most it may hold ([`MAX_CURVES`] or [`MAX_PANELS`]).
+    pub max: usize,
+}
+
+impl Plot {
+    /// Checks the lengths of the plot's lists against [`MAX_CURVES`] and [`MAX_PANELS`]
+    /// (which also bound the picture's size); names the first list past its limit.
+    pub fn check(&self) -> Result<(), TooMany> {
+        let lists: &[(&'static str, usize, usize)] = match self {
+            Plot::Slices { theta_i, phi_i } => &[
+                ("theta_i", theta_i.len(), MAX_CURVES),
+                ("phi_i", phi_i.len(), MAX_PANELS),
+            ],
+            Plot::Hemisphere { .. } => &[],
+            Plot::Polar { theta_o, .. } => &[("theta_o", theta_o.len(), MAX_CURVES)],
+        };
+        match lists.iter().find(|(_, len, max)| len > max) {
+            Some(&(list, len, max)) => Err(TooMany { list, len, max }),
+            None => Ok(()),
+        }
+    }
+}
+
 /// The pixel size of a plot.
 pub fn size(plot: &Plot, sources: usize) -> (u32, u32) {
     match plot {
@@ -793,6 +830,12 @@ pub fn write(
     sources: &[Source<'_>],
     overwrite: bool,
 ) -> Result<(), String> {
+    if let Err(t) = plot.check() {
+        return Err(format!(
+            "{} angles in {}, more than the {} a plot holds",
+            t.len, t.list, t.max
+        ));
+    }
     let (w, h) = size(plot, sources.len());
     let ext = path
         .extension()
@@ -832,6 +875,27 @@ pub fn write(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lists_past_their_limits_are_named() {
+        let slices = |curves: usize, panels: usize| Plot::Slices {
+            theta_i: vec![10.0; curves],
+            phi_i: vec![0.0; panels],
+        };
+        assert_eq!(slices(MAX_CURVES, MAX_PANELS).check(), Ok(()));
+        let t = slices(MAX_CURVES + 1, 1).check().unwrap_err();
+        assert_eq!((t.list, t.len, t.max), ("theta_i", 13, 12));
+        assert_eq!(slices(1, MAX_PANELS + 1).check().unwrap_err().list, "phi_i");
+        let polar = Plot::Polar {
+            theta_i: 30.0,
+            phi_i: 0.0,
+            theta_o: vec![20.0; MAX_CURVES + 1],
+        };
+        assert_eq!(polar.check().unwrap_err().list, "theta_o");
+        // The largest plot allowed stays a modest picture.
+        let (w, h) = size(&slices(MAX_CURVES, MAX_PANELS), 2);
+        assert!(u64::from(w) * u64::from(h) * 3 < 16 << 20);
+    }
 
     /// A map whose cell (r, p) holds 1000 r + p: bilinear in the cell indices.
     fn ramp() -> Vec<f64> {

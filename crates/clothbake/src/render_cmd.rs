@@ -309,6 +309,16 @@ pub fn run_plot(a: &PlotArgs) -> Result<String, CliError> {
             }
         }
     };
+    if let Err(t) = p.check() {
+        let flag = t.list.replace('_', "-");
+        return Err(CliError::new(
+            format!(
+                "--{flag} lists {} angles, more than the {} one plot holds",
+                t.len, t.max
+            ),
+            format!("give at most {} angles (or draw several plots)", t.max),
+        ));
+    }
     for o in &outputs {
         plot::write(o, &p, &sources, a.force).map_err(|m| {
             CliError::new(
