@@ -40,12 +40,7 @@ pub fn shipped_files(ext: &str) -> Vec<PathBuf> {
 /// A direction grid of `n_theta` by `n_phi` cells for both the incident and the outgoing
 /// direction.
 pub fn grid(n_theta: u32, n_phi: u32) -> Grid {
-    Grid {
-        n_theta_i: n_theta,
-        n_phi_i: n_phi,
-        n_theta_o: n_theta,
-        n_phi_o: n_phi,
-    }
+    Grid::new(n_theta, n_phi, n_theta, n_phi)
 }
 
 /// The thesis's model of `fabric` (Huo facets, one bounce) as a BSDF, f_r in 1/sr.

@@ -46,6 +46,7 @@ struct Shipped {
     thesis: bool,
 }
 
+/// One of the thesis's samples.
 const fn shipped(
     name: &'static str,
     period: (usize, usize),
@@ -61,20 +62,14 @@ const fn shipped(
     }
 }
 
-/// A preset of real cloth: float length (f + 1) s - 2 r over f crossing threads of spacing s
-/// and radius r (docs/fabric-format.md).
-const fn preset(
-    name: &'static str,
-    period: (usize, usize),
-    warp_len: &'static [f64],
-    weft_len: &'static [f64],
-) -> Shipped {
-    Shipped {
-        name,
-        period,
-        warp_len,
-        weft_len,
-        thesis: false,
+impl Shipped {
+    /// This fabric as a preset of real cloth: float length (f + 1) s - 2 r over f crossing
+    /// threads of spacing s and radius r (docs/fabric-format.md).
+    const fn real(self) -> Shipped {
+        Shipped {
+            thesis: false,
+            ..self
+        }
     }
 }
 
@@ -87,14 +82,14 @@ const SHIPPED: [Shipped; 10] = [
     // One endless warp cylinder (no finite float); the weft never comes up.
     shipped("parallel", (1, 1), &[], &[]),
     // Warp over 1 weft: 2 x 0.3528 - 2 x 0.0924; weft over 1 warp: 2 x 0.1910 - 2 x 0.0924.
-    preset("cotton-poplin", (2, 2), &[0.5208], &[0.1972]),
+    shipped("cotton-poplin", (2, 2), &[0.5208], &[0.1972]).real(),
     // Over 2 at spacing 2.1167, radius 0.7056: 3 x 2.1167 - 2 x 0.7056.
-    preset("wool-twill", (4, 4), &[4.9389], &[4.9389]),
+    shipped("wool-twill", (4, 4), &[4.9389], &[4.9389]).real(),
     // Warp over 4 wefts (0.2222, r 0.0487): 5 x 0.2222 - 2 x 0.0487; weft over 1 warp (0.0833,
     // r 0.0398): 2 x 0.0833 - 2 x 0.0398.
-    preset("silk-charmeuse", (5, 5), &[1.0136], &[0.0870]),
+    shipped("silk-charmeuse", (5, 5), &[1.0136], &[0.0870]).real(),
     // Warp over 1 weft: 2 x 0.3175 - 2 x 0.1117; weft over 1 warp: 2 x 0.2309 - 2 x 0.1117.
-    preset("polyester-taffeta", (2, 2), &[0.4116], &[0.2384]),
+    shipped("polyester-taffeta", (2, 2), &[0.4116], &[0.2384]).real(),
 ];
 
 #[test]

@@ -17,12 +17,7 @@ use serde_json::Value;
 const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/python/read_exr.py");
 
 fn sample_table() -> Table {
-    let grid = Grid {
-        n_theta_i: 2,
-        n_phi_i: 3,
-        n_theta_o: 4,
-        n_phi_o: 5,
-    };
+    let grid = Grid::new(2, 3, 4, 5);
     let meta = Metadata::new(
         "clothbake 0.1.0",
         grid,

@@ -158,20 +158,27 @@ fn each_cell_matches_the_ray_traced_truth() {
         if PRESETS.contains(&file) {
             continue;
         }
-        let f = fabric(file);
-        let model = AnalyticModel::new(&f, FacetModel::Huo);
-        let truth = RayTracer::new(&f, FacetModel::Huo);
-        let mut means = Vec::new();
-        for (n, (wi, wo)) in pairs().into_iter().enumerate() {
-            let (worst, mean, cov) = cell_errors(&model, &truth, wi, wo, 11 + n as u64);
-            eprintln!("{file:13} pair {n}: mean {mean:.4} worst {worst:.4} coverage {cov:.4}");
-            assert!(worst < 0.12, "{file} pair {n}: worst cell {worst}");
-            assert!(cov < 0.04, "{file} pair {n}: coverage off by {cov}");
-            means.push(mean);
-        }
-        let mean = means.iter().sum::<f64>() / means.len() as f64;
-        assert!(mean < 0.04, "{file}: mean cell error {mean}");
+        cells_within(file, 0.12, 0.04, 0.04);
     }
+}
+
+/// Holds every cell of `file` against the truth at [`pairs`]: the worst cell's relative error
+/// under `worst`, the coverage's error under `coverage` at each pair, and the mean cell error
+/// over the pairs under `mean`.
+fn cells_within(file: &str, worst: f64, coverage: f64, mean: f64) {
+    let f = fabric(file);
+    let model = AnalyticModel::new(&f, FacetModel::Huo);
+    let truth = RayTracer::new(&f, FacetModel::Huo);
+    let mut means = Vec::new();
+    for (n, (wi, wo)) in pairs().into_iter().enumerate() {
+        let (w, m, c) = cell_errors(&model, &truth, wi, wo, 11 + n as u64);
+        eprintln!("{file:13} pair {n}: mean {m:.4} worst {w:.4} coverage {c:.4}");
+        assert!(w < worst, "{file} pair {n}: worst cell {w}");
+        assert!(c < coverage, "{file} pair {n}: coverage off by {c}");
+        means.push(m);
+    }
+    let m = means.iter().sum::<f64>() / means.len() as f64;
+    assert!(m < mean, "{file}: mean cell error {m}");
 }
 
 #[test]
@@ -181,19 +188,7 @@ fn each_cell_of_the_presets_stays_within_the_measured_bounds() {
     // pairs), coverage off by up to 0.21, mean cell error 1.5% (denim) to 4.8% (wool-twill).
     // Bounds a little above those: a regression detector, and the documented limit.
     for file in PRESETS {
-        let f = fabric(file);
-        let model = AnalyticModel::new(&f, FacetModel::Huo);
-        let truth = RayTracer::new(&f, FacetModel::Huo);
-        let mut means = Vec::new();
-        for (n, (wi, wo)) in pairs().into_iter().enumerate() {
-            let (worst, mean, cov) = cell_errors(&model, &truth, wi, wo, 11 + n as u64);
-            eprintln!("{file:13} pair {n}: mean {mean:.4} worst {worst:.4} coverage {cov:.4}");
-            assert!(worst < 0.25, "{file} pair {n}: worst cell {worst}");
-            assert!(cov < 0.25, "{file} pair {n}: coverage off by {cov}");
-            means.push(mean);
-        }
-        let mean = means.iter().sum::<f64>() / means.len() as f64;
-        assert!(mean < 0.06, "{file}: mean cell error {mean}");
+        cells_within(file, 0.25, 0.25, 0.06);
     }
 }
 

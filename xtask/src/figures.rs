@@ -174,12 +174,7 @@ fn up_close(root: &Path, dir: &Path, width: u32, height: u32) {
     for file in ["gingham.wif", "twill.json", "denim.wif"] {
         let f = Fabric::from_path(&root.join("tables").join(file)).unwrap();
         let opts = clothbake_bake::BakeOptions {
-            grid: clothbake_loader::Grid {
-                n_theta_i: 16,
-                n_phi_i: 32,
-                n_theta_o: 16,
-                n_phi_o: 32,
-            },
+            grid: clothbake_loader::Grid::new(16, 32, 16, 32),
             spatial: true,
             ..Default::default()
         };

@@ -308,12 +308,7 @@ fn loader_accuracy() {
     use clothbake_tests::accuracy::{baked_brdf, measure};
     let (pairs, seed) = (20_000, 7);
     let fabric = Fabric::from_path(&root().join("tables/twill.json")).expect("tables/twill.json");
-    let grid = |t: u32, p: u32| Grid {
-        n_theta_i: t,
-        n_phi_i: p,
-        n_theta_o: t,
-        n_phi_o: p,
-    };
+    let grid = |t: u32, p: u32| Grid::new(t, p, t, p);
     let cases = [
         (grid(8, 16), Precision::F32),
         (grid(16, 32), Precision::F32),

@@ -17,12 +17,7 @@ use std::sync::Mutex;
 fn setup() -> (Fabric, BakeOptions) {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/twill.json");
     let o = BakeOptions {
-        grid: Grid {
-            n_theta_i: 16,
-            n_phi_i: 32,
-            n_theta_o: 16,
-            n_phi_o: 32,
-        },
+        grid: Grid::new(16, 32, 16, 32),
         ..BakeOptions::default()
     };
     (Fabric::from_path(&p).expect("tables/twill.json"), o)

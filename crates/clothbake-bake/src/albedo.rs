@@ -55,12 +55,7 @@ mod tests {
 
     #[test]
     fn lambertian_table_has_its_albedo() {
-        let g = Grid {
-            n_theta_i: 3,
-            n_phi_i: 4,
-            n_theta_o: 7,
-            n_phi_o: 5,
-        };
+        let g = Grid::new(3, 4, 7, 5);
         let rho = [0.4f32, 0.2, 0.1];
         let values = (0..g.len())
             .flat_map(|_| rho.map(|r| r / std::f32::consts::PI))

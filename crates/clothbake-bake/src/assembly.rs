@@ -204,12 +204,7 @@ mod tests {
     use clothbake_loader::Grid;
 
     fn grid() -> Grid {
-        Grid {
-            n_theta_i: 2,
-            n_phi_i: 4,
-            n_theta_o: 3,
-            n_phi_o: 4,
-        }
+        Grid::new(2, 4, 3, 4)
     }
 
     /// Row `r`'s values: distinct numbers, so that every misplaced value shows.

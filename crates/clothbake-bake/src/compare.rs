@@ -257,12 +257,7 @@ mod tests {
         Table::new(meta, (0..3 * g.len()).map(f).collect()).unwrap()
     }
 
-    const G: Grid = Grid {
-        n_theta_i: 2,
-        n_phi_i: 3,
-        n_theta_o: 4,
-        n_phi_o: 5,
-    };
+    const G: Grid = Grid::new(2, 3, 4, 5);
 
     #[test]
     fn identical_tables() {

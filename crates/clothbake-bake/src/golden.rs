@@ -12,12 +12,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 /// The golden grid: 8 x 16 x 8 x 16 cells.
-pub const GRID: Grid = Grid {
-    n_theta_i: 8,
-    n_phi_i: 16,
-    n_theta_o: 8,
-    n_phi_o: 16,
-};
+pub const GRID: Grid = Grid::new(8, 16, 8, 16);
 
 /// A fresh bake must equal its golden table to a relative 1e-9: in effect bit for bit in f32
 /// (an f32 carries 7 significant digits).

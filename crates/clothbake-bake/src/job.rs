@@ -586,12 +586,7 @@ mod tests {
         // The basket weave has 8 classes: 3 + 16 values a cell against 3.
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables");
         let f = Fabric::from_path(&dir.join("basket.json")).unwrap();
-        let grid = Grid {
-            n_theta_i: 32,
-            n_phi_i: 64,
-            n_theta_o: 32,
-            n_phi_o: 64,
-        };
+        let grid = Grid::new(32, 64, 32, 64);
         let avg = BakeOptions {
             grid,
             ..BakeOptions::default()

@@ -132,12 +132,7 @@ mod tests {
     use super::*;
 
     fn grid(n: [u32; 4]) -> Grid {
-        Grid {
-            n_theta_i: n[0],
-            n_phi_i: n[1],
-            n_theta_o: n[2],
-            n_phi_o: n[3],
-        }
+        Grid::new(n[0], n[1], n[2], n[3])
     }
 
     #[test]

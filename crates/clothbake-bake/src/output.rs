@@ -171,12 +171,7 @@ mod tests {
     use clothbake_loader::{read_table, Grid, Metadata};
 
     fn table() -> Table {
-        let g = Grid {
-            n_theta_i: 2,
-            n_phi_i: 3,
-            n_theta_o: 2,
-            n_phi_o: 4,
-        };
+        let g = Grid::new(2, 3, 2, 4);
         let values = (0..3 * g.len()).map(|k| 0.01 * k as f32).collect();
         Table::new(
             Metadata::new("clothbake test", g, "{}", "{}", "none"),

@@ -15,7 +15,7 @@ use crate::transport::Multiple;
 use clothbake_core::interreflection::{Orders, Ranges, Sampling};
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{
-    AnalyticBsdf, AnalyticModel, Bsdf, Caps, ClassTerms, Fabric, FacetModel, Kernel, RayTracer,
+    AnalyticBsdf, AnalyticModel, Bsdf, Caps, ClassTerms, Fabric, FacetModel, RayTracer,
     SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
 };
 use clothbake_loader::spatial::value_index;
@@ -26,12 +26,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// The default grid: 32 x 64 x 32 x 64 cells (2.8 degrees in theta, 5.6 in phi).
-pub const DEFAULT_GRID: Grid = Grid {
-    n_theta_i: 32,
-    n_phi_i: 64,
-    n_theta_o: 32,
-    n_phi_o: 64,
-};
+pub const DEFAULT_GRID: Grid = Grid::new(32, 64, 32, 64);
 
 /// How each cell is evaluated.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,20 +83,6 @@ impl Default for BakeOptions {
     }
 }
 
-fn caps_name(c: Caps) -> &'static str {
-    match c {
-        Caps::Excluded => "excluded",
-        Caps::Shaded => "shaded",
-    }
-}
-
-fn kernel_name(k: Kernel) -> &'static str {
-    match k {
-        Kernel::Thesis => "thesis",
-        Kernel::Radiometric => "radiometric",
-    }
-}
-
 fn orders_json(o: Orders) -> Value {
     json!({"theta": o.theta, "beta": o.beta, "axial": o.axial})
 }
@@ -142,7 +123,7 @@ impl BakeOptions {
                 v["method"] = json!("raytrace");
                 v["samples"] = json!(samples);
                 v["seed"] = json!(seed);
-                v["caps"] = json!(caps_name(caps));
+                v["caps"] = json!(caps.name());
             }
         }
         v["bounces"] = json!(self.bounces);
@@ -163,7 +144,7 @@ impl BakeOptions {
                     "sampling": sampling_json(p),
                 }),
             };
-            sec["kernel"] = json!(kernel_name(s.kernel));
+            sec["kernel"] = json!(s.kernel.name());
             v["secondary"] = sec;
         }
         if self.spatial {
@@ -679,6 +660,7 @@ pub fn bake(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use clothbake_core::Kernel;
 
     fn twill() -> Fabric {
         Fabric::from_path(
@@ -784,12 +766,7 @@ mod tests {
 
     #[test]
     fn orbits() {
-        let g = Grid {
-            n_theta_i: 1,
-            n_phi_i: 8,
-            n_theta_o: 1,
-            n_phi_o: 8,
-        };
+        let g = Grid::new(1, 8, 1, 8);
         let all = [Symmetry::MirrorX, Symmetry::MirrorY, Symmetry::Rotate180];
         // Each orbit of the full group has 4 elements (no cell centre is on a mirror line).
         let canonical = (0..8)

@@ -28,12 +28,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
 
 /// The largest coarse grid: 8 x 16 x 8 x 16 nodes (11 degrees in theta, 22.5 in phi).
-pub const COARSE: Grid = Grid {
-    n_theta_i: 8,
-    n_phi_i: 16,
-    n_theta_o: 8,
-    n_phi_o: 16,
-};
+pub const COARSE: Grid = Grid::new(8, 16, 8, 16);
 
 /// Primary rays per coarse node and round.
 pub const PATHS: usize = 65_536;
@@ -54,12 +49,12 @@ pub const SEED: u64 = 1;
 
 /// The coarse grid for a table grid: [`COARSE`], no finer than the table on any axis.
 pub fn coarse_grid(table: &Grid) -> Grid {
-    Grid {
-        n_theta_i: table.n_theta_i.min(COARSE.n_theta_i),
-        n_phi_i: table.n_phi_i.min(COARSE.n_phi_i),
-        n_theta_o: table.n_theta_o.min(COARSE.n_theta_o),
-        n_phi_o: table.n_phi_o.min(COARSE.n_phi_o),
-    }
+    Grid::new(
+        table.n_theta_i.min(COARSE.n_theta_i),
+        table.n_phi_i.min(COARSE.n_phi_i),
+        table.n_theta_o.min(COARSE.n_theta_o),
+        table.n_phi_o.min(COARSE.n_phi_o),
+    )
 }
 
 /// How the multiple-bounce part is made, for the table's `options_json` (`info` shows it).

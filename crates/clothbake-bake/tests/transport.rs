@@ -95,12 +95,7 @@ fn the_tables_multiple_bounce_part_matches_a_brute_force_path_trace() {
 #[test]
 fn the_multiple_part_is_the_same_for_any_thread_count_and_row_split() {
     let f = fabric("twill");
-    let table = Grid {
-        n_theta_i: 4,
-        n_phi_i: 8,
-        n_theta_o: 4,
-        n_phi_o: 8,
-    };
+    let table = Grid::new(4, 8, 4, 8);
     let cancel = AtomicBool::new(false);
     let rows: Vec<usize> = (0..(table.n_theta_i * table.n_phi_i) as usize).collect();
     let values = |threads: usize, split: &[&[usize]]| -> Vec<[f64; 3]> {
@@ -142,12 +137,7 @@ fn a_full_transport_bake_is_bit_identical_for_any_thread_count_and_row_split() {
     use clothbake_bake::{bake, BakeOptions, Baker};
     let f = fabric("twill");
     let o = BakeOptions {
-        grid: Grid {
-            n_theta_i: 2,
-            n_phi_i: 4,
-            n_theta_o: 2,
-            n_phi_o: 4,
-        },
+        grid: Grid::new(2, 4, 2, 4),
         bounces: ALL_BOUNCES,
         ..BakeOptions::default()
     };

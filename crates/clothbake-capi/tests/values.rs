@@ -12,12 +12,7 @@ fn table(name: &str, value: f32) -> PathBuf {
     let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("capi-values");
     std::fs::create_dir_all(&d).unwrap();
     let p = d.join(name);
-    let g = Grid {
-        n_theta_i: 2,
-        n_phi_i: 4,
-        n_theta_o: 2,
-        n_phi_o: 4,
-    };
+    let g = Grid::new(2, 4, 2, 4);
     let header = serde_json::to_value(Metadata::new("clothbake test", g, "{}", "{}", "none"));
     let values = vec![value; 3 * g.len()];
     write_container(&p, ContainerKind::Table, &header.unwrap(), &values, true).unwrap();

@@ -98,6 +98,38 @@ pub struct ActiveTable {
     pub entries: Vec<(f64, Occluder)>,
 }
 
+/// The scan's choice of the next active occluder (sec. 3.2): `o`, at index `k` and farther out
+/// than `cur`, becomes `best` when its common tangent with `cur` lies in (0, `upper`) and is
+/// steeper than best's.
+fn consider(cur: &Occluder, o: &Occluder, k: usize, upper: f64, best: &mut Option<(f64, usize)>) {
+    if let Some(psi) = common_tangent(cur, o) {
+        if psi > 0.0 && psi < upper && best.is_none_or(|(b, _)| psi > b) {
+            *best = Some((psi, k));
+        }
+    }
+}
+
+/// One step of the scan: enters `cur` for the elevations down to the tangent to `best` (or to
+/// 0 when there is none, which ends the table); returns the next occluder's index.
+fn advance(
+    entries: &mut Vec<(f64, Occluder)>,
+    cur: Occluder,
+    best: Option<(f64, usize)>,
+    upper: &mut f64,
+) -> Option<usize> {
+    match best {
+        Some((psi, k)) => {
+            entries.push((psi, cur));
+            *upper = psi;
+            Some(k)
+        }
+        None => {
+            entries.push((0.0, cur));
+            None
+        }
+    }
+}
+
 impl ActiveTable {
     /// The cylinder scan of sec. 3.2: start from the nearest occluder (met first by a vertical
     /// scan line), then repeatedly swing the scan line toward the horizon, tangent to the current
@@ -119,25 +151,13 @@ impl ActiveTable {
             // one is steepest below the current range.
             let mut best: Option<(f64, usize)> = None;
             for (k, o) in occluders.iter().enumerate() {
-                if k == j || o.u <= cur.u {
-                    continue;
-                }
-                if let Some(psi) = common_tangent(&cur, o) {
-                    if psi > 0.0 && psi < upper && best.is_none_or(|(b, _)| psi > b) {
-                        best = Some((psi, k));
-                    }
+                if k != j && o.u > cur.u {
+                    consider(&cur, o, k, upper, &mut best);
                 }
             }
-            match best {
-                Some((psi, k)) => {
-                    entries.push((psi, cur));
-                    upper = psi;
-                    j = k;
-                }
-                None => {
-                    entries.push((0.0, cur));
-                    break;
-                }
+            match advance(&mut entries, cur, best, &mut upper) {
+                Some(k) => j = k,
+                None => break,
             }
         }
         ActiveTable { entries }
@@ -199,27 +219,16 @@ impl ActiveTable {
                     break;
                 }
                 if o.u > cur.u {
-                    if let Some(psi) = common_tangent(&cur, &o) {
-                        if psi > 0.0 && psi < upper && best.is_none_or(|(b, _)| psi > b) {
-                            best = Some((psi, k));
-                        }
-                    }
+                    consider(&cur, &o, k, upper, &mut best);
                 }
                 k += 1;
             }
             if !lazy.ordered {
                 return ActiveTable::scan(&lazy.rest());
             }
-            match best {
-                Some((psi, k)) => {
-                    entries.push((psi, cur));
-                    upper = psi;
-                    j = k;
-                }
-                None => {
-                    entries.push((0.0, cur));
-                    break;
-                }
+            match advance(&mut entries, cur, best, &mut upper) {
+                Some(k) => j = k,
+                None => break,
             }
         }
         ActiveTable { entries }

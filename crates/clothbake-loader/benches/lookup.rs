@@ -18,12 +18,7 @@ const WARM: usize = 64;
 /// Pairs of the random pool (24 MiB of pairs; the table's values are 95 MB at f16, 190 MB at f32).
 const RANDOM: usize = 1 << 20;
 
-const GRID: Grid = Grid {
-    n_theta_i: 32,
-    n_phi_i: 64,
-    n_theta_o: 32,
-    n_phi_o: 64,
-};
+const GRID: Grid = Grid::new(32, 64, 32, 64);
 
 fn brdf(memory: Memory, reciprocal: bool) -> Brdf {
     let values = (0..GRID.len() * 3)

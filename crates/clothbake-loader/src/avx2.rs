@@ -501,12 +501,7 @@ mod tests {
     fn positions_match_f64_angles_over_the_hemisphere() {
         probe::AVX2.require();
         assert!(available());
-        let g = Grid {
-            n_theta_i: 32,
-            n_phi_i: 64,
-            n_theta_o: 90,
-            n_phi_o: 360,
-        };
+        let g = Grid::new(32, 64, 90, 360);
         // The positions need the lookup's constants only.
         let nodes = Nodes::empty(&g);
         let n = [g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o];

@@ -544,12 +544,7 @@ mod tests {
 
     #[test]
     fn runs_are_the_lanes_at_their_offsets_or_none() {
-        let g = Grid {
-            n_theta_i: 2,
-            n_phi_i: 3,
-            n_theta_o: 4,
-            n_phi_o: 5,
-        };
+        let g = Grid::new(2, 3, 4, 5);
         let node = |a: u32, b: u32, c: u32, d: u32| [a as f32, b as f32, (10 * c + d) as f32];
         let nodes = Nodes::new(&g, &node, false);
         let Values::F32(v) = &nodes.values else {
@@ -622,22 +617,22 @@ mod tests {
         lines
     }
 
-    #[test]
-    fn a_lookup_reads_few_cache_lines() {
-        // The default grid; random angles over the whole domain (azimuths over [-pi, 2 pi)).
-        let g = Grid {
-            n_theta_i: 32,
-            n_phi_i: 64,
-            n_theta_o: 32,
-            n_phi_o: 64,
-        };
-        let mut state = 1u64;
-        let mut next = move || {
+    /// Uniform numbers in [0, 1) from a 64-bit LCG seeded with `seed`.
+    fn uniform(seed: u64) -> impl FnMut() -> f32 {
+        let mut state = seed;
+        move || {
             state = state
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        }
+    }
+
+    #[test]
+    fn a_lookup_reads_few_cache_lines() {
+        // The default grid; random angles over the whole domain (azimuths over [-pi, 2 pi)).
+        let g = Grid::new(32, 64, 32, 64);
+        let mut next = uniform(1);
         let pi = std::f32::consts::PI;
         let angles: Vec<[f32; 4]> = (0..100_000)
             .map(|_| {
@@ -675,13 +670,7 @@ mod tests {
     fn the_tiles_blend_as_the_plain_grid_bit_for_bit() {
         // The blend written straight from the node function (no layout): the corner's rules,
         // the 16 nodes by their indices, summed in the kernel's order.
-        let mut state = 5u64;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = uniform(5);
         let node = |a: u32, b: u32, c: u32, d: u32| {
             let x = (a * 7919 + b * 104_729 + c * 31 + d * 1009) as f32;
             [
@@ -699,12 +688,7 @@ mod tests {
             [3, 2, 2, 3],
             [2, 3, 1, 4],
         ] {
-            let g = Grid {
-                n_theta_i: n[0],
-                n_phi_i: n[1],
-                n_theta_o: n[2],
-                n_phi_o: n[3],
-            };
+            let g = Grid::new(n[0], n[1], n[2], n[3]);
             for f16 in [true, false] {
                 let nodes = Nodes::new4(&g, &node, f16);
                 let stored = |a, b, c, d| {

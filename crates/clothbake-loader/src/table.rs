@@ -64,6 +64,17 @@ pub struct Grid {
 }
 
 impl Grid {
+    /// The grid of `n_theta_i x n_phi_i x n_theta_o x n_phi_o` cells, unchecked (as a struct
+    /// literal; [`Grid::validate`] checks).
+    pub const fn new(n_theta_i: u32, n_phi_i: u32, n_theta_o: u32, n_phi_o: u32) -> Grid {
+        Grid {
+            n_theta_i,
+            n_phi_i,
+            n_theta_o,
+            n_phi_o,
+        }
+    }
+
     /// Number of cells. Saturates at `usize::MAX` for absurd grids that [`Grid::validate`]
     /// rejects.
     pub fn len(&self) -> usize {

@@ -9,12 +9,7 @@ use clothbake_loader::{
 };
 
 /// A grid with a different size on every axis, so that layout mix-ups show.
-const GRID: Grid = Grid {
-    n_theta_i: 2,
-    n_phi_i: 3,
-    n_theta_o: 4,
-    n_phi_o: 5,
-};
+const GRID: Grid = Grid::new(2, 3, 4, 5);
 
 fn sample_meta(grid: Grid) -> Metadata {
     Metadata::new(
@@ -134,19 +129,9 @@ fn grid_index_and_cell_centres() {
     GRID.validate().unwrap();
     let zero = Grid { n_phi_o: 0, ..GRID };
     assert!(message(zero.validate().unwrap_err()).contains("n_phi_o is 0"));
-    let huge = Grid {
-        n_theta_i: 1 << 16,
-        n_phi_i: 1 << 16,
-        n_theta_o: 2,
-        n_phi_o: 1,
-    };
+    let huge = Grid::new(1 << 16, 1 << 16, 2, 1);
     assert!(message(huge.validate().unwrap_err()).contains("more than the limit"));
-    let absurd = Grid {
-        n_theta_i: u32::MAX,
-        n_phi_i: u32::MAX,
-        n_theta_o: u32::MAX,
-        n_phi_o: 9,
-    };
+    let absurd = Grid::new(u32::MAX, u32::MAX, u32::MAX, 9);
     assert!(absurd.validate().is_err());
 }
 

@@ -18,12 +18,7 @@ mod probe {
     include!("../build/probe.rs");
 }
 
-const GRID: Grid = Grid {
-    n_theta_i: 5,
-    n_phi_i: 7,
-    n_theta_o: 4,
-    n_phi_o: 9,
-};
+const GRID: Grid = Grid::new(5, 7, 4, 9);
 
 fn table() -> Table {
     let values = (0..GRID.len() * 3)

@@ -53,12 +53,7 @@ fn parse_v1(b: &[u8]) -> Table {
     let meta = Metadata {
         format_version: c.u32(),
         tool: c.text(),
-        grid: Grid {
-            n_theta_i: c.u32(),
-            n_phi_i: c.u32(),
-            n_theta_o: c.u32(),
-            n_phi_o: c.u32(),
-        },
+        grid: Grid::new(c.u32(), c.u32(), c.u32(), c.u32()),
         centring: c.text(),
         quantity: c.text(),
         units: c.text(),

@@ -6,12 +6,7 @@ use clothbake_loader::{
     write_exr, Brdf, Grid, Memory, Metadata, Options, Precision, Table, TableError,
 };
 
-const GRID: Grid = Grid {
-    n_theta_i: 4,
-    n_phi_i: 6,
-    n_theta_o: 5,
-    n_phi_o: 8,
-};
+const GRID: Grid = Grid::new(4, 6, 5, 8);
 
 fn table_of(grid: Grid, f: impl Fn(u32, u32, u32, u32, usize) -> f32) -> Table {
     let mut values = vec![0f32; grid.len() * 3];
@@ -194,12 +189,7 @@ fn beyond_the_last_centre_the_last_ring_is_held_and_below_the_horizon_is_zero() 
 
 #[test]
 fn reciprocal_lookups_are_symmetric_averages() {
-    let g = Grid {
-        n_theta_i: 4,
-        n_phi_i: 6,
-        n_theta_o: 4,
-        n_phi_o: 6,
-    };
+    let g = Grid::new(4, 6, 4, 6);
     let t = table_of(g, wiggly);
     let plain = Brdf::from_table(t.clone(), opts()).unwrap();
     let sym = Brdf::from_table(

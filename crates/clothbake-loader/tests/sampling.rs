@@ -4,12 +4,7 @@
 use clothbake_loader::{Brdf, Grid, Metadata, Options, Table};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
-const GRID: Grid = Grid {
-    n_theta_i: 8,
-    n_phi_i: 16,
-    n_theta_o: 6,
-    n_phi_o: 12,
-};
+const GRID: Grid = Grid::new(8, 16, 6, 12);
 
 /// A glossy lobe around the mirror direction plus a diffuse part, zero beyond 70 degrees
 /// of incidence (an empty region the sampler must still cover, as interpolation leaks into it).

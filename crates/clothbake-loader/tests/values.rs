@@ -10,12 +10,7 @@ use clothbake_loader::{
     Precision, Table, MAX_VALUE,
 };
 
-const GRID: Grid = Grid {
-    n_theta_i: 4,
-    n_phi_i: 8,
-    n_theta_o: 4,
-    n_phi_o: 8,
-};
+const GRID: Grid = Grid::new(4, 8, 4, 8);
 
 fn dir(name: &str) -> PathBuf {
     let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("loader-values-{name}"));

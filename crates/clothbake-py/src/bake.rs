@@ -134,12 +134,7 @@ pub fn bake(
     spatial: bool,
 ) -> PyResult<Option<PyTable>> {
     let bounces = bounces_arg(bounces.as_ref())?;
-    let grid = Grid {
-        n_theta_i: res.0,
-        n_phi_i: res.1,
-        n_theta_o: res.2,
-        n_phi_o: res.3,
-    };
+    let grid = Grid::new(res.0, res.1, res.2, res.3);
     grid.validate().map_err(|e| bad("res", e))?;
     let raytrace = choice(
         "method",

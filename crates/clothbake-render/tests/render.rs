@@ -301,12 +301,7 @@ fn table_shader_agrees_with_the_model() {
     use clothbake_render::shade::Shader;
     let twill = fabric("twill");
     let opts = BakeOptions {
-        grid: clothbake_loader::Grid {
-            n_theta_i: 16,
-            n_phi_i: 32,
-            n_theta_o: 16,
-            n_phi_o: 32,
-        },
+        grid: clothbake_loader::Grid::new(16, 32, 16, 32),
         ..BakeOptions::default()
     };
     let table = bake(&twill, &opts, &|_| {}, &AtomicBool::new(false))

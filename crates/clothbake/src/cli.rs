@@ -933,12 +933,7 @@ pub fn parse_res(s: &str) -> Result<Grid, String> {
             }
         };
     }
-    let g = Grid {
-        n_theta_i: n[0],
-        n_phi_i: n[1],
-        n_theta_o: n[2],
-        n_phi_o: n[3],
-    };
+    let g = Grid::new(n[0], n[1], n[2], n[3]);
     let cells: u64 = n.iter().map(|&x| u64::from(x)).product();
     if cells > clothbake_loader::MAX_CELLS {
         return Err(format!(

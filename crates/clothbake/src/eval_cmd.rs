@@ -6,8 +6,8 @@ use crate::report::{self, Report};
 use clothbake_core::interreflection::Ranges;
 use clothbake_core::pathtrace::PathOptions;
 use clothbake_core::{
-    AnalyticModel, Caps, Fabric, FabricError, FacetModel, Kernel, PlainNaming, RayTracer,
-    Reflection, Secondary, SecondaryMethod, SecondaryOptions, Transport, Variant,
+    AnalyticModel, Caps, Fabric, FabricError, FacetModel, PlainNaming, RayTracer, Reflection,
+    Secondary, SecondaryMethod, SecondaryOptions, Transport, Variant,
 };
 use std::path::Path;
 
@@ -176,11 +176,11 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
             "variant {}, {bounces}",
             Variant::from(args.model.variant).name()
         ),
-        Method::Raytrace => format!("caps {}, {bounces}", caps_name(args.caps.into())),
+        Method::Raytrace => format!("caps {}, {bounces}", Caps::from(args.caps).name()),
     };
     let secondary = secondary.map(|o| match args.method {
         Method::Analytic => describe_secondary(&o),
-        Method::Raytrace => format!("path tracer, {} kernel", kernel_name(o.kernel)),
+        Method::Raytrace => format!("path tracer, {} kernel", o.kernel.name()),
     });
     let rep = Report {
         fabric_name: fabric.name(),
@@ -231,21 +231,7 @@ pub fn describe_secondary(o: &SecondaryOptions) -> String {
             if p.exact_solid_angle { "exact" } else { "area" }
         ),
     };
-    format!("{how}, {} kernel", kernel_name(o.kernel))
-}
-
-fn kernel_name(k: Kernel) -> &'static str {
-    match k {
-        Kernel::Thesis => "thesis",
-        Kernel::Radiometric => "radiometric",
-    }
-}
-
-fn caps_name(c: Caps) -> &'static str {
-    match c {
-        Caps::Excluded => "excluded",
-        Caps::Shaded => "shaded",
-    }
+    format!("{how}, {} kernel", o.kernel.name())
 }
 
 /// Reads the fabric of `--weave` (JSON or WIF draft, with the draft's size flags; or a shipped

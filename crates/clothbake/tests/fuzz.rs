@@ -374,12 +374,7 @@ fn files_with(ext: &str) -> Vec<Vec<u8>> {
     paths.iter().map(|p| std::fs::read(p).unwrap()).collect()
 }
 
-const GRID: Grid = Grid {
-    n_theta_i: 2,
-    n_phi_i: 4,
-    n_theta_o: 2,
-    n_phi_o: 4,
-};
+const GRID: Grid = Grid::new(2, 4, 2, 4);
 
 fn small_table() -> Table {
     let fabric = std::fs::read_to_string(tables().join("plain.json")).unwrap();

@@ -69,6 +69,16 @@ pub enum Kernel {
     Radiometric,
 }
 
+impl Kernel {
+    /// The kernel's name, as the command line and the tables' options spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kernel::Thesis => "thesis",
+            Kernel::Radiometric => "radiometric",
+        }
+    }
+}
+
 /// The four components of the secondary reflection (thesis intensity units), RGB.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Secondary {

@@ -51,6 +51,16 @@ pub enum Caps {
     Shaded,
 }
 
+impl Caps {
+    /// The setting's name, as the command line and the tables' options spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Caps::Excluded => "excluded",
+            Caps::Shaded => "shaded",
+        }
+    }
+}
+
 /// A ray's first yarn hit.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Hit {
