@@ -281,20 +281,16 @@ pub fn write_part(path: &Path, part: &Part, overwrite: bool) -> Result<(), Table
 /// Writes a shard or checkpoint file of `rows` (increasing) whose values, `count` in all,
 /// `chunks` gives row by row (see [`write_part`]).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn write_rows<I>(
+pub(crate) fn write_rows(
     path: &Path,
     kind: Kind,
     shard: Option<ShardId>,
     meta: &Metadata,
     rows: &[usize],
     count: u64,
-    chunks: I,
+    chunks: impl IntoIterator<Item = impl AsRef<[f32]>>,
     overwrite: bool,
-) -> Result<(), TableError>
-where
-    I: IntoIterator,
-    I::Item: AsRef<[f32]>,
-{
+) -> Result<(), TableError> {
     let header = Header {
         shard,
         rows: ranges(rows.iter().copied()),

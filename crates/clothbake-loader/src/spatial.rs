@@ -21,6 +21,7 @@ use crate::lookup::{has_value, pad4, SimdPath};
 use crate::nodes::{Nodes, Values};
 use crate::stored::Samples;
 use crate::table::Grid;
+use clothbake_bsdf::Footprint;
 
 /// Most crossing cells a spatial table's period may have (2^16): the layout is stored as JSON
 /// in the header.
@@ -404,7 +405,7 @@ impl SpatialLookup {
         if !has_value(wi, wo) {
             return Some([0.0; 3]);
         }
-        Some(self.eval_footprint(simd, wi, wo, u, v, width))
+        Some(self.eval_footprint(simd, wi, wo, Footprint { u, v, width }))
     }
 
     /// A point's f_r: its cell's `rho_d D + S` (its coverage cancels; where the class is not
@@ -429,7 +430,7 @@ impl SpatialLookup {
         self.point(SimdPath::Avx2, wi, wo, u, v)
     }
 
-    /// [`SpatialLookup::eval_at`] of a footprint of side `width` in (0, 1), both directions
+    /// [`SpatialLookup::eval_at`] of a footprint whose side is in (0, 1), both directions
     /// above the horizon.
     #[inline(never)]
     fn eval_footprint(
@@ -437,14 +438,12 @@ impl SpatialLookup {
         simd: SimdPath,
         wi: [f32; 3],
         wo: [f32; 3],
-        u: f64,
-        v: f64,
-        width: f64,
+        at: Footprint,
     ) -> [f32; 3] {
         let Some(o) = angles(wo) else {
             return [0.0; 3];
         };
-        let seen = self.seen(u, v, width);
+        let seen = self.seen(at.u, at.v, at.width);
         let (mut num, mut den) = ([0.0f32; 3], 0.0f32);
         for (k, (&share, a)) in seen.share.iter().zip(&seen.albedo).enumerate() {
             if share <= 0.0 {
