@@ -7,8 +7,9 @@ length r from the sheet's centre, azimuth phi, follows the sphere (polar angle r
 the contact angle; beyond, it hangs along a profile in the vertical plane at azimuth phi
 whose slope relaxes toward the vertical and, near the floor, toward the floor (a smooth
 skirt that settles on the floor), kept outside the ball (it rests on the ball until it hangs
-free), with folds: the hanging part bulges outward by 0.5 + 0.5 sin(k phi), more the lower it
-hangs. Arc length is kept along each radial line, so the UVs
+free), with pleats: the hanging part stands out in FOLDS ridges around the ball (a squared sine of
+irregular phase and height, ridges narrower than the valleys between them), more the lower it
+hangs, up to FOLD_DEPTH at the hem. Arc length is kept along each radial line, so the UVs
 (the sheet's coordinates) stay close to an isometric parameterisation and weave periods keep
 their size. Not a cloth simulation: a shape that reads as a cloth over a ball.
 """
@@ -18,7 +19,8 @@ import numpy as np
 SPHERE_RADIUS = 1.0
 HALF_SIDE = 3.0
 CONTACT = np.radians(62.0)  # polar angle where the cloth leaves the sphere
-FOLDS = 8  # folds around the skirt
+FOLDS = 9  # folds around the skirt
+FOLD_DEPTH = 0.42  # how far a fold's ridge stands out at the hem
 LIFT = 0.012  # the cloth's distance from the sphere and the floor
 
 
@@ -67,8 +69,12 @@ def vertices(n):
     rho_on = ro * np.sin(theta)
     z_on = SPHERE_RADIUS + ro * np.cos(theta)
     t = np.maximum(r - r_c, 0.0)
-    depth = np.clip(t / 1.2, 0.0, 1.0)
-    fold = 0.22 * depth * (0.5 + 0.5 * np.sin(FOLDS * phi + 0.6 * np.sin(3 * phi)))
+    depth = np.clip(t / 0.9, 0.0, 1.0)
+    # Ridges narrower than the valleys between them (a squared sine), of irregular spacing
+    # and height: the pleats of cloth hanging from a round support.
+    wave = 0.5 + 0.5 * np.sin(FOLDS * phi + 0.7 * np.sin(3 * phi) + 0.4 * np.sin(5 * phi))
+    height = 1.0 + 0.35 * np.sin(2 * phi + 1.3)
+    fold = FOLD_DEPTH * depth * height * wave**2
     rho_off, z_off = _profile(t, fold)
     rho = np.where(on, rho_on, rho_off)
     z = np.where(on, z_on, z_off)
