@@ -75,12 +75,26 @@ fn close(a: f64, b: f64, rel: f64) -> bool {
 fn each_cell_of_the_table_is_the_models_reflection_there() {
     // The loader's point lookup (width 0) at a grid node, in every crossing cell, against the
     // model's own per-cell reflection and coverage (AnalyticModel::intensity_in): the classes'
-    // albedo factoring, the row packing, the file layout and the cell location all in one.
-    for file in ["twill.json", "satin5.json", "gingham.wif"] {
+    // albedo factoring, the row packing, the file layout, the cell location and the sharing
+    // of mirror-image classes all in one. Classes held: the pieces of one float at mirrored
+    // places along it (first and last, second and second-to-last) are mirror images, with
+    // their neighbourhoods, so a float of n pieces needs ceil(n / 2): the twill's 2-piece warp
+    // float 1 and its weft piece 1 (3 classes, 2 held); the satin's 4-piece float 2 and its
+    // weft piece 1 (5, 3); the basket's four warp pieces (two threads side by side, each
+    // float two pieces long) mirror one another in x and y, likewise its four weft pieces
+    // (8, 2); the gingham's one-piece warp and weft floats, which no mirror maps onto each
+    // other (2, 2).
+    for (file, stored) in [
+        ("twill.json", 2),
+        ("satin5.json", 3),
+        ("gingham.wif", 2),
+        ("basket.json", 2),
+    ] {
         let f = fabric(file);
         let model = AnalyticModel::new(&f, FacetModel::Huo);
         let brdf = Brdf::from_table(baked(&f, true), Options::default()).unwrap();
-        assert!(brdf.spatial().is_some());
+        let held = brdf.spatial().unwrap().stored_classes();
+        assert_eq!(held, stored, "{file}: {held} classes held");
         for (wi, wo) in node_pairs() {
             for (cell, u, v) in cell_centres(&model) {
                 let local = model.intensity_in(wi, wo, cell, None);
@@ -229,6 +243,37 @@ fn footprints_move_from_the_cell_to_the_average() {
         .iter()
         .fold((f32::MAX, f32::MIN), |(a, b), &x| (a.min(x), b.max(x)));
     assert!(hi > 1.1 * lo, "the twill's cells are alike: {vals:?}");
+}
+
+#[test]
+fn mirror_images_are_shared_in_half_float_tables_too() {
+    // The basket from a half-float OpenEXR file: its mirror images differ by up to a rounding
+    // of the half floats, and are still held once; every cell's lookup against the same table
+    // in floats (shared at the floats' tolerance) within half-float precision.
+    let dir = std::env::temp_dir().join(format!("clothbake-mirror-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = fabric("basket.json");
+    let t = baked(&f, true);
+    let exr = dir.join("basket.exr");
+    clothbake_loader::write_exr(&exr, &t, clothbake_loader::Precision::F16, false).unwrap();
+    let half = Brdf::open(&exr, Options::default()).unwrap();
+    assert_eq!(half.spatial().unwrap().stored_classes(), 2);
+    let full = Brdf::from_table(t, Options::default()).unwrap();
+    let model = AnalyticModel::new(&f, FacetModel::Huo);
+    for (wi, wo) in node_pairs() {
+        for (_, u, v) in cell_centres(&model) {
+            let a = half.eval_at(f32s(wi), f32s(wo), u, v, 0.0);
+            let b = full.eval_at(f32s(wi), f32s(wo), u, v, 0.0);
+            for k in 0..3 {
+                let (a, b) = (f64::from(a[k]), f64::from(b[k]));
+                assert!(
+                    close(a, b, 2e-3),
+                    "cell at ({u}, {v}) channel {k}: {a} vs {b}"
+                );
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -252,8 +252,87 @@ fn angles(w: [f32; 3]) -> Option<(f32, f32)> {
 pub struct SpatialLookup {
     layout: Spatial,
     grid: Grid,
-    /// Class pair m's nodes.
+    /// Each class's stored class and the mirror ([`Mirror`]) that maps it onto that one.
+    shared: Vec<(u32, Mirror)>,
+    /// Stored class pair m's nodes.
     pairs: Vec<Nodes>,
+}
+
+/// A mirror of the cloth's frame, as bits: 1 negates x (the weft direction), 2 negates y (the
+/// warp direction), 3 both (a half turn about the normal); 0 is none.
+type Mirror = u8;
+
+/// `w` mirrored by `m`.
+#[inline(always)]
+fn mirrored(w: [f32; 3], m: Mirror) -> [f32; 3] {
+    let sx = if m & 1 != 0 { -1.0 } else { 1.0 };
+    let sy = if m & 2 != 0 { -1.0 } else { 1.0 };
+    [w[0] * sx, w[1] * sy, w[2]]
+}
+
+/// The azimuth cell (of `n`) whose centre `m` moves cell `p`'s centre to; `None` for a mirror
+/// in x on an odd number of cells, which maps centres between cells.
+fn mirrored_cell(p: u32, n: u32, m: Mirror) -> Option<u32> {
+    match m {
+        0 => Some(p),
+        2 => Some(n - 1 - p),
+        _ if n % 2 == 1 => None,
+        1 => Some((n / 2 + n - 1 - p) % n),
+        _ => Some((p + n / 2) % n),
+    }
+}
+
+/// True when class `c`'s values and visible areas equal class `j`'s mirrored by `m` at every
+/// grid cell, to `tol` of the larger (the stored precision: a mirror image evaluates in
+/// another order and rounds apart).
+fn mirror_of(
+    layout: &Spatial,
+    grid: &Grid,
+    values: &Samples,
+    (c, j, m): (usize, usize, Mirror),
+    tol: f32,
+) -> bool {
+    let n = grid.len();
+    let close = |a: f32, b: f32| (a - b).abs() <= tol * a.abs().max(b.abs()) + 1e-12;
+    let (npi, npo) = (grid.n_phi_i, grid.n_phi_o);
+    let (Some(pi_map), Some(po_map)) = (
+        (0..npi)
+            .map(|p| mirrored_cell(p, npi, m))
+            .collect::<Option<Vec<_>>>(),
+        (0..npo)
+            .map(|p| mirrored_cell(p, npo, m))
+            .collect::<Option<Vec<_>>>(),
+    ) else {
+        return false;
+    };
+    let nto = grid.n_theta_o as usize;
+    let vis = |k: usize, to: usize, po: usize| layout.visible[(k * nto + to) * npo as usize + po];
+    for to in 0..nto {
+        for (po, &q) in po_map.iter().enumerate() {
+            if !close(vis(c, to, po), vis(j, to, q as usize)) {
+                return false;
+            }
+        }
+    }
+    for ti in 0..grid.n_theta_i {
+        for pi in 0..npi {
+            for to in 0..grid.n_theta_o {
+                for po in 0..npo {
+                    let a = grid.index(ti, pi, to, po);
+                    let b = grid.index(ti, pi_map[pi as usize], to, po_map[po as usize]);
+                    for d in 0..2 {
+                        if !close(
+                            values.get(2 * (c * n + a) + d),
+                            values.get(2 * (j * n + b) + d),
+                        ) {
+                            return false;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    true
 }
 
 /// What a footprint of the period sees of each class.
@@ -267,15 +346,40 @@ struct Seen {
 impl SpatialLookup {
     /// The lookup of a table's class values (`values`, as [`Spatial::values_len`] counts them),
     /// held in half floats when `f16`.
+    ///
+    /// A class that is another's mirror image (a mirror of the frame in x, y or both; e.g. the
+    /// basket's two halves of a float), to the stored precision (1.5e-3 of the larger value
+    /// for half floats, 1e-5 for floats) at every grid cell, is held once: its lookups read the
+    /// other's nodes at the mirrored directions.
     pub(crate) fn new(layout: Spatial, grid: Grid, values: &Samples, f16: bool) -> SpatialLookup {
         debug_assert_eq!(values.len(), layout.values_len(&grid));
-        let k = layout.classes as usize;
         let n = grid.len();
+        let tol = if matches!(values, Samples::F16(_)) {
+            1.5e-3
+        } else {
+            1e-5
+        };
+        // Stored classes (their index in the table) and each class's (stored, mirror).
+        let mut stored: Vec<usize> = Vec::new();
+        let mut shared = Vec::with_capacity(layout.classes as usize);
+        for c in 0..layout.classes as usize {
+            let found = stored.iter().enumerate().find_map(|(s, &j)| {
+                [1, 2, 3]
+                    .into_iter()
+                    .find(|&m| mirror_of(&layout, &grid, values, (c, j, m), tol))
+                    .map(|m| (s as u32, m))
+            });
+            shared.push(found.unwrap_or_else(|| {
+                stored.push(c);
+                ((stored.len() - 1) as u32, 0)
+            }));
+        }
+        let k = stored.len();
         let pairs = (0..k.div_ceil(2))
             .map(|m| {
-                let at = |class: usize, c: usize, j: usize| {
-                    if class < k {
-                        values.get(2 * (class * n + c) + j)
+                let at = |s: usize, c: usize, j: usize| {
+                    if s < k {
+                        values.get(2 * (stored[s] * n + c) + j)
                     } else {
                         0.0
                     }
@@ -298,8 +402,18 @@ impl SpatialLookup {
         SpatialLookup {
             layout,
             grid,
+            shared,
             pairs,
         }
+    }
+
+    /// Number of classes held (after mirror images are shared).
+    pub fn stored_classes(&self) -> usize {
+        self.shared
+            .iter()
+            .map(|&(s, _)| s as usize + 1)
+            .max()
+            .unwrap_or(0)
     }
 
     /// The layout.
@@ -322,9 +436,12 @@ impl SpatialLookup {
     }
 
     /// Class `k`'s (D, S) at the directions, interpolated as the averaged table is (16 nodes,
-    /// pole rows), by `simd`'s kernel.
+    /// pole rows), by `simd`'s kernel; a shared class's from its stored class at the mirrored
+    /// directions.
     #[inline]
     fn class_f(&self, simd: SimdPath, k: usize, wi: [f32; 3], wo: [f32; 3]) -> [f32; 2] {
+        let (k, m) = self.shared[k];
+        let (k, wi, wo) = (k as usize, mirrored(wi, m), mirrored(wo, m));
         let nodes = &self.pairs[k / 2];
         let f = match (&nodes.values, simd) {
             // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C (the
@@ -520,6 +637,38 @@ impl SpatialLookup {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn mirrors_move_cell_centres_onto_cell_centres() {
+        // The centre of cell p at (p + 0.5) 360 / n degrees, mirrored as the direction is.
+        for n in [1u32, 2, 3, 8, 12, 64] {
+            for p in 0..n {
+                let phi = (f64::from(p) + 0.5) * 360.0 / f64::from(n);
+                let w = [
+                    phi.to_radians().cos() as f32,
+                    phi.to_radians().sin() as f32,
+                    0.5,
+                ];
+                for m in [1, 2, 3] {
+                    let Some(q) = mirrored_cell(p, n, m) else {
+                        assert!(m & 1 == 1 && n % 2 == 1, "n {n} mirror {m}");
+                        continue;
+                    };
+                    let v = mirrored(w, m);
+                    let want = (f64::from(q) + 0.5) * 360.0 / f64::from(n);
+                    let got = f64::from(v[1])
+                        .atan2(f64::from(v[0]))
+                        .to_degrees()
+                        .rem_euclid(360.0);
+                    let d = (got - want).abs();
+                    assert!(
+                        d.min(360.0 - d) < 1e-4,
+                        "n {n} p {p} mirror {m}: {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn overlaps_cover_the_interval_once() {
