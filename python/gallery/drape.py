@@ -69,7 +69,10 @@ def vertices(n):
     rho_on = ro * np.sin(theta)
     z_on = SPHERE_RADIUS + ro * np.cos(theta)
     t = np.maximum(r - r_c, 0.0)
-    depth = np.clip(t / 0.9, 0.0, 1.0)
+    # Growing from nothing at the contact circle without a kink (a smoothstep of the hanging
+    # length), so the pleats start where the cloth leaves the ball.
+    d = np.clip(t / 1.1, 0.0, 1.0)
+    depth = d * d * (3.0 - 2.0 * d)
     # Ridges narrower than the valleys between them (a squared sine), of irregular spacing
     # and height: the pleats of cloth hanging from a round support.
     wave = 0.5 + 0.5 * np.sin(FOLDS * phi + 0.7 * np.sin(3 * phi) + 0.4 * np.sin(5 * phi))
