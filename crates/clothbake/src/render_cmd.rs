@@ -275,14 +275,6 @@ pub fn run_plot(a: &PlotArgs) -> Result<String, CliError> {
     }
     let kinds: Vec<(&Path, &str)> = outputs.iter().map(|o| (o.as_path(), "plot")).collect();
     preflight(&kinds, a.force, &inputs(&a.brdf))?;
-    let srcs = sources(&a.brdf, 2)?;
-    let sources: Vec<Source<'_>> = srcs
-        .iter()
-        .map(|(name, s)| Source {
-            name: name.clone(),
-            shader: s,
-        })
-        .collect();
     let p = match a.kind {
         PlotKind::Slices => Plot::Slices {
             theta_i: a.theta_i.clone(),
@@ -319,6 +311,14 @@ pub fn run_plot(a: &PlotArgs) -> Result<String, CliError> {
             format!("give at most {} angles (or draw several plots)", t.max),
         ));
     }
+    let srcs = sources(&a.brdf, 2)?;
+    let sources: Vec<Source<'_>> = srcs
+        .iter()
+        .map(|(name, s)| Source {
+            name: name.clone(),
+            shader: s,
+        })
+        .collect();
     for o in &outputs {
         plot::write(o, &p, &sources, a.force).map_err(|m| {
             CliError::new(
