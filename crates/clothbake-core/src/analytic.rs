@@ -471,10 +471,10 @@ fn key_length_unit(fabric: &Fabric) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// The key of a unit's neighbour pair: the unit, then each neighbour's distance, radius, height
-/// and float extent along the axis relative to the piece (lengths divided by `unit`; an endless
-/// float as +-1e300).
-fn neighbour_key(unit_id: usize, nbs: &[Option<Neighbour>; 2], unit: f64) -> Vec<f64> {
+/// The key of a unit's neighbour pair, written into `key`: the unit, then each neighbour's
+/// distance, radius, height and float extent along the axis relative to the piece (lengths
+/// divided by `unit`; an endless float as +-1e300).
+fn neighbour_key(unit_id: usize, nbs: &[Option<Neighbour>; 2], unit: f64, key: &mut Vec<f64>) {
     let along = |x: f64| {
         if x.is_finite() {
             x / unit
@@ -482,7 +482,8 @@ fn neighbour_key(unit_id: usize, nbs: &[Option<Neighbour>; 2], unit: f64) -> Vec
             x.signum() * 1e300
         }
     };
-    let mut key = vec![unit_id as f64];
+    key.clear();
+    key.push(unit_id as f64);
     for nb in nbs {
         key.extend(nb.map_or([0.0; 5], |n| {
             [
@@ -494,7 +495,6 @@ fn neighbour_key(unit_id: usize, nbs: &[Option<Neighbour>; 2], unit: f64) -> Vec
             ]
         }));
     }
-    key
 }
 
 /// Appends an active table to a unit key, lengths divided by `unit`.
@@ -538,13 +538,19 @@ impl AnalyticModel {
             disc_shapes(fabric, Group::Warp),
             disc_shapes(fabric, Group::Weft),
         ];
+        // Buffers reused from piece to piece: the shapes a profile can hold and the keys.
+        let mut end_shapes: Vec<(f64, f64)> = Vec::new();
+        let mut side_shapes: Vec<(f64, f64)> = Vec::new();
+        let mut key: Vec<f64> = Vec::new();
+        let mut pair_key: Vec<f64> = Vec::new();
         for seg in &geo.segments {
             let g = seg.group;
             let c = g.other();
             let top = equal_area_height(seg.radius, seg.height);
             // What the profiles can hold (scan_ordered): along the axis, the crossing threads
             // end-on and this thread's own floats side-on, within a period and a half.
-            let mut end_shapes = discs[c as usize].clone();
+            end_shapes.clear();
+            end_shapes.extend_from_slice(&discs[c as usize]);
             end_shapes.push((0.0, top));
             let end_u = 3.0 * geo.period_along(g);
             let (end_plus, end_minus) = match seg.extent {
@@ -581,7 +587,8 @@ impl AnalyticModel {
                 // Across it: the parallel threads end-on and crossing thread k side-on, within
                 // a period.
                 let cross_yarn = fabric.group(c).threads[rem(k, geo.fabric.weave().n(c))];
-                let mut side_shapes = discs[g as usize].clone();
+                side_shapes.clear();
+                side_shapes.extend_from_slice(&discs[g as usize]);
                 side_shapes.push((0.0, equal_area_height(cross_yarn.radius, cross_yarn.height)));
                 let side_u = 2.0 * geo.period_across(g);
                 let neighbour = |dir: isize| {
@@ -609,55 +616,43 @@ impl AnalyticModel {
                     })
                 };
                 let nbs = [neighbour(1), neighbour(-1)];
-                let unit = Unit {
-                    seg: data.clone(),
-                    range: (lo, hi),
-                    neighbours: vec![(nbs, 1)],
-                    side_plus: ActiveTable::scan_ordered(
-                        side_profile(&geo, seg, k, 1),
-                        &side_shapes,
-                        side_u,
-                    ),
-                    side_minus: ActiveTable::scan_ordered(
-                        side_profile(&geo, seg, k, -1),
-                        &side_shapes,
-                        side_u,
-                    ),
-                    count: 1,
-                };
+                let side_plus =
+                    ActiveTable::scan_ordered(side_profile(&geo, seg, k, 1), &side_shapes, side_u);
+                let side_minus =
+                    ActiveTable::scan_ordered(side_profile(&geo, seg, k, -1), &side_shapes, side_u);
                 // Key: everything the unit's reflection depends on, relative to its segment,
                 // lengths in units of `unit_len`.
                 let origin = seg.extent.map_or(lo, |e| e.0);
-                let mut key = vec![
+                key.clear();
+                key.extend([
                     g as u8 as f64,
                     seg.radius / unit_len,
                     seg.height / unit_len,
                     seg.extent.map_or(-1.0, |e| (e.1 - e.0) / unit_len),
                     (lo - origin) / unit_len,
                     (hi - origin) / unit_len,
-                ];
+                ]);
                 let mat = data.material;
                 key.extend([mat.specular, mat.exponent]);
-                for t in [
-                    &unit.side_plus,
-                    &unit.side_minus,
-                    &data.end_plus,
-                    &data.end_minus,
-                ] {
+                for t in [&side_plus, &side_minus, &data.end_plus, &data.end_minus] {
                     table_key(t, unit_len, &mut key);
                 }
-                let class_key = key.clone();
+                // The class key: the unit key without the albedos that follow.
+                let class_len = key.len();
                 key.extend(mat.albedo);
                 // Per-thread colours: the neighbours' albedos enter the secondary reflection.
                 for nb in &nbs {
                     key.extend(nb.map_or([-1.0; 3], |n| n.material.albedo));
                 }
-                let Some(i) = merge.then(|| index.find_or_insert(key)).flatten() else {
+                let cell = grid.index(grid.crossing(g, seg.thread, k));
+                let Some(i) = merge.then(|| index.find_or_insert(&key)).flatten() else {
                     if merge {
-                        pairs.find_or_insert(neighbour_key(units.len(), &nbs, unit_len));
+                        neighbour_key(units.len(), &nbs, unit_len, &mut pair_key);
+                        pairs.find_or_insert(&pair_key);
                         pair_at.push((units.len(), 0));
                     }
-                    let class = match merge.then(|| classes.find_or_insert(class_key)).flatten() {
+                    let found = merge.then(|| classes.find_or_insert(&key[..class_len]));
+                    let class = match found.flatten() {
                         Some(c) => c as u32,
                         None => {
                             class_unit.push(units.len() as u32);
@@ -665,14 +660,21 @@ impl AnalyticModel {
                         }
                     };
                     unit_class.push(class);
-                    cell_units[grid.index(grid.crossing(g, seg.thread, k))] =
-                        (units.len() as u32, 0);
-                    units.push(unit);
+                    cell_units[cell] = (units.len() as u32, 0);
+                    units.push(Unit {
+                        seg: data.clone(),
+                        range: (lo, hi),
+                        neighbours: vec![(nbs, 1)],
+                        side_plus,
+                        side_minus,
+                        count: 1,
+                    });
                     continue;
                 };
                 units[i].count += 1;
                 // The neighbours' sizes, distance and float extent along the axis.
-                let variant = match pairs.find_or_insert(neighbour_key(i, &nbs, unit_len)) {
+                neighbour_key(i, &nbs, unit_len, &mut pair_key);
+                let variant = match pairs.find_or_insert(&pair_key) {
                     Some(v) => {
                         units[i].neighbours[pair_at[v].1].1 += 1;
                         pair_at[v].1
@@ -683,8 +685,7 @@ impl AnalyticModel {
                         units[i].neighbours.len() - 1
                     }
                 };
-                cell_units[grid.index(grid.crossing(g, seg.thread, k))] =
-                    (i as u32, variant as u32);
+                cell_units[cell] = (i as u32, variant as u32);
             }
         }
         AnalyticModel {

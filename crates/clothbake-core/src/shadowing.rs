@@ -183,7 +183,7 @@ impl ActiveTable {
         let mut lazy = Lazy {
             source,
             shapes,
-            buf: Vec::new(),
+            buf: Vec::with_capacity(16),
             ordered: true,
         };
         let r_max = shapes.iter().map(|s| s.0).fold(0.0, f64::max);
@@ -203,7 +203,7 @@ impl ActiveTable {
         let Some((_, mut j)) = first else {
             return ActiveTable::scan(&lazy.rest());
         };
-        let mut entries = Vec::new();
+        let mut entries = Vec::with_capacity(4);
         let mut upper = FRAC_PI_2;
         loop {
             if !lazy.ordered {
@@ -211,15 +211,21 @@ impl ActiveTable {
             }
             let cur = lazy.buf[j];
             let mut best: Option<(f64, usize)> = None;
+            // sin of the best elevation so far (0 while there is none), less a margin.
+            let mut threshold = -BEAT_MARGIN;
             // Occluders before j lie no farther out than cur (order): never candidates.
             let mut k = j + 1;
             while let Some(o) = lazy.get(k) {
                 let du = o.u - cur.u;
-                if du > 0.0 && !beatable(&cur, du, u_max, shapes, best.map(|b| b.0)) {
+                if du > 0.0 && !beatable(&cur, du, u_max, shapes, threshold) {
                     break;
                 }
                 if o.u > cur.u {
+                    let before = best;
                     consider(&cur, &o, k, upper, &mut best);
+                    if best != before {
+                        threshold = best.map_or(0.0, |b| b.0.sin()) - BEAT_MARGIN;
+                    }
                 }
                 k += 1;
             }
@@ -280,12 +286,13 @@ impl<I: Iterator<Item = Occluder>> Lazy<'_, I> {
     }
 }
 
+/// Slack in sin psi below which [`beatable`] rules a farther occluder out.
+const BEAT_MARGIN: f64 = 1e-9;
+
 /// Whether an occluder at least `du` (> 0) beyond `cur`, of one of `shapes`, at `u` at most
-/// `u_max`, may have a common tangent with `cur` steeper than `best` (or than 0): see
-/// [`ActiveTable::scan_ordered`].
-fn beatable(cur: &Occluder, du: f64, u_max: f64, shapes: &[(f64, f64)], best: Option<f64>) -> bool {
-    const MARGIN: f64 = 1e-9;
-    let threshold = best.map_or(0.0, f64::sin) - MARGIN;
+/// `u_max`, may have a common tangent with `cur` whose sine exceeds `threshold` (the best
+/// elevation's sine, or 0, less [`BEAT_MARGIN`]): see [`ActiveTable::scan_ordered`].
+fn beatable(cur: &Occluder, du: f64, u_max: f64, shapes: &[(f64, f64)], threshold: f64) -> bool {
     shapes.iter().any(|&(rho, z)| {
         if rho == cur.rho && z == cur.z {
             // Same shape: dz = d_rho = 0 give exactly psi = 0 (atan2(0, du) + asin(0)).

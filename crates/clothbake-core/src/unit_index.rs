@@ -55,12 +55,12 @@ impl UnitIndex {
     }
 
     /// The first unit whose key agrees with `key`, or `None` after adding `key` as a new unit
-    /// (numbered in order of creation from 0).
-    pub fn find_or_insert(&mut self, key: Vec<f64>) -> Option<usize> {
+    /// (numbered in order of creation from 0). Only a new key is copied.
+    pub fn find_or_insert(&mut self, key: &[f64]) -> Option<usize> {
         if self.keys.len() < LINEAR {
-            let found = (0..self.keys.len()).find(|&i| self.same(&self.keys[i], &key));
+            let found = (0..self.keys.len()).find(|&i| self.same(&self.keys[i], key));
             if found.is_none() {
-                self.keys.push(key);
+                self.keys.push(key.to_vec());
                 if self.keys.len() == LINEAR {
                     // Every key in its home cell, ids in order of creation.
                     for (i, k) in self.keys.iter().enumerate() {
@@ -84,21 +84,18 @@ impl UnitIndex {
             acc.checked_mul(span).filter(|&p| p <= MAX_PROBES)
         });
         let found = match probes {
-            Some(1) => self.cells.get(&home).and_then(|ids| {
-                ids.iter()
-                    .copied()
-                    .find(|&i| self.same(&self.keys[i], &key))
-            }),
+            Some(1) => self
+                .cells
+                .get(&home)
+                .and_then(|ids| ids.iter().copied().find(|&i| self.same(&self.keys[i], key))),
             Some(_) => {
                 let mut best: Option<usize> = None;
                 let mut probe = ranges.iter().map(|r| r.0).collect::<Vec<i64>>();
                 loop {
                     if let Some(ids) = self.cells.get(&probe) {
                         // Ids within a cell are in order of creation.
-                        if let Some(i) = ids
-                            .iter()
-                            .copied()
-                            .find(|&i| self.same(&self.keys[i], &key))
+                        if let Some(i) =
+                            ids.iter().copied().find(|&i| self.same(&self.keys[i], key))
                         {
                             best = Some(best.map_or(i, |b| b.min(i)));
                         }
@@ -116,11 +113,11 @@ impl UnitIndex {
                 }
                 best
             }
-            None => (0..self.keys.len()).find(|&i| self.same(&self.keys[i], &key)),
+            None => (0..self.keys.len()).find(|&i| self.same(&self.keys[i], key)),
         };
         if found.is_none() {
             self.cells.entry(home).or_default().push(self.keys.len());
-            self.keys.push(key);
+            self.keys.push(key.to_vec());
         }
         found
     }
@@ -173,7 +170,7 @@ mod tests {
                 })
                 .collect();
             let want = linear(&keys, &key, tol);
-            assert_eq!(index.find_or_insert(key.clone()), want, "{key:?}");
+            assert_eq!(index.find_or_insert(&key), want, "{key:?}");
             if want.is_none() {
                 keys.push(key);
             } else {
@@ -190,13 +187,13 @@ mod tests {
         // LINEAR other units, so that the hash is in use.
         let mut index = UnitIndex::new(1e-9);
         for k in 0..LINEAR {
-            assert_eq!(index.find_or_insert(vec![k as f64; 12]), None);
+            assert_eq!(index.find_or_insert(&[k as f64; 12]), None);
         }
         let a = vec![0.5e-6; 12];
         let b: Vec<f64> = a.iter().map(|x| x + 0.5e-9).collect();
-        assert_eq!(index.find_or_insert(a), None);
-        assert_eq!(index.find_or_insert(b), Some(LINEAR));
-        assert_eq!(index.find_or_insert(vec![0.5e-6; 11]), None);
-        assert_eq!(index.find_or_insert(vec![3.0; 12]), Some(3));
+        assert_eq!(index.find_or_insert(&a), None);
+        assert_eq!(index.find_or_insert(&b), Some(LINEAR));
+        assert_eq!(index.find_or_insert(&[0.5e-6; 11]), None);
+        assert_eq!(index.find_or_insert(&[3.0; 12]), Some(3));
     }
 }

@@ -7,27 +7,33 @@ use super::yarns::Yarns;
 use crate::vec3::Vec3;
 use crate::weave::Group;
 
-/// One cell of the walk over the periodic grid: unwrapped cell indices and the ray parameter at
-/// which the ray leaves it.
+/// One cell of the walk over the periodic grid: the period copy it lies in, its index within
+/// that copy's cells, and the ray parameter at which the ray leaves it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CellVisit {
-    /// Unwrapped cell index along x (cell `ix` covers `[ix cx, (ix + 1) cx)`).
-    pub ix: i64,
-    /// Unwrapped cell index along y.
-    pub iy: i64,
+    /// The period copy (tx, ty): unwrapped cell (ix, iy) lies in copy (ix div nx, iy div ny).
+    pub tile: (i64, i64),
+    /// The cell within its copy, ly * nx + lx with (lx, ly) = (ix mod nx, iy mod ny).
+    pub cell: usize,
     /// Ray parameter at which the ray leaves the cell (capped at `t_max`).
     pub t_exit: f64,
 }
 
-/// The period-copy enumeration: the cells of an unbounded grid of cell size (`cx`, `cy`) that
-/// the xy path `(ox, oy) + t (dx, dy)`, `0 <= t <= t_max`, crosses, in order (a 2-D DDA after
-/// Amanatides & Woo). With cells that divide the period, cell (ix, iy) belongs to period copy
-/// (ix div nx, iy div ny) and is that copy's local cell (ix mod nx, iy mod ny), so every
-/// copy of every segment the path could hit is visited, however long (grazing) the path is.
+/// The period-copy enumeration: the cells of an unbounded grid of cell size (`cx`, `cy`),
+/// `nx` by `ny` cells to a period, that the xy path `(ox, oy) + t (dx, dy)`, `0 <= t <= t_max`,
+/// crosses, in order (a 2-D DDA after Amanatides & Woo). Cell (ix, iy) belongs to period copy
+/// (ix div nx, iy div ny) and is that copy's local cell (ix mod nx, iy mod ny): the walk keeps
+/// the copy and the local cell as it steps (no division per cell), so every copy of every
+/// segment the path could hit is visited, however long (grazing) the path is.
 #[derive(Clone, Debug)]
 pub struct CellWalk {
-    ix: i64,
-    iy: i64,
+    /// Local cell (lx, ly) within the copy (tx, ty).
+    lx: i64,
+    ly: i64,
+    tx: i64,
+    ty: i64,
+    nx: i64,
+    ny: i64,
     step_x: i64,
     step_y: i64,
     next_x: f64,
@@ -38,57 +44,52 @@ pub struct CellWalk {
     done: bool,
 }
 
-impl CellWalk {
-    /// Starts the walk at the cell containing (`ox`, `oy`).
-    pub fn new(ox: f64, oy: f64, dx: f64, dy: f64, cx: f64, cy: f64, t_max: f64) -> CellWalk {
-        let ix = (ox / cx).floor() as i64;
-        let iy = (oy / cy).floor() as i64;
-        let axis = |i: i64, o: f64, d: f64, c: f64| -> (i64, f64, f64) {
-            if d > 0.0 {
-                (1, ((i + 1) as f64 * c - o) / d, c / d)
-            } else if d < 0.0 {
-                (-1, (i as f64 * c - o) / d, -c / d)
-            } else {
-                (0, f64::INFINITY, f64::INFINITY)
-            }
-        };
-        let (step_x, next_x, delta_x) = axis(ix, ox, dx, cx);
-        let (step_y, next_y, delta_y) = axis(iy, oy, dy, cy);
-        CellWalk {
-            ix,
-            iy,
-            step_x,
-            step_y,
-            next_x: next_x.max(0.0),
-            next_y: next_y.max(0.0),
-            delta_x,
-            delta_y,
-            t_max,
-            done: false,
-        }
+/// One axis of a walk's start: the step (-1, 0 or 1), the parameter of the first cell border
+/// crossed and the parameter between borders, for cell `i` of size `c`, origin `o`, direction `d`.
+fn axis_start(i: i64, o: f64, d: f64, c: f64) -> (i64, f64, f64) {
+    if d > 0.0 {
+        (1, ((i + 1) as f64 * c - o) / d, c / d)
+    } else if d < 0.0 {
+        (-1, (i as f64 * c - o) / d, -c / d)
+    } else {
+        (0, f64::INFINITY, f64::INFINITY)
+    }
+}
+
+/// Steps local cell `l` of a copy `t` with `n` cells by `step`, wrapping into the next copy.
+#[inline]
+fn wrap_step(l: &mut i64, t: &mut i64, step: i64, n: i64) {
+    *l += step;
+    if *l >= n {
+        *l = 0;
+        *t += 1;
+    } else if *l < 0 {
+        *l = n - 1;
+        *t -= 1;
     }
 }
 
 impl Iterator for CellWalk {
     type Item = CellVisit;
 
+    #[inline]
     fn next(&mut self) -> Option<CellVisit> {
         if self.done {
             return None;
         }
         let t_exit = self.next_x.min(self.next_y);
         let visit = CellVisit {
-            ix: self.ix,
-            iy: self.iy,
+            tile: (self.tx, self.ty),
+            cell: (self.ly * self.nx + self.lx) as usize,
             t_exit: t_exit.min(self.t_max),
         };
         if t_exit >= self.t_max {
             self.done = true;
         } else if self.next_x <= self.next_y {
-            self.ix += self.step_x;
+            wrap_step(&mut self.lx, &mut self.tx, self.step_x, self.nx);
             self.next_x += self.delta_x;
         } else {
-            self.iy += self.step_y;
+            wrap_step(&mut self.ly, &mut self.ty, self.step_y, self.ny);
             self.next_y += self.delta_y;
         }
         Some(visit)
@@ -273,23 +274,53 @@ impl CellIndex {
         }
     }
 
-    /// The walk over the cells that the xy path of `o + t d`, `0 <= t <= t_max`, crosses.
+    /// The walk over the cells that the xy path of `o + t d`, `0 <= t <= t_max`, crosses,
+    /// starting at the cell containing (o.x, o.y).
+    #[inline]
     pub(crate) fn walk(&self, o: Vec3, d: Vec3, t_max: f64) -> CellWalk {
-        CellWalk::new(o.x, o.y, d.x, d.y, self.cx, self.cy, t_max)
+        let ix = (o.x / self.cx).floor() as i64;
+        let iy = (o.y / self.cy).floor() as i64;
+        let (step_x, next_x, delta_x) = axis_start(ix, o.x, d.x, self.cx);
+        let (step_y, next_y, delta_y) = axis_start(iy, o.y, d.y, self.cy);
+        // (copy, local cell) of an unwrapped index; no division for the base period's cells,
+        // where primary rays start.
+        let split = |i: i64, n: i64| {
+            if (0..n).contains(&i) {
+                (0, i)
+            } else {
+                (i.div_euclid(n), i.rem_euclid(n))
+            }
+        };
+        let ((tx, lx), (ty, ly)) = (split(ix, self.nx), split(iy, self.ny));
+        CellWalk {
+            lx,
+            ly,
+            tx,
+            ty,
+            nx: self.nx,
+            ny: self.ny,
+            step_x,
+            step_y,
+            next_x: next_x.max(0.0),
+            next_y: next_y.max(0.0),
+            delta_x,
+            delta_y,
+            t_max,
+            done: false,
+        }
     }
 
-    /// The period copy (tx, ty) an unwrapped cell belongs to, the ray origin `o` moved into the
-    /// base period by that copy's offset, and the ids of the prims listed in the cell.
+    /// The ray origin `o` moved into the base period by the offset of the visit's copy, and
+    /// the ids of the prims listed in its cell.
     #[inline]
-    pub(crate) fn visit(&self, cell: &CellVisit, o: Vec3) -> ((i64, i64), Vec3, &[u32]) {
-        let (tx, ty) = (cell.ix.div_euclid(self.nx), cell.iy.div_euclid(self.ny));
-        let c = (cell.iy.rem_euclid(self.ny) * self.nx + cell.ix.rem_euclid(self.nx)) as usize;
-        let items = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
+    pub(crate) fn visit(&self, cell: &CellVisit, o: Vec3) -> (Vec3, &[u32]) {
+        let items =
+            &self.items[self.starts[cell.cell] as usize..self.starts[cell.cell + 1] as usize];
         let local = Vec3::new(
-            o.x - tx as f64 * self.period.0,
-            o.y - ty as f64 * self.period.1,
+            o.x - cell.tile.0 as f64 * self.period.0,
+            o.y - cell.tile.1 as f64 * self.period.1,
             o.z,
         );
-        ((tx, ty), local, items)
+        (local, items)
     }
 }

@@ -106,6 +106,7 @@ pub struct SegmentShape {
 /// cylinder, cap slab, half-space z >= 0), so the ray enters it at the last of their entries
 /// and must do so before the first of their exits. An entry through the floor plane (a ray
 /// coming from below the floor) is the floor's hit, not the yarn's, and gives `None`.
+#[inline]
 pub fn segment_entry(
     ray: &LocalRay,
     s: &SegmentShape,
@@ -114,10 +115,22 @@ pub fn segment_entry(
 ) -> Option<(f64, Surface)> {
     let [ou, ov, oz] = ray.o;
     let [du, dv, dz] = ray.d;
+    // The cap slab first: it is cheaper than the cylinder and rejects most segments a ray
+    // passes beside along their axis. An entry at or after `t_max` or an exit at or before
+    // `t_min` leaves no entry inside (t_min, t_max), whatever the cylinder gives.
+    let slab = match s.extent {
+        Some((lo, hi)) => {
+            let (a, b) = cap_slab_interval(ov, dv, lo, hi)?;
+            if a >= t_max || b <= t_min {
+                return None;
+            }
+            Some((a, b))
+        }
+        None => None,
+    };
     let (mut t_in, mut t_out) = cylinder_interval(ou, oz, du, dz, s.axis, s.height, s.radius)?;
     let mut surface = Surface::Side;
-    if let Some((lo, hi)) = s.extent {
-        let (a, b) = cap_slab_interval(ov, dv, lo, hi)?;
+    if let Some((a, b)) = slab {
         if a > t_in {
             t_in = a;
             surface = if dv > 0.0 {

@@ -150,7 +150,8 @@ impl RayTracer {
         let mut best: Option<Hit> = None;
         let mut best_t = t_max;
         for cell in cells.walk(o, d, t_max) {
-            let ((tx, ty), ol, items) = cells.visit(&cell, o);
+            let (ol, items) = cells.visit(&cell, o);
+            let (tx, ty) = cell.tile;
             for &id in items {
                 let p = &cells.prims[id as usize];
                 if let Some((t, surface)) = segment_entry(&p.local(ol, d), &p.shape, t_min, best_t)
