@@ -15,7 +15,7 @@
 use std::arch::x86_64::*;
 
 use crate::angles::HORIZON_COS;
-use crate::nodes::{column_offset, next_column, Lane, Nodes, SpanLanes};
+use crate::nodes::{column_offset, next_column, Lane, Nodes, SpanLanes, TILE};
 
 /// True when this processor runs the kernel.
 pub(crate) fn available() -> bool {
@@ -402,9 +402,11 @@ pub(crate) unsafe fn batch<V: Lane>(
 ) {
     // `GROUP` pairs at a time: all corners before all gathers, so that the next pairs' angle
     // arithmetic overlaps the loads of the first (same operations as `eval`: the same bits).
-    // Pipelined: the next group's corners are found and their runs prefetched before this
-    // group's gathers, so that random pairs' memory reads overlap (a hint: no effect on the
-    // values).
+    // Pipelined for half floats: the next group's corners are found and their lines
+    // prefetched before this group's gathers, so that random pairs' memory reads overlap (a
+    // hint: no effect on the values). Measured on f32 tables (two lines a tile), the pipeline
+    // made random batches 1.1x faster but batches in cache 1.12x slower (the held corners),
+    // so f32 batches are not pipelined (docs/performance.md).
     const GROUP: usize = 4;
     /// The corners of pairs `k..k + GROUP`, or `None` when one is off the table's domain or the
     /// lookup is symmetrised (then each pair goes through `eval`).
@@ -432,27 +434,19 @@ pub(crate) unsafe fn batch<V: Lane>(
             ]
         })
     }
-    let n = wi.len().min(wo.len()).min(out.len());
-    let (wi, wo, out) = (&wi[..n], &wo[..n], &mut out[..n]);
-    let groups = n / GROUP;
-    let mut next = if groups > 0 {
-        corners(nodes, reciprocal, wi, wo, 0)
-    } else {
-        None
-    };
-    for j in 0..groups {
-        let k = j * GROUP;
-        let cur = next;
-        if j + 1 < groups {
-            next = corners(nodes, reciprocal, wi, wo, k + GROUP);
-            if let Some(c) = &next {
-                for c in c {
-                    nodes.prefetch(v, c.base);
-                }
-            }
-        }
-        let o = &mut out[k..k + GROUP];
-        match cur {
+    /// Group `k..k + GROUP` into `o`, from its corners or, without them, pair by pair.
+    #[inline]
+    #[target_feature(enable = "avx2,fma,f16c")]
+    unsafe fn finish<V: Lane>(
+        nodes: &Nodes,
+        v: &[V],
+        reciprocal: bool,
+        (wi, wo): (&[[f32; 3]], &[[f32; 3]]),
+        k: usize,
+        corners: Option<[Corner; GROUP]>,
+        o: &mut [[f32; 3]],
+    ) {
+        match corners {
             Some(c) => {
                 for (o, c) in o.iter_mut().zip(&c) {
                     *o = gather(nodes, v, c);
@@ -464,6 +458,41 @@ pub(crate) unsafe fn batch<V: Lane>(
                 }
             }
         }
+    }
+    let n = wi.len().min(wo.len()).min(out.len());
+    let (wi, wo, out) = (&wi[..n], &wo[..n], &mut out[..n]);
+    let groups = n / GROUP;
+    let pipelined = size_of::<V>() * TILE <= 64;
+    let mut next = if groups > 0 && pipelined {
+        corners(nodes, reciprocal, wi, wo, 0)
+    } else {
+        None
+    };
+    for j in 0..groups {
+        let k = j * GROUP;
+        let cur = if pipelined {
+            let cur = next;
+            if j + 1 < groups {
+                next = corners(nodes, reciprocal, wi, wo, k + GROUP);
+                if let Some(c) = &next {
+                    for c in c {
+                        nodes.prefetch(v, c.base);
+                    }
+                }
+            }
+            cur
+        } else {
+            corners(nodes, reciprocal, wi, wo, k)
+        };
+        finish(
+            nodes,
+            v,
+            reciprocal,
+            (wi, wo),
+            k,
+            cur,
+            &mut out[k..k + GROUP],
+        );
     }
     let k = groups * GROUP;
     for (i, o) in out[k..].iter_mut().enumerate() {

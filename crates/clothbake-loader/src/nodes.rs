@@ -411,9 +411,9 @@ impl Nodes {
     }
 
     /// Asks the processor to bring the runs of a lookup at `base` into the caches (a hint with
-    /// no effect on any value): for each `(ia, ib)`, the first lane of its first run and the
-    /// last of its second, so that an f32 tile's two lines are fetched. Bases out of range are
-    /// skipped.
+    /// no effect on any value): for each `(ia, ib)` the line of its f16 tile, or the first lane
+    /// of its first run and the last of its second, an f32 tile's two lines. Bases out of range
+    /// are skipped.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub(crate) fn prefetch<V>(&self, v: &[V], base: [usize; 2]) {
@@ -424,12 +424,16 @@ impl Nodes {
         }
         let [s_ti, _, _] = self.strides;
         let p = v.as_ptr();
+        // An f16 tile is one aligned line (its first lane suffices); an f32 tile is two.
+        let two_lines = size_of::<V>() * TILE > 64;
         for b in base {
             for at in [b, b + s_ti] {
-                for lane in [at, at + TILE_ROW + 7] {
-                    // SAFETY: as in `with_runs`, every run of 8 from these starts lies inside
-                    // `v`; a prefetch reads nothing the program sees.
-                    unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(lane).cast::<i8>()) }
+                // SAFETY: as in `with_runs`, every run of 8 from these starts lies inside `v`;
+                // a prefetch reads nothing the program sees.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(at).cast::<i8>()) };
+                if two_lines {
+                    // SAFETY: as above (the last lane of the second run).
+                    unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(at + TILE_ROW + 7).cast::<i8>()) };
                 }
             }
         }
