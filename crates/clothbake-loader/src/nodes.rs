@@ -412,28 +412,26 @@ impl Nodes {
 
     /// Asks the processor to bring the runs of a lookup at `base` into the caches (a hint with
     /// no effect on any value): for each `(ia, ib)` the line of its f16 tile, or the first lane
-    /// of its first run and the last of its second, an f32 tile's two lines. Bases out of range
-    /// are skipped.
+    /// of its first run and the last of its second, an f32 tile's two lines. The addresses are
+    /// formed with wrapping arithmetic and a prefetch never faults, so no bound is checked.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub(crate) fn prefetch<V>(&self, v: &[V], base: [usize; 2]) {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        match v.len().checked_sub(self.extent) {
-            Some(last) if base[0] <= last && base[1] <= last => {}
-            _ => return,
-        }
         let [s_ti, _, _] = self.strides;
         let p = v.as_ptr();
         // An f16 tile is one aligned line (its first lane suffices); an f32 tile is two.
         let two_lines = size_of::<V>() * TILE > 64;
         for b in base {
             for at in [b, b + s_ti] {
-                // SAFETY: as in `with_runs`, every run of 8 from these starts lies inside `v`;
-                // a prefetch reads nothing the program sees.
-                unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(at).cast::<i8>()) };
+                // SAFETY: a prefetch reads nothing the program sees and never faults, whatever
+                // the address; the pointer is not dereferenced.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(at).cast::<i8>()) };
                 if two_lines {
-                    // SAFETY: as above (the last lane of the second run).
-                    unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(at + TILE_ROW + 7).cast::<i8>()) };
+                    // SAFETY: as above.
+                    unsafe {
+                        _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(at + TILE_ROW + 7).cast::<i8>())
+                    };
                 }
             }
         }
