@@ -65,6 +65,25 @@ fn spatial_lookup(c: &mut Criterion) {
             })
         });
     }
+    // Latency: each lookup's input depends on the previous result (as a path tracer's next
+    // bounce depends on this one), so no two lookups' memory reads overlap.
+    g.bench_function("averaged/eval_dependent", |b| {
+        let mut k = 0;
+        b.iter(|| {
+            let f = brdf.eval(black_box(wi[k]), black_box(wo[k]));
+            k = (k + 1 + usize::from(f[0] == f32::INFINITY)) & (N - 1);
+            f
+        })
+    });
+    g.bench_function("spatial/eval_at_point_dependent", |b| {
+        let mut k = 0;
+        b.iter(|| {
+            let (u, v) = uv[k];
+            let f = brdf.eval_at(black_box(wi[k]), black_box(wo[k]), u, v, 0.0);
+            k = (k + 1 + usize::from(f[0] == f32::INFINITY)) & (N - 1);
+            f
+        })
+    });
     // One cell: every lookup reads the same class pair's node table (the working set of an
     // averaged lookup), to tell the cost of spreading over the classes' tables.
     g.bench_function("spatial/eval_at_point_one_cell", |b| {

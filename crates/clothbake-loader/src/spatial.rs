@@ -256,6 +256,72 @@ pub struct SpatialLookup {
     shared: Vec<(u32, Mirror)>,
     /// Stored class pair m's nodes.
     pairs: Vec<Nodes>,
+    /// A point's cell along u and along v, found without a search.
+    u_bins: Bins,
+    v_bins: Bins,
+    /// What a point lookup reads of each cell (row-major), in one place.
+    points: Vec<PointCell>,
+}
+
+/// A point lookup's view of one cell: its class's stored pair and lanes, the mirror as signs
+/// of x and y, its thread's albedo.
+#[derive(Clone, Copy, Debug)]
+struct PointCell {
+    pair: u32,
+    /// Lane of D in the pair's 4 (0 or 2); S is the next.
+    lane: u32,
+    /// The factors (+-1) of x and y that [`mirrored`] applies.
+    sign: [f32; 2],
+    albedo: [f32; 3],
+}
+
+/// The cell of an axis's `edges` holding a fraction of the period, found from uniform bins
+/// (each bin's first cell, then at most a step or two) instead of a search: the same cell as
+/// [`Spatial::locate`] (tested), in fewer instructions and no unpredictable branches.
+#[derive(Clone, Debug)]
+struct Bins {
+    edges: Vec<f64>,
+    /// Bins per period.
+    n: f64,
+    /// The cell holding each bin's start.
+    first: Vec<u32>,
+}
+
+impl Bins {
+    fn new(edges: &[f64]) -> Bins {
+        let cells = edges.len() - 1;
+        let n = (4 * cells).max(16);
+        let first = (0..n)
+            .map(|b| Spatial::locate(edges, edges[0] + b as f64 / n as f64) as u32)
+            .collect();
+        Bins {
+            edges: edges.to_vec(),
+            n: n as f64,
+            first,
+        }
+    }
+
+    /// The cell holding fraction `t` (wrapped; not finite: 0), as [`Spatial::locate`].
+    #[inline(always)]
+    fn locate(&self, t: f64) -> usize {
+        let e = &self.edges;
+        let e0 = e[0];
+        let t = if t.is_finite() { t } else { 0.0 };
+        let d = t - e0;
+        let f = d - d.floor();
+        let x = e0 + f;
+        // `as` saturates; the bin only starts the walk, which ends at the last edge <= x.
+        let b = ((f * self.n) as usize).min(self.first.len() - 1);
+        let mut i = self.first[b] as usize;
+        let last = e.len() - 2;
+        while i > 0 && e[i] > x {
+            i -= 1;
+        }
+        while i < last && e[i + 1] <= x {
+            i += 1;
+        }
+        i
+    }
 }
 
 /// A mirror of the cloth's frame, as bits: 1 negates x (the weft direction), 2 negates y (the
@@ -399,7 +465,25 @@ impl SpatialLookup {
                 )
             })
             .collect();
+        let points = layout
+            .cell_class
+            .iter()
+            .zip(&layout.cell_albedo)
+            .map(|(&k, &albedo)| {
+                let (s, m) = shared[k as usize];
+                let sign = |bit: u8| if m & bit != 0 { -1.0 } else { 1.0 };
+                PointCell {
+                    pair: s / 2,
+                    lane: 2 * (s % 2),
+                    sign: [sign(1), sign(2)],
+                    albedo,
+                }
+            })
+            .collect();
         SpatialLookup {
+            u_bins: Bins::new(&layout.u_edges),
+            v_bins: Bins::new(&layout.v_edges),
+            points,
             layout,
             grid,
             shared,
@@ -442,8 +526,15 @@ impl SpatialLookup {
     fn class_f(&self, simd: SimdPath, k: usize, wi: [f32; 3], wo: [f32; 3]) -> [f32; 2] {
         let (k, m) = self.shared[k];
         let (k, wi, wo) = (k as usize, mirrored(wi, m), mirrored(wo, m));
-        let nodes = &self.pairs[k / 2];
-        let f = match (&nodes.values, simd) {
+        let f = Self::pair_f(&self.pairs[k / 2], simd, wi, wo);
+        let j = 2 * (k % 2);
+        [f[j], f[j + 1]]
+    }
+
+    /// A class pair's 4 lanes (D, S of each) at the directions, by `simd`'s kernel.
+    #[inline(always)]
+    fn pair_f(nodes: &Nodes, simd: SimdPath, wi: [f32; 3], wo: [f32; 3]) -> [f32; 4] {
+        match (&nodes.values, simd) {
             // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C (the
             // table's `SimdPath`, checked by `Brdf::with_simd_path` and `SimdPath::best`).
             #[cfg(target_arch = "x86_64")]
@@ -452,9 +543,7 @@ impl SpatialLookup {
             (Values::F32(v), SimdPath::Avx2) => unsafe { avx2::eval4(nodes, v, wi, wo) },
             (Values::F16(v), _) => nodes.blend4(v, crate::nodes::angles(wi, wo)),
             (Values::F32(v), _) => nodes.blend4(v, crate::nodes::angles(wi, wo)),
-        };
-        let j = 2 * (k % 2);
-        [f[j], f[j + 1]]
+        }
     }
 
     /// Class `k`'s visible share of the period at outgoing angles `o`, interpolated.
@@ -529,11 +618,16 @@ impl SpatialLookup {
     /// seen, D and S are 0).
     #[inline(always)]
     fn point(&self, simd: SimdPath, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
-        let l = &self.layout;
-        let (i, j) = l.cell_at(u, v);
-        let c = j * l.dims().0 + i;
-        let [d, s] = self.class_f(simd, l.cell_class[c] as usize, wi, wo);
-        l.cell_albedo[c].map(|a| (a * d + s).max(0.0))
+        let (i, j) = (self.u_bins.locate(u), self.v_bins.locate(v));
+        let p = self.points[j * (self.u_bins.edges.len() - 1) + i];
+        // As `class_f`: the stored class at the mirrored directions (x +-1: the same bits).
+        let [sx, sy] = p.sign;
+        let m = |w: [f32; 3]| [w[0] * sx, w[1] * sy, w[2]];
+        let f = Self::pair_f(&self.pairs[p.pair as usize], simd, m(wi), m(wo));
+        // The lane is 0 or 2 (`& 2` lets the compiler drop the bound checks).
+        let l = p.lane as usize & 2;
+        let (d, s) = (f[l], f[l + 1]);
+        p.albedo.map(|a| (a * d + s).max(0.0))
     }
 
     /// [`SpatialLookup::point`] compiled for AVX2 (the cell's `floor` one instruction, the
@@ -637,6 +731,41 @@ impl SpatialLookup {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bins_find_the_cell_that_the_search_finds() {
+        // Uneven cells, points on and beside every edge, outside the period, not finite.
+        for inner in [
+            vec![0.0],
+            vec![-0.2, 0.1, 0.15, 0.5],
+            vec![0.05, 0.06, 0.07, 0.5, 1.0],
+            (0..37)
+                .map(|k| (f64::from(k) / 37.0).powf(1.7) + 0.3)
+                .collect(),
+        ] {
+            // The last edge one period after the first, as every layout has it.
+            let edges: Vec<f64> = inner.iter().copied().chain([inner[0] + 1.0]).collect();
+            let bins = Bins::new(&edges);
+            let mut ts: Vec<f64> = vec![f64::NAN, f64::INFINITY, -1e300, 1e300, -0.0];
+            for &x in &edges {
+                for d in [-1e-12, 0.0, 1e-12, -1.0, 1.0, 3.0, -7.0] {
+                    ts.push(x + d);
+                    ts.push(f64::from_bits((x + d).to_bits().wrapping_add(1)));
+                    ts.push(f64::from_bits((x + d).to_bits().wrapping_sub(1)));
+                }
+            }
+            let mut r = 0x9e37_79b9_7f4a_7c15u64;
+            for _ in 0..20_000 {
+                r ^= r << 13;
+                r ^= r >> 7;
+                r ^= r << 17;
+                ts.push((r >> 11) as f64 / (1u64 << 53) as f64 * 6.0 - 3.0);
+            }
+            for t in ts {
+                assert_eq!(bins.locate(t), Spatial::locate(&edges, t), "{edges:?} {t}");
+            }
+        }
+    }
 
     #[test]
     fn mirrors_move_cell_centres_onto_cell_centres() {
