@@ -302,16 +302,22 @@ impl Bins {
     }
 
     /// The cell holding fraction `t` (wrapped; not finite: 0), as [`Spatial::locate`].
-    #[inline(always)]
+    #[cfg(test)]
     fn locate(&self, t: f64) -> usize {
+        self.locate_finite(if t.is_finite() { t } else { 0.0 })
+    }
+
+    /// [`Bins::locate`] of a finite `t`.
+    #[inline(always)]
+    fn locate_finite(&self, t: f64) -> usize {
         let e = &self.edges;
         let e0 = e[0];
-        let t = if t.is_finite() { t } else { 0.0 };
         let d = t - e0;
         let f = d - d.floor();
         let x = e0 + f;
-        // `as` saturates; the bin only starts the walk, which ends at the last edge <= x.
-        let b = ((f * self.n) as usize).min(self.first.len() - 1);
+        // f in [0, 1] and at most 2^18 bins: in range of i32 (and `as` saturates anyway); the
+        // bin only starts the walk, which ends at the last edge <= x.
+        let b = ((f * self.n) as i32 as usize).min(self.first.len() - 1);
         let mut i = self.first[b] as usize;
         let last = e.len() - 2;
         while i > 0 && e[i] > x {
@@ -614,11 +620,12 @@ impl SpatialLookup {
         Some(self.eval_footprint(simd, wi, wo, Footprint { u, v, width }))
     }
 
-    /// A point's f_r: its cell's `rho_d D + S` (its coverage cancels; where the class is not
-    /// seen, D and S are 0).
+    /// A point's f_r (u, v finite): its cell's `rho_d D + S` (its coverage cancels; where the
+    /// class is not seen, D and S are 0).
     #[inline(always)]
     fn point(&self, simd: SimdPath, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
-        let (i, j) = (self.u_bins.locate(u), self.v_bins.locate(v));
+        // `eval_at` passes finite u, v only.
+        let (i, j) = (self.u_bins.locate_finite(u), self.v_bins.locate_finite(v));
         let p = self.points[j * (self.u_bins.edges.len() - 1) + i];
         // As `class_f`: the stored class at the mirrored directions (x +-1: the same bits).
         let [sx, sy] = p.sign;
