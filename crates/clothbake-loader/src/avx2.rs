@@ -15,7 +15,7 @@
 use std::arch::x86_64::*;
 
 use crate::angles::HORIZON_COS;
-use crate::nodes::{column_offset, next_column, Lane, Nodes, SpanLanes, TILE};
+use crate::nodes::{column_offset, next_column, one_line_tiles, Lane, Nodes, SpanLanes};
 
 /// True when this processor runs the kernel.
 pub(crate) fn available() -> bool {
@@ -462,7 +462,7 @@ pub(crate) unsafe fn batch<V: Lane>(
     let n = wi.len().min(wo.len()).min(out.len());
     let (wi, wo, out) = (&wi[..n], &wo[..n], &mut out[..n]);
     let groups = n / GROUP;
-    let pipelined = size_of::<V>() * TILE <= 64;
+    let pipelined = one_line_tiles::<V>();
     let mut next = if groups > 0 && pipelined {
         corners(nodes, reciprocal, wi, wo, 0)
     } else {

@@ -75,6 +75,12 @@ pub(crate) struct Tiles<V> {
     tiles: Vec<Tile<V>>,
 }
 
+/// True when a tile of lanes `V` is one cache line (half floats; f32 tiles are two).
+#[cfg(target_arch = "x86_64")]
+pub(crate) const fn one_line_tiles<V>() -> bool {
+    size_of::<V>() * TILE <= 64
+}
+
 /// One tile's lanes, aligned to a cache line.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
@@ -421,7 +427,7 @@ impl Nodes {
         let [s_ti, _, _] = self.strides;
         let p = v.as_ptr();
         // An f16 tile is one aligned line (its first lane suffices); an f32 tile is two.
-        let two_lines = size_of::<V>() * TILE > 64;
+        let two_lines = !one_line_tiles::<V>();
         for b in base {
             for at in [b, b + s_ti] {
                 // SAFETY: a prefetch reads nothing the program sees and never faults, whatever

@@ -252,8 +252,8 @@ fn angles(w: [f32; 3]) -> Option<(f32, f32)> {
 pub struct SpatialLookup {
     layout: Spatial,
     grid: Grid,
-    /// Each class's stored class and the mirror ([`Mirror`]) that maps it onto that one.
-    shared: Vec<(u32, Mirror)>,
+    /// Where each class is held: its stored class and the mirror onto it.
+    classes: Vec<Held>,
     /// Stored class pair m's nodes.
     pairs: Vec<Nodes>,
     /// A point's cell along u and along v, found without a search.
@@ -263,15 +263,36 @@ pub struct SpatialLookup {
     points: Vec<PointCell>,
 }
 
-/// A point lookup's view of one cell: its class's stored pair and lanes, the mirror as signs
-/// of x and y, its thread's albedo.
+/// Where a class is held: stored class `2 pair + lane / 2` (its D in lane `lane` of pair
+/// `pair`'s 4, S in the next), read at the directions mirrored by `sign`.
+#[derive(Clone, Copy, Debug)]
+struct Held {
+    pair: u32,
+    /// 0 or 2.
+    lane: u32,
+    /// The factors (+-1) of x and y of the mirror ([`mirror_signs`]).
+    sign: [f32; 2],
+}
+
+impl Held {
+    fn new(stored: u32, m: Mirror) -> Held {
+        Held {
+            pair: stored / 2,
+            lane: 2 * (stored % 2),
+            sign: mirror_signs(m),
+        }
+    }
+
+    /// Index of the stored class.
+    fn stored(&self) -> usize {
+        (2 * self.pair + self.lane / 2) as usize
+    }
+}
+
+/// A point lookup's view of one cell: where its class is held and its thread's albedo.
 #[derive(Clone, Copy, Debug)]
 struct PointCell {
-    pair: u32,
-    /// Lane of D in the pair's 4 (0 or 2); S is the next.
-    lane: u32,
-    /// The factors (+-1) of x and y that [`mirrored`] applies.
-    sign: [f32; 2],
+    held: Held,
     albedo: [f32; 3],
 }
 
@@ -334,12 +355,22 @@ impl Bins {
 /// warp direction), 3 both (a half turn about the normal); 0 is none.
 type Mirror = u8;
 
-/// `w` mirrored by `m`.
+/// The factors (+-1) of x and y of mirror `m`.
+fn mirror_signs(m: Mirror) -> [f32; 2] {
+    let sign = |bit: Mirror| if m & bit != 0 { -1.0 } else { 1.0 };
+    [sign(1), sign(2)]
+}
+
+/// `w` with x and y multiplied by `sign` (a mirror's [`mirror_signs`]; exact).
 #[inline(always)]
-fn mirrored(w: [f32; 3], m: Mirror) -> [f32; 3] {
-    let sx = if m & 1 != 0 { -1.0 } else { 1.0 };
-    let sy = if m & 2 != 0 { -1.0 } else { 1.0 };
+fn flipped(w: [f32; 3], [sx, sy]: [f32; 2]) -> [f32; 3] {
     [w[0] * sx, w[1] * sy, w[2]]
+}
+
+/// `w` mirrored by `m`.
+#[cfg(test)]
+fn mirrored(w: [f32; 3], m: Mirror) -> [f32; 3] {
+    flipped(w, mirror_signs(m))
 }
 
 /// The azimuth cell (of `n`) whose centre `m` moves cell `p`'s centre to; `None` for a mirror
@@ -431,19 +462,19 @@ impl SpatialLookup {
         } else {
             1e-5
         };
-        // Stored classes (their index in the table) and each class's (stored, mirror).
+        // Stored classes (their index in the table) and where each class is held.
         let mut stored: Vec<usize> = Vec::new();
-        let mut shared = Vec::with_capacity(layout.classes as usize);
+        let mut classes = Vec::with_capacity(layout.classes as usize);
         for c in 0..layout.classes as usize {
             let found = stored.iter().enumerate().find_map(|(s, &j)| {
                 [1, 2, 3]
                     .into_iter()
                     .find(|&m| mirror_of(&layout, &grid, values, (c, j, m), tol))
-                    .map(|m| (s as u32, m))
+                    .map(|m| Held::new(s as u32, m))
             });
-            shared.push(found.unwrap_or_else(|| {
+            classes.push(found.unwrap_or_else(|| {
                 stored.push(c);
-                ((stored.len() - 1) as u32, 0)
+                Held::new((stored.len() - 1) as u32, 0)
             }));
         }
         let k = stored.len();
@@ -475,15 +506,9 @@ impl SpatialLookup {
             .cell_class
             .iter()
             .zip(&layout.cell_albedo)
-            .map(|(&k, &albedo)| {
-                let (s, m) = shared[k as usize];
-                let sign = |bit: u8| if m & bit != 0 { -1.0 } else { 1.0 };
-                PointCell {
-                    pair: s / 2,
-                    lane: 2 * (s % 2),
-                    sign: [sign(1), sign(2)],
-                    albedo,
-                }
+            .map(|(&k, &albedo)| PointCell {
+                held: classes[k as usize],
+                albedo,
             })
             .collect();
         SpatialLookup {
@@ -492,16 +517,16 @@ impl SpatialLookup {
             points,
             layout,
             grid,
-            shared,
+            classes,
             pairs,
         }
     }
 
     /// Number of classes held (after mirror images are shared).
     pub fn stored_classes(&self) -> usize {
-        self.shared
+        self.classes
             .iter()
-            .map(|&(s, _)| s as usize + 1)
+            .map(|h| h.stored() + 1)
             .max()
             .unwrap_or(0)
     }
@@ -530,11 +555,17 @@ impl SpatialLookup {
     /// directions.
     #[inline]
     fn class_f(&self, simd: SimdPath, k: usize, wi: [f32; 3], wo: [f32; 3]) -> [f32; 2] {
-        let (k, m) = self.shared[k];
-        let (k, wi, wo) = (k as usize, mirrored(wi, m), mirrored(wo, m));
-        let f = Self::pair_f(&self.pairs[k / 2], simd, wi, wo);
-        let j = 2 * (k % 2);
-        [f[j], f[j + 1]]
+        self.held_f(simd, self.classes[k], wi, wo)
+    }
+
+    /// The (D, S) of the class held at `h`: its pair's lanes at the mirrored directions.
+    #[inline(always)]
+    fn held_f(&self, simd: SimdPath, h: Held, wi: [f32; 3], wo: [f32; 3]) -> [f32; 2] {
+        let (wi, wo) = (flipped(wi, h.sign), flipped(wo, h.sign));
+        let f = Self::pair_f(&self.pairs[h.pair as usize], simd, wi, wo);
+        // The lane is 0 or 2 (`& 2` lets the compiler drop the bound checks).
+        let l = h.lane as usize & 2;
+        [f[l], f[l + 1]]
     }
 
     /// A class pair's 4 lanes (D, S of each) at the directions, by `simd`'s kernel.
@@ -627,13 +658,7 @@ impl SpatialLookup {
         // `eval_at` passes finite u, v only.
         let (i, j) = (self.u_bins.locate_finite(u), self.v_bins.locate_finite(v));
         let p = self.points[j * (self.u_bins.edges.len() - 1) + i];
-        // As `class_f`: the stored class at the mirrored directions (x +-1: the same bits).
-        let [sx, sy] = p.sign;
-        let m = |w: [f32; 3]| [w[0] * sx, w[1] * sy, w[2]];
-        let f = Self::pair_f(&self.pairs[p.pair as usize], simd, m(wi), m(wo));
-        // The lane is 0 or 2 (`& 2` lets the compiler drop the bound checks).
-        let l = p.lane as usize & 2;
-        let (d, s) = (f[l], f[l + 1]);
+        let [d, s] = self.held_f(simd, p.held, wi, wo);
         p.albedo.map(|a| (a * d + s).max(0.0))
     }
 
