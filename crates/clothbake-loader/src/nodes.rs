@@ -187,6 +187,9 @@ pub(crate) trait Lane: Copy + sealed::Sealed {
     /// The processor must have AVX2, FMA and F16C.
     #[cfg(target_arch = "x86_64")]
     unsafe fn load8(run: &[Self; 8]) -> __m256;
+
+    /// `values`' tiles when they are of this lane type.
+    fn tiles(values: &Values) -> Option<&Tiles<Self>>;
 }
 
 impl Lane for f16 {
@@ -202,6 +205,14 @@ impl Lane for f16 {
         // 16 bytes, unaligned: the 8 halves of `run`.
         _mm256_cvtph_ps(_mm_loadu_si128(run.as_ptr().cast::<__m128i>()))
     }
+
+    #[inline(always)]
+    fn tiles(values: &Values) -> Option<&Tiles<f16>> {
+        match values {
+            Values::F16(t) => Some(t),
+            Values::F32(_) => None,
+        }
+    }
 }
 
 impl Lane for f32 {
@@ -216,6 +227,14 @@ impl Lane for f32 {
     unsafe fn load8(run: &[f32; 8]) -> __m256 {
         // 32 bytes, unaligned: the 8 floats of `run`.
         _mm256_loadu_ps(run.as_ptr())
+    }
+
+    #[inline(always)]
+    fn tiles(values: &Values) -> Option<&Tiles<f32>> {
+        match values {
+            Values::F32(t) => Some(t),
+            Values::F16(_) => None,
+        }
     }
 }
 

@@ -18,7 +18,7 @@ use crate::angles::{above_horizon, theta_phi};
 use crate::avx2;
 use crate::error::TableError;
 use crate::lookup::{has_value, pad4, SimdPath};
-use crate::nodes::{Nodes, Values};
+use crate::nodes::{Lane, Nodes, Values};
 use crate::stored::Samples;
 use crate::table::Grid;
 use clothbake_bsdf::Footprint;
@@ -261,6 +261,8 @@ pub struct SpatialLookup {
     v_bins: Bins,
     /// What a point lookup reads of each cell (row-major), in one place.
     points: Vec<PointCell>,
+    /// Whether the node tables hold half floats.
+    f16: bool,
 }
 
 /// Where a class is held: stored class `2 pair + lane / 2` (its D in lane `lane` of pair
@@ -297,28 +299,87 @@ struct PointCell {
 }
 
 /// The cell of an axis's `edges` holding a fraction of the period, found from uniform bins
-/// (each bin's first cell, then at most a step or two) instead of a search: the same cell as
-/// [`Spatial::locate`] (tested), in fewer instructions and no unpredictable branches.
+/// instead of a search: the same cell as [`Spatial::locate`] (tested), in few instructions and
+/// no unpredictable branches.
+///
+/// Bin `b` of `n` (a power of two, so that `f n` is exact) holds fractions in [b / n,
+/// (b + 1) / n). The bins are made fine enough that none holds more than one edge, so a
+/// point's cell is its bin's first cell, or the next one from the bin's split edge on: one
+/// comparison. An axis whose cells differ too much in width for that within 2^20 bins walks
+/// from the bin's first cell instead.
 #[derive(Clone, Debug)]
 struct Bins {
+    /// The first edge (kept beside the bins for locality).
+    e0: f64,
     edges: Vec<f64>,
     /// Bins per period.
     n: f64,
-    /// The cell holding each bin's start.
-    first: Vec<u32>,
+    /// Per bin: the edge from which the point lies in the next cell (infinite when the bin
+    /// has none), and the cell holding the bin's start; one more for f = 1 (by rounding).
+    bins: Vec<(f64, u32)>,
+    /// Whether every bin holds at most one edge (else the walk corrects the cell).
+    split: bool,
 }
+
+/// `x` (finite, in [0, 2^31)) truncated toward zero: one instruction where the saturating
+/// `as` takes seven.
+#[inline(always)]
+fn truncate(x: f64) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_cvttsd_si32, _mm_set_sd};
+        // SAFETY: SSE2 is part of every x86_64 processor. Out of range or NaN gives
+        // i32::MIN, which the caller's clamp bounds.
+        unsafe { _mm_cvttsd_si32(_mm_set_sd(x)) as u32 }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        x as u32
+    }
+}
+
+/// Most bins an axis may use (the split needs a bin narrower than the narrowest cell).
+const MAX_BINS: usize = 1 << 20;
 
 impl Bins {
     fn new(edges: &[f64]) -> Bins {
         let cells = edges.len() - 1;
-        let n = (4 * cells).max(16);
-        let first = (0..n)
-            .map(|b| Spatial::locate(edges, edges[0] + b as f64 / n as f64) as u32)
-            .collect();
-        Bins {
-            edges: edges.to_vec(),
-            n: n as f64,
-            first,
+        let e0 = edges[0];
+        // The cell of x = e0 + f, by the search's own rule on the same x the lookup forms.
+        let cell = |x: f64| {
+            edges
+                .partition_point(|&e| e <= x)
+                .saturating_sub(1)
+                .min(cells - 1)
+        };
+        let mut n = (4 * cells).max(16).next_power_of_two();
+        loop {
+            let first: Vec<usize> = (0..=n).map(|b| cell(e0 + b as f64 / n as f64)).collect();
+            // A point of bin b lies between its start and the next bin's start (rounding is
+            // monotonic), so its cell is first[b] or first[b] + 1 when first[b + 1] is at
+            // most that.
+            let split = first.windows(2).all(|w| w[1] <= w[0] + 1);
+            if split || n >= MAX_BINS {
+                let bins = first
+                    .iter()
+                    .map(|&i| {
+                        let next = if i + 1 < cells {
+                            edges[i + 1]
+                        } else {
+                            f64::INFINITY
+                        };
+                        (next, i as u32)
+                    })
+                    .collect();
+                return Bins {
+                    e0,
+                    edges: edges.to_vec(),
+                    n: n as f64,
+                    bins,
+                    split,
+                };
+            }
+            n *= 2;
         }
     }
 
@@ -331,21 +392,24 @@ impl Bins {
     /// [`Bins::locate`] of a finite `t`.
     #[inline(always)]
     fn locate_finite(&self, t: f64) -> usize {
-        let e = &self.edges;
-        let e0 = e[0];
+        let e0 = self.e0;
         let d = t - e0;
         let f = d - d.floor();
         let x = e0 + f;
-        // f in [0, 1] and at most 2^18 bins: in range of i32 (and `as` saturates anyway); the
-        // bin only starts the walk, which ends at the last edge <= x.
-        let b = ((f * self.n) as i32 as usize).min(self.first.len() - 1);
-        let mut i = self.first[b] as usize;
-        let last = e.len() - 2;
-        while i > 0 && e[i] > x {
-            i -= 1;
-        }
-        while i < last && e[i + 1] <= x {
-            i += 1;
+        // f in [0, 1] (1 by rounding): bin n holds f = 1 alone, and the clamp only keeps
+        // the index in bounds.
+        let b = (truncate(f * self.n) as usize).min(self.bins.len() - 1);
+        let (next, first) = self.bins[b];
+        let mut i = first as usize + usize::from(x >= next);
+        if !self.split {
+            let e = &self.edges;
+            let last = e.len() - 2;
+            while i > 0 && e[i] > x {
+                i -= 1;
+            }
+            while i < last && e[i + 1] <= x {
+                i += 1;
+            }
         }
         i
     }
@@ -519,6 +583,7 @@ impl SpatialLookup {
             grid,
             classes,
             pairs,
+            f16,
         }
     }
 
@@ -640,7 +705,9 @@ impl SpatialLookup {
                 // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C
                 // (the table's `SimdPath`, as in `class_f`).
                 #[cfg(target_arch = "x86_64")]
-                SimdPath::Avx2 => unsafe { self.point_avx2(wi, wo, u, v) },
+                SimdPath::Avx2 if self.f16 => unsafe { self.point_avx2::<half::f16>(wi, wo, u, v) },
+                #[cfg(target_arch = "x86_64")]
+                SimdPath::Avx2 => unsafe { self.point_avx2::<f32>(wi, wo, u, v) },
                 _ if has_value(wi, wo) => self.point(simd, wi, wo, u, v),
                 _ => [0.0; 3],
             });
@@ -656,21 +723,36 @@ impl SpatialLookup {
     #[inline(always)]
     fn point(&self, simd: SimdPath, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
         // `eval_at` passes finite u, v only.
-        let (i, j) = (self.u_bins.locate_finite(u), self.v_bins.locate_finite(v));
-        let p = self.points[j * (self.u_bins.edges.len() - 1) + i];
+        let p = self.point_cell(u, v);
         let [d, s] = self.held_f(simd, p.held, wi, wo);
         p.albedo.map(|a| (a * d + s).max(0.0))
     }
 
-    /// [`SpatialLookup::point`] compiled for AVX2 (the cell's `floor` one instruction, the
-    /// kernel inline).
+    /// [`SpatialLookup::point`] compiled for AVX2 on lanes `V` (the cell's `floor` one
+    /// instruction, the kernel inline: one call site per lane type).
     ///
     /// # Safety
     /// The processor must have AVX2, FMA and F16C.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,f16c")]
-    unsafe fn point_avx2(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
-        self.point(SimdPath::Avx2, wi, wo, u, v)
+    unsafe fn point_avx2<V: Lane>(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
+        let p = self.point_cell(u, v);
+        let h = p.held;
+        let nodes = &self.pairs[h.pair as usize];
+        let Some(values) = V::tiles(&nodes.values) else {
+            return [0.0; 3];
+        };
+        let f = avx2::eval4(nodes, values, flipped(wi, h.sign), flipped(wo, h.sign));
+        let l = h.lane as usize & 2;
+        let (d, s) = (f[l], f[l + 1]);
+        p.albedo.map(|a| (a * d + s).max(0.0))
+    }
+
+    /// The record of the cell holding (u, v) (finite).
+    #[inline(always)]
+    fn point_cell(&self, u: f64, v: f64) -> PointCell {
+        let (i, j) = (self.u_bins.locate_finite(u), self.v_bins.locate_finite(v));
+        self.points[j * (self.u_bins.edges.len() - 1) + i]
     }
 
     /// [`SpatialLookup::eval_at`] of a footprint whose side is in (0, 1), both directions
@@ -774,10 +856,13 @@ mod tests {
             (0..37)
                 .map(|k| (f64::from(k) / 37.0).powf(1.7) + 0.3)
                 .collect(),
+            // Cells too narrow for the split within the most bins: the walk.
+            vec![0.1, 0.1 + 1e-9, 0.1 + 2e-9, 0.5],
         ] {
             // The last edge one period after the first, as every layout has it.
             let edges: Vec<f64> = inner.iter().copied().chain([inner[0] + 1.0]).collect();
             let bins = Bins::new(&edges);
+            assert_eq!(bins.split, inner.len() < 4 || inner[1] - inner[0] > 1e-6);
             let mut ts: Vec<f64> = vec![f64::NAN, f64::INFINITY, -1e300, 1e300, -0.0];
             for &x in &edges {
                 for d in [-1e-12, 0.0, 1e-12, -1.0, 1.0, 3.0, -7.0] {
