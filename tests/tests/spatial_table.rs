@@ -4,7 +4,7 @@
 //! table through both file formats.
 
 use clothbake_bake::{bake, BakeOptions};
-use clothbake_core::{AnalyticModel, Cell, Fabric, FacetModel, UnitVec3};
+use clothbake_core::{AnalyticModel, Cell, Fabric, FacetModel, SecondaryOptions, UnitVec3};
 use clothbake_loader::{Brdf, Grid, Options, Table};
 use clothbake_tests::fixtures::{grid, tables};
 use std::sync::atomic::AtomicBool;
@@ -19,9 +19,14 @@ fn fabric(file: &str) -> Fabric {
 }
 
 fn baked(f: &Fabric, spatial: bool) -> Table {
+    baked_with(f, spatial, 1)
+}
+
+fn baked_with(f: &Fabric, spatial: bool, bounces: u32) -> Table {
     let opts = BakeOptions {
         grid: table_grid(),
         spatial,
+        bounces,
         ..BakeOptions::default()
     };
     bake(f, &opts, &|_| {}, &AtomicBool::new(false))
@@ -90,20 +95,92 @@ fn each_cell_of_the_table_is_the_models_reflection_there() {
         ("gingham.wif", 2),
         ("basket.json", 2),
     ] {
-        let f = fabric(file);
-        let model = AnalyticModel::new(&f, FacetModel::Huo);
-        let brdf = Brdf::from_table(baked(&f, true), Options::default()).unwrap();
-        let held = brdf.spatial().unwrap().stored_classes();
-        assert_eq!(held, stored, "{file}: {held} classes held");
+        cells_are_the_models(file, 1, stored);
+    }
+}
+
+#[test]
+fn with_the_second_bounce_each_cell_is_the_models_reflection_there() {
+    // As above with `--bounces 2`: each cell adds its piece's I_2 from its two parallel
+    // neighbours (docs/spatial.md), whose albedos differ from the cell's own at the gingham's
+    // stripe edges. Classes are apart where the neighbours differ in geometry (none of these:
+    // their direct classes already differ there), and a mirror image is held once with its
+    // sides exchanged where the mirror exchanges them: the basket's threads side by side,
+    // whose pair partner lies on opposite sides, are again 8 classes in 2.
+    for (file, stored) in [
+        ("twill.json", 2),
+        ("satin5.json", 3),
+        ("gingham.wif", 2),
+        ("basket.json", 2),
+    ] {
+        cells_are_the_models(file, 2, stored);
+    }
+}
+
+/// Shipped fabric `file` with every warp and every weft of its own colour: each thread's
+/// parallel neighbours differ from it and from each other.
+fn striped(file: &str) -> Fabric {
+    let text = std::fs::read_to_string(tables().join(file)).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let colours = [
+        [0.8, 0.1, 0.1],
+        [0.1, 0.7, 0.2],
+        [0.2, 0.1, 0.9],
+        [0.9, 0.9, 0.9],
+        [0.5, 0.4, 0.1],
+    ];
+    for (g, shift) in [("warp", 0), ("weft", 2)] {
+        let n = v["pattern"].as_array().map(|rows| match g {
+            "warp" => rows[0].as_array().unwrap().len(),
+            _ => rows.len(),
+        });
+        let list: Vec<[f64; 3]> = (0..n.unwrap()).map(|t| colours[(t + shift) % 5]).collect();
+        v[g]["thread_albedo"] = serde_json::json!(list);
+    }
+    Fabric::from_json_str(&v.to_string(), file).unwrap()
+}
+
+#[test]
+fn with_the_second_bounce_the_neighbours_colours_enter() {
+    // I_2 is bilinear in the albedos of the cell's thread and of each neighbour: striped, the
+    // twill's and the satin's classes are the plain ones', each cell's neighbours of their own
+    // colours (the satin's middle pieces have a neighbour on either side).
+    for (file, stored) in [("twill.json", 2), ("satin5.json", 3)] {
+        let f = striped(file);
+        cells_of(&f, file, 2, stored);
+        footprints_of_fabric(&f, file, 2);
+    }
+}
+
+/// The loader's point lookups of `file` baked with `bounces` against the model's per-cell
+/// reflection and coverage, every cell at every node pair; `stored` classes held.
+fn cells_are_the_models(file: &str, bounces: u32, stored: usize) {
+    cells_of(&fabric(file), file, bounces, stored)
+}
+
+/// As [`cells_are_the_models`], of fabric `f` named `file`.
+fn cells_of(f: &Fabric, file: &str, bounces: u32, stored: usize) {
+    {
+        let model = AnalyticModel::new(f, FacetModel::Huo);
+        let brdf = Brdf::from_table(baked_with(f, true, bounces), Options::default()).unwrap();
+        let sp = brdf.spatial().unwrap();
+        let held = sp.stored_classes();
+        assert_eq!(
+            held,
+            stored,
+            "{file}, {bounces} bounces: {held} of {} classes held",
+            sp.layout().classes
+        );
+        let secondary = (bounces == 2).then(SecondaryOptions::default);
         for (wi, wo) in node_pairs() {
             for (cell, u, v) in cell_centres(&model) {
-                let local = model.intensity_in(wi, wo, cell, None);
+                let local = model.intensity_in(wi, wo, cell, secondary.as_ref());
                 let want = local.reflection.brdf(wi);
                 let got = brdf.eval_at(f32s(wi), f32s(wo), u, v, 0.0);
                 for k in 0..3 {
                     assert!(
                         close(f64::from(got[k]), want[k], 1e-5),
-                        "{file} cell {cell:?} channel {k}: table {} model {}",
+                        "{file}, {bounces} bounces, cell {cell:?} channel {k}: table {} model {}",
                         got[k],
                         want[k]
                     );
@@ -123,17 +200,32 @@ fn each_cell_of_the_table_is_the_models_reflection_there() {
 fn the_averaged_part_is_the_averaged_bake() {
     // The spatial bake evaluates every cell (no symmetry copies); the average it stores is the
     // averaged bake's to rounding.
-    for file in ["twill.json", "gingham.wif"] {
+    // With the second bounce it is formed over the cells, the averaged bake's over the units.
+    for (file, bounces) in [
+        ("twill.json", 1),
+        ("gingham.wif", 1),
+        ("twill.json", 2),
+        ("gingham.wif", 2),
+        ("basket.json", 2),
+    ] {
         let f = fabric(file);
-        let (s, a) = (baked(&f, true), baked(&f, false));
+        let (s, a) = (
+            baked_with(&f, true, bounces),
+            baked_with(&f, false, bounces),
+        );
         let n = 3 * table_grid().len();
         assert_eq!(a.values.len(), n);
-        let classes = s.meta.spatial.as_ref().unwrap().classes as usize;
-        assert_eq!(s.values.len(), n + 2 * classes * table_grid().len());
+        let sp = s.meta.spatial.as_ref().unwrap();
+        let lanes = if bounces == 2 { 6 } else { 2 };
+        assert_eq!(sp.lanes(), lanes);
+        assert_eq!(
+            s.values.len(),
+            n + lanes * sp.classes as usize * table_grid().len()
+        );
         for (k, (x, y)) in s.values[..n].iter().zip(&a.values).enumerate() {
             assert!(
                 close(f64::from(*x), f64::from(*y), 1e-6),
-                "{file} value {k}: {x} vs {y}"
+                "{file}, {bounces} bounces, value {k}: {x} vs {y}"
             );
         }
     }
@@ -141,9 +233,30 @@ fn the_averaged_part_is_the_averaged_bake() {
 
 #[test]
 fn footprints_move_from_the_cell_to_the_average() {
-    let f = fabric("twill.json");
-    let model = AnalyticModel::new(&f, FacetModel::Huo);
-    let brdf = Brdf::from_table(baked(&f, true), Options::default()).unwrap();
+    footprints_of("twill.json", 1);
+}
+
+#[test]
+fn with_the_second_bounce_footprints_move_from_the_cell_to_the_average() {
+    // The twill's mirror-image classes are held with their sides exchanged (see above), and
+    // the gingham's neighbours differ in colour at its stripe edges.
+    footprints_of("twill.json", 2);
+    footprints_of("gingham.wif", 1);
+}
+
+/// Footprints of `file` baked with `bounces`: from a period on the averaged table, just under
+/// one the mean of the cells; the directional coverage; both kernels alike; nothing below the
+/// horizon.
+fn footprints_of(file: &str, bounces: u32) {
+    footprints_of_fabric(&fabric(file), file, bounces)
+}
+
+/// As [`footprints_of`], of fabric `f` named `file`.
+fn footprints_of_fabric(f: &Fabric, file: &str, bounces: u32) {
+    let model = AnalyticModel::new(f, FacetModel::Huo);
+    let brdf = Brdf::from_table(baked_with(f, true, bounces), Options::default()).unwrap();
+    let layout = brdf.spatial().unwrap().layout();
+    let (u0, v0) = (layout.u_edges[0], layout.v_edges[0]);
     for (wi, wo) in node_pairs() {
         let (wi, wo) = (f32s(wi), f32s(wo));
         let avg = brdf.eval(wi, wo);
@@ -157,7 +270,12 @@ fn footprints_move_from_the_cell_to_the_average() {
         let (mut num, mut den) = ([0.0f64; 3], 0.0f64);
         for j in 0..N {
             for i in 0..N {
-                let (u, v) = ((i as f64 + 0.5) / N as f64, (j as f64 + 0.5) / N as f64);
+                // From the first cell edge, so that no point falls on an edge (the gingham's
+                // cells start half a cell before 0).
+                let (u, v) = (
+                    u0 + (i as f64 + 0.5) / N as f64,
+                    v0 + (j as f64 + 0.5) / N as f64,
+                );
                 let c = f64::from(brdf.coverage_at(wo, u, v, 0.0));
                 let fr = brdf.eval_at(wi, wo, u, v, 0.0);
                 for k in 0..3 {
@@ -170,7 +288,8 @@ fn footprints_move_from_the_cell_to_the_average() {
             let mean = if den > 0.0 { num[k] / den } else { 0.0 };
             assert!(
                 close(mean, f64::from(avg[k]), 5e-3),
-                "grid mean {mean} vs average {}",
+                "{file}, {bounces} bounces, {wi:?} {wo:?} channel {k}: grid mean {mean} vs \
+                 average {}",
                 avg[k]
             );
             assert!(

@@ -44,7 +44,7 @@ impl Assembly {
         Assembly {
             orbits: orbits.clone(),
             state: Mutex::new(State {
-                values: vec![0.0; cells * (3 + 2 * orbits.classes())],
+                values: vec![0.0; cells * (3 + orbits.class_values())],
                 done: vec![false; rows.len()],
             }),
             rows,
@@ -91,7 +91,8 @@ impl Assembly {
             self.orbits.row_evaluations(row),
             "row {row}'s length"
         );
-        let (m, class_values) = (self.cells(), 2 * self.orbits.classes());
+        let (m, class_values) = (self.cells(), self.orbits.class_values());
+        let lanes = self.orbits.lanes();
         let mut s = self.state.lock().expect("no panics while held");
         let mut entries = vals.chunks_exact(self.orbits.stride());
         let values = &mut s.values;
@@ -99,7 +100,7 @@ impl Assembly {
             let v = entries.next().expect("one entry per canonical cell");
             values[3 * c..][..3].copy_from_slice(&v[0]);
             for (k, x) in v[1..].iter().flatten().take(class_values).enumerate() {
-                values[value_index(3 + k, c, m)] = *x;
+                values[value_index(3 + k, c, m, lanes)] = *x;
             }
         });
         s.done[row - self.rows.start] = true;
@@ -111,7 +112,8 @@ impl Assembly {
         if !self.rows.contains(&row) {
             return None;
         }
-        let (m, class_values) = (self.cells(), 2 * self.orbits.classes());
+        let (m, class_values) = (self.cells(), self.orbits.class_values());
+        let lanes = self.orbits.lanes();
         let s = self.state.lock().expect("no panics while held");
         if !s.done[row - self.rows.start] {
             return None;
@@ -119,7 +121,7 @@ impl Assembly {
         let mut out = Vec::with_capacity(self.orbits.row_evaluations(row));
         self.each_canonical_cell(row, |c| {
             out.push([s.values[3 * c], s.values[3 * c + 1], s.values[3 * c + 2]]);
-            let mut class = (0..class_values).map(|k| s.values[value_index(3 + k, c, m)]);
+            let mut class = (0..class_values).map(|k| s.values[value_index(3 + k, c, m, lanes)]);
             while let Some(a) = class.next() {
                 let b = class.next().unwrap_or(0.0);
                 let c = class.next().unwrap_or(0.0);
@@ -223,7 +225,8 @@ mod tests {
         for o in [
             Orbits::new(&grid(), &[]),
             Orbits::new(&grid(), &syms),
-            Orbits::spatial(&grid(), 2),
+            Orbits::spatial(&grid(), 2, 2),
+            Orbits::spatial(&grid(), 2, 6),
         ] {
             let a = Assembly::new(&o, 2..6);
             assert!(a.row(3).is_none());
@@ -233,11 +236,13 @@ mod tests {
             assert_eq!(a.done_rows(), [2, 3, 5]);
             for r in [2, 3, 5] {
                 let mut want = row_of(&o, r);
-                // The classes' padding comes back as 0 (2 K = 4 values in 2 entries).
+                // The classes' padding comes back as 0 (2 K = 4 values in 2 entries; 6 K = 12
+                // in 4, none).
                 if o.classes() > 0 {
                     for e in want.chunks_exact_mut(o.stride()) {
-                        e[2][1] = 0.0;
-                        e[2][2] = 0.0;
+                        for x in e[1..].iter_mut().flatten().skip(o.class_values()) {
+                            *x = 0.0;
+                        }
                     }
                 }
                 assert_eq!(a.row(r).unwrap(), want, "row {r}");

@@ -478,15 +478,17 @@ pub fn check_memory(
         Target::Memory => (rows, Kept::Table(None), None, 0),
     };
     let cells = baked * per_row;
-    // A spatial bake holds 3 + 2 K values a cell where an averaged one holds 3.
+    // A spatial bake holds 3 + 2 K values a cell (3 + 6 K with the second bounce) where an
+    // averaged one holds 3.
     let scale = if job.options.spatial {
         let variant = match job.options.method {
             crate::sweep::Method::Analytic { variant } => variant,
             crate::sweep::Method::Raytrace { .. } => Default::default(),
         };
+        let two = job.options.bounces == 2;
         let k = clothbake_core::AnalyticModel::with_variant(job.fabric, job.options.facet, variant)
-            .classes() as u64;
-        3 + 2 * k
+            .classes_with(two) as u64;
+        3 + if two { 6 } else { 2 } * k
     } else {
         3
     };

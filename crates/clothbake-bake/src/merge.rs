@@ -28,7 +28,7 @@ pub fn orbits_of(meta: &Metadata) -> Result<Orbits, String> {
                 meta.symmetry
             ));
         }
-        return Ok(Orbits::spatial(&meta.grid, l.classes as usize));
+        return Ok(Orbits::spatial(&meta.grid, l.classes as usize, l.lanes()));
     }
     let syms = usable_symmetries(&fabric, &meta.grid);
     if symmetry_name(&syms) != meta.symmetry {

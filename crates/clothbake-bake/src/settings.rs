@@ -267,10 +267,11 @@ impl Settings {
                 n.word("secondary", "raytrace")
             ));
         }
-        if self.spatial && (self.raytrace || self.bounces.bounces != 1) {
+        if self.spatial && (self.raytrace || self.bounces.bounces > 2) {
             return Err(format!(
-                "{} tabulates the analytic model's direct reflection; drop {} or use {} and {} \
-                 (spatial tables with inter-reflection or from the ray tracer are not built yet)",
+                "{} tabulates the analytic model's direct and secondary reflection; drop {} or \
+                 use {} and {} or 2 (the path-traced orders of every bounce and the ray tracer's \
+                 tables are averaged over the period)",
                 f("spatial"),
                 f("spatial"),
                 n.word("method", "analytic"),

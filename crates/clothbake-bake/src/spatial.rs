@@ -1,22 +1,28 @@
 //! `bake --spatial`: what a spatially varying table adds to the averaged one (docs/spatial.md,
 //! docs/table-format.md): the period's layout ([`layout`]) and, per grid cell, each class's
-//! diffuse and specular f_r ([`class_values`]), packed three to a [`crate::Row`] entry after
-//! the averaged RGB.
+//! diffuse and specular f_r and with the second bounce its neighbours' terms
+//! ([`class_values`]), packed three to a [`crate::Row`] entry after the averaged RGB.
 
-use clothbake_core::{AnalyticModel, ClassTerms, UnitVec3};
+use clothbake_core::{AnalyticModel, ClassTerms, SecondaryOptions, UnitVec3};
 use clothbake_loader::spatial::MAX_SPATIAL_CELLS;
 use clothbake_loader::{Grid, Spatial};
 
 use crate::sweep::direction;
 
-/// Entries of a row per grid cell in a spatial bake of `classes` classes: the averaged RGB and
-/// the classes' 2 K values, three to an entry.
-pub fn stride(classes: usize) -> usize {
-    1 + (2 * classes).div_ceil(3)
+/// Entries of a row per grid cell in a spatial bake whose classes hold `class_values` values
+/// per grid cell (2 K, or 6 K with the second bounce): the averaged RGB and those, three to an
+/// entry.
+pub fn stride(class_values: usize) -> usize {
+    1 + class_values.div_ceil(3)
 }
 
-/// The layout of `model`'s period on grid `g`, or why it cannot be baked.
-pub fn layout(model: &AnalyticModel, g: &Grid) -> Result<Spatial, String> {
+/// The layout of `model`'s period on grid `g`, with the second bounce's classes and neighbour
+/// albedos when `secondary` is given, or why it cannot be baked.
+pub fn layout(
+    model: &AnalyticModel,
+    g: &Grid,
+    secondary: Option<&SecondaryOptions>,
+) -> Result<Spatial, String> {
     let cells = model.cells();
     let (nx, ny) = cells.dims();
     if nx * ny > MAX_SPATIAL_CELLS {
@@ -26,14 +32,14 @@ pub fn layout(model: &AnalyticModel, g: &Grid) -> Result<Spatial, String> {
         ));
     }
     let (u_edges, v_edges) = cells.edge_fractions();
-    let classes = model.classes();
-    let cell_classes = model.cell_classes();
+    let classes = model.classes_with(secondary.is_some());
+    let cell_classes = model.cell_classes_with(secondary.is_some());
     let mut visible = vec![0.0f32; classes * g.n_theta_o as usize * g.n_phi_o as usize];
     let mut terms = vec![ClassTerms::default(); classes];
     for to in 0..g.n_theta_o {
         for po in 0..g.n_phi_o {
             let wo = direction(to, g.n_theta_o, po, g.n_phi_o);
-            model.class_terms(UnitVec3::Z, wo, &mut terms);
+            model.class_terms_with(UnitVec3::Z, wo, secondary, &mut terms);
             for (k, t) in terms.iter().enumerate() {
                 let n = (k * g.n_theta_o as usize + to as usize) * g.n_phi_o as usize + po as usize;
                 visible[n] = t.visible as f32;
@@ -44,17 +50,40 @@ pub fn layout(model: &AnalyticModel, g: &Grid) -> Result<Spatial, String> {
         classes: classes as u32,
         u_edges,
         v_edges,
-        cell_class: cell_classes.iter().map(|c| c.0).collect(),
-        cell_albedo: cell_classes.iter().map(|c| c.1.map(|a| a as f32)).collect(),
+        cell_class: cell_classes.iter().map(|c| c.class).collect(),
+        cell_albedo: cell_classes
+            .iter()
+            .map(|c| c.albedo.map(|a| a as f32))
+            .collect(),
         visible,
+        secondary: secondary.is_some(),
+        cell_neighbours: match secondary {
+            Some(_) => cell_classes
+                .iter()
+                .map(|c| c.neighbours.map(|n| n.map(|a| a as f32)))
+                .collect(),
+            None => Vec::new(),
+        },
     })
 }
 
-/// The classes' values (from [`AnalyticModel::class_terms`]) appended to `out` three to an
-/// entry (diffuse and specular of class 0, diffuse of class 1, ...; the last entry padded with
-/// 0).
-pub fn class_values(terms: &[ClassTerms], out: &mut Vec<[f32; 3]>) {
-    let mut flat = terms.iter().flat_map(|t| [t.diffuse, t.specular]);
+/// The classes' values (from [`AnalyticModel::class_terms_with`]) appended to `out` three to
+/// an entry: per class diffuse and specular and, with the second bounce (`secondary`), its +c
+/// side's neighbour and both terms, then the -c side's; the last entry padded with 0.
+pub fn class_values(terms: &[ClassTerms], secondary: bool, out: &mut Vec<[f32; 3]>) {
+    let lanes = if secondary { 6 } else { 2 };
+    let mut flat = terms.iter().flat_map(|t| {
+        [
+            t.diffuse,
+            t.specular,
+            t.neighbour[0],
+            t.both[0],
+            t.neighbour[1],
+            t.both[1],
+        ]
+        .into_iter()
+        .take(lanes)
+    });
     while let Some(a) = flat.next() {
         let b = flat.next().unwrap_or(0.0);
         let c = flat.next().unwrap_or(0.0);

@@ -237,11 +237,11 @@ pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
     opts.grid
         .validate()
         .map_err(|e| BakeError::Invalid(e.to_string()))?;
-    if opts.spatial && (opts.bounces != 1 || !matches!(opts.method, Method::Analytic { .. })) {
+    if opts.spatial && (opts.bounces > 2 || !matches!(opts.method, Method::Analytic { .. })) {
         return Err(BakeError::Invalid(
-            "--spatial bakes the analytic model's direct reflection; give --bounces 1 and \
-             --method analytic with --spatial (spatial tables with inter-reflection are not \
-             built yet)"
+            "--spatial bakes the analytic model's direct and secondary reflection; give \
+             --bounces 1 or 2 and --method analytic with --spatial (the path-traced orders of \
+             --bounces all and the ray tracer's tables are averaged over the period)"
                 .into(),
         ));
     }
@@ -288,6 +288,8 @@ pub struct Orbits {
     stride: usize,
     /// A spatial bake's classes (0 otherwise).
     classes: usize,
+    /// A spatial bake's values per class and grid cell (`Spatial::lanes`).
+    lanes: usize,
 }
 
 impl Orbits {
@@ -314,15 +316,18 @@ impl Orbits {
             per_phi_i,
             stride: 1,
             classes: 0,
+            lanes: 2,
         }
     }
 
-    /// The orbits of a spatial bake of `classes` classes: no symmetry (it would map cells of
-    /// the period onto others), [`crate::spatial::stride`] row entries per cell.
-    pub fn spatial(g: &Grid, classes: usize) -> Orbits {
+    /// The orbits of a spatial bake of `classes` classes of `lanes` values per grid cell: no
+    /// symmetry (it would map cells of the period onto others), [`crate::spatial::stride`] row
+    /// entries per cell.
+    pub fn spatial(g: &Grid, classes: usize, lanes: usize) -> Orbits {
         Orbits {
-            stride: crate::spatial::stride(classes),
+            stride: crate::spatial::stride(lanes * classes),
             classes,
+            lanes,
             ..Orbits::new(g, &[])
         }
     }
@@ -368,6 +373,16 @@ impl Orbits {
         self.classes
     }
 
+    /// A spatial bake's values per class and grid cell.
+    pub fn lanes(&self) -> usize {
+        self.lanes
+    }
+
+    /// A spatial bake's class values per grid cell (0 otherwise).
+    pub fn class_values(&self) -> usize {
+        self.lanes * self.classes
+    }
+
     /// Entries of `row`'s [`Row`]: the cells it evaluates times [`Orbits::stride`].
     pub fn row_evaluations(&self, row: usize) -> usize {
         let (_, pi) = row_cell(&self.grid, row);
@@ -404,9 +419,9 @@ impl Orbits {
         let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
         assert_eq!(rows.len(), self.rows(), "one Row per grid row");
         let n = g.len();
-        // A spatial table's classes: 2 K values per cell after the averaged RGB (the cell's last
-        // row entry may end in padding).
-        let class_values = 2 * self.classes;
+        // A spatial table's classes: lanes K values per cell after the averaged RGB (the
+        // cell's last row entry may end in padding).
+        let class_values = self.class_values();
         let mut values = vec![f32::NAN; n * 3 + n * class_values];
         for (row, vals) in rows.iter().enumerate() {
             assert_eq!(vals.len(), self.row_evaluations(row), "row {row}'s length");
@@ -419,7 +434,7 @@ impl Orbits {
                         let c = g.index(ti, pi, to, po);
                         values[3 * c..][..3].copy_from_slice(&v[0]);
                         for (m, x) in v[1..].iter().flatten().take(class_values).enumerate() {
-                            values[value_index(3 + m, c, n)] = *x;
+                            values[value_index(3 + m, c, n, self.lanes)] = *x;
                         }
                     }
                 }
@@ -486,16 +501,23 @@ impl Baker {
         let eval: CellFn = match (opts.method, multiple.clone()) {
             (Method::Analytic { variant }, None) if opts.spatial => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
-                let layout = crate::spatial::layout(&m, &g).map_err(BakeError::Invalid)?;
+                let layout = crate::spatial::layout(&m, &g, secondary.as_ref())
+                    .map_err(BakeError::Invalid)?;
                 syms.clear();
-                let classes = m.classes();
+                let classes = layout.classes as usize;
+                let cells = secondary.map(|_| m.cell_classes_with(true));
                 spatial = Some(layout);
                 Box::new(move |_, wi, wo, out| {
-                    // The average from the classes: each unit is evaluated once.
+                    // The average from the classes: each unit (with the second bounce, each
+                    // unit beside each neighbour pair) is evaluated once.
                     let mut terms = vec![ClassTerms::default(); classes];
-                    m.class_terms(wi, wo, &mut terms);
-                    out.push(m.average_of_classes(&terms).map(|x| x as f32));
-                    crate::spatial::class_values(&terms, out);
+                    m.class_terms_with(wi, wo, secondary.as_ref(), &mut terms);
+                    let average = match &cells {
+                        Some(cells) => m.average_of_cells(cells, &terms),
+                        None => m.average_of_classes(&terms),
+                    };
+                    out.push(average.map(|x| x as f32));
+                    crate::spatial::class_values(&terms, cells.is_some(), out);
                 })
             }
             (Method::Analytic { variant }, Some(mb)) => {
@@ -538,7 +560,7 @@ impl Baker {
             spatial: None,
         };
         let orbits = match &spatial {
-            Some(l) => Orbits::spatial(&g, l.classes as usize),
+            Some(l) => Orbits::spatial(&g, l.classes as usize, l.lanes()),
             None => Orbits::new(&g, &syms),
         };
         let meta = Metadata { spatial, ..meta };

@@ -178,20 +178,47 @@ pub struct AnalyticModel {
     unit_class: Vec<u32>,
     /// A unit of each class.
     class_unit: Vec<u32>,
+    /// The class with the second bounce of each cell, by [`CellGrid::index`]: cells whose
+    /// class and neighbours' geometry agree (their albedos may differ).
+    bounce_class: Vec<u32>,
+    /// Each such class's unit and neighbour pair (the variant), as in `cell_units`.
+    bounce_unit: Vec<(u32, u32)>,
 }
 
-/// A class's direct reflection for one pair of directions, per unit diffuse albedo
+/// A class's reflection for one pair of directions, per unit diffuse albedo
 /// (docs/spatial.md): a cell of the class whose thread has albedo rho_d reflects
-/// f_r = rho_d `diffuse` + `specular` (eqs 4.1, 4.11 restricted to the cell's piece).
+/// f_r = rho_d `diffuse` + `specular` (eqs 4.1, 4.11 restricted to the cell's piece). With the
+/// second bounce (eq. 5.15, sec. 5.4), its neighbours on the +c and -c sides, of albedos
+/// rho_+ and rho_-, add sum_k rho_k (`neighbour[k]` + rho_d `both[k]`), and `diffuse` and
+/// `specular` include I_sd and I_ss.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ClassTerms {
-    /// f_r of the diffuse term with rho_d = 1, in 1/sr.
+    /// f_r of the terms proportional to the thread's own diffuse albedo, at rho_d = 1, in 1/sr.
     pub diffuse: f64,
-    /// f_r of the specular term, in 1/sr.
+    /// f_r of the terms of no diffuse albedo (the specular term; with the second bounce also
+    /// I_ss), in 1/sr.
     pub specular: f64,
+    /// f_r of I_ds from the neighbour on the +c side and on the -c side, per unit albedo of
+    /// that neighbour (0 with one bounce).
+    pub neighbour: [f64; 2],
+    /// f_r of I_dd from each side, per unit albedo of both threads (0 with one bounce).
+    pub both: [f64; 2],
     /// The piece's visible projected area seen from `wo` over the period's projected area:
     /// a cell's coverage is this over the cell's share of the period's area.
     pub visible: f64,
+}
+
+/// What a spatial table records of one crossing cell: its class and the albedos its
+/// [`ClassTerms`] are multiplied by.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CellClass {
+    /// The class of the unit the cell shows.
+    pub class: u32,
+    /// The diffuse albedo of its thread.
+    pub albedo: [f64; 3],
+    /// The diffuse albedos of its parallel neighbours on the +c and -c sides (0 where there
+    /// is none); they matter with the second bounce only.
+    pub neighbours: [[f64; 3]; 2],
 }
 
 /// What the model answers at one point of the weave period (docs/spatial.md).
@@ -306,9 +333,10 @@ struct UnitTerms {
     l_v: f64,
     /// Projected width of the visible arc (with |E_p|): S_v = l_v * width (eq. 4.3).
     width: f64,
-    /// Secondary reflection per unit visible length from each neighbour pair asked for, with
-    /// the number of pieces beside that pair (empty with one bounce).
-    secondary: Vec<(Secondary, u32)>,
+    /// Secondary reflection per unit visible length from each neighbour pair asked for, from
+    /// the +c and the -c side, with the number of pieces beside that pair (empty with one
+    /// bounce).
+    secondary: Vec<([Secondary; 2], u32)>,
     /// Lit and visible length l_vi and the arc integrals of the facet's diffuse factor and
     /// specular intensity (eqs 4.4-4.10); `None` where no point is both lit and visible.
     lit: Option<(f64, f64, f64)>,
@@ -688,6 +716,28 @@ impl AnalyticModel {
                 cell_units[cell] = (i as u32, variant as u32);
             }
         }
+        // Classes with the second bounce: a cell's class and its neighbours' geometry.
+        let mut bounce_index = UnitIndex::new(KEY_TOLERANCE);
+        let mut bounce_unit: Vec<(u32, u32)> = Vec::new();
+        let bounce_class = cell_units
+            .iter()
+            .map(|&(u, var)| {
+                let nbs = &units[u as usize].neighbours[var as usize].0;
+                neighbour_key(
+                    unit_class[u as usize] as usize,
+                    nbs,
+                    unit_len,
+                    &mut pair_key,
+                );
+                match bounce_index.find_or_insert(&pair_key) {
+                    Some(b) => b as u32,
+                    None => {
+                        bounce_unit.push((u, var));
+                        bounce_unit.len() as u32 - 1
+                    }
+                }
+            })
+            .collect();
         AnalyticModel {
             facet,
             variant,
@@ -696,6 +746,8 @@ impl AnalyticModel {
             cell_units,
             unit_class,
             class_unit,
+            bounce_class,
+            bounce_unit,
         }
     }
 
@@ -756,13 +808,13 @@ impl AnalyticModel {
         let views = Views::both(wi, wo);
         for u in &self.units {
             let v = &views[u.seg.group as usize];
-            let Some(t) = self.unit_terms(u, &u.neighbours, v, wi, wo, secondary) else {
+            let Some(t) = self.unit_terms(u, &u.neighbours, v, wi, wo, secondary, false) else {
                 continue;
             };
             let d = u.count as f64;
             s_total += d * t.l_v * t.width;
             for (s, n) in &t.secondary {
-                i_2.add_scaled(s, f64::from(*n) * t.l_v);
+                i_2.add_scaled(&both_sides(s), f64::from(*n) * t.l_v);
             }
             let Some((l_vi, kd, ks)) = t.lit else {
                 continue;
@@ -811,9 +863,10 @@ impl AnalyticModel {
         })
     }
 
-    /// Unit `u`'s terms of eq. 4.11 (and of I_2 with `secondary`) for light from `wi` seen
-    /// from `wo` (both above the horizon; `views` of its group): `None` where nothing of it is
-    /// visible.
+    /// Unit `u`'s terms of eq. 4.11 (and of I_2 with `secondary`, from threads of albedo 1 when
+    /// `white`) for light from `wi` seen from `wo` (both above the horizon; `views` of its
+    /// group): `None` where nothing of it is visible.
+    #[allow(clippy::too_many_arguments)]
     fn unit_terms(
         &self,
         u: &Unit,
@@ -822,6 +875,7 @@ impl AnalyticModel {
         wi: UnitVec3,
         wo: UnitVec3,
         secondary: Option<&SecondaryOptions>,
+        white: bool,
     ) -> Option<UnitTerms> {
         let seg = &u.seg;
         // The eye's and the light's arcs first: two independent chains of divisions and
@@ -836,7 +890,10 @@ impl AnalyticModel {
             let (l, e) = (wi.get(), wo.get());
             variants
                 .iter()
-                .map(|(nbs, n)| (self.secondary(u, nbs, opts, l, e, v.arc.arc, lit.arc), *n))
+                .map(|(nbs, n)| {
+                    let sides = self.secondary(u, nbs, opts, l, e, (v.arc.arc, lit.arc), white);
+                    (sides, *n)
+                })
                 .collect()
         });
         let l_vi = overlap(u.range, meet(v.along, lit_len));
@@ -892,7 +949,7 @@ impl AnalyticModel {
         let u = &self.units[unit as usize];
         let variants = std::slice::from_ref(&u.neighbours[variant as usize]);
         let views = Views::both(wi, wo)[u.seg.group as usize];
-        let Some(t) = self.unit_terms(u, variants, &views, wi, wo, secondary) else {
+        let Some(t) = self.unit_terms(u, variants, &views, wi, wo, secondary, false) else {
             return empty;
         };
         let s_v = t.l_v * t.width;
@@ -909,9 +966,9 @@ impl AnalyticModel {
                 i_d,
                 i_s,
                 secondary: secondary.map(|_| {
-                    t.secondary
-                        .first()
-                        .map_or_else(Secondary::default, |s| s.0.scaled(1.0 / t.width))
+                    t.secondary.first().map_or_else(Secondary::default, |s| {
+                        both_sides(&s.0).scaled(1.0 / t.width)
+                    })
                 }),
             },
             coverage,
@@ -955,7 +1012,7 @@ impl AnalyticModel {
         for (o, &u) in out.iter_mut().zip(&self.class_unit) {
             let u = &self.units[u as usize];
             let v = &views[u.seg.group as usize];
-            let Some(t) = self.unit_terms(u, &[], v, wi, wo, None) else {
+            let Some(t) = self.unit_terms(u, &[], v, wi, wo, None, false) else {
                 continue;
             };
             let s_v = t.l_v * t.width;
@@ -987,6 +1044,121 @@ impl AnalyticModel {
                 *n += w * (a * t.diffuse + t.specular);
             }
             den += w;
+        }
+        if den > 0.0 {
+            num.map(|n| n / den)
+        } else {
+            [0.0; 3]
+        }
+    }
+
+    /// Number of classes with the second bounce (`secondary`) or without: with it, cells of
+    /// one class beside neighbours of different geometry are apart.
+    pub fn classes_with(&self, secondary: bool) -> usize {
+        if secondary {
+            self.bounce_unit.len()
+        } else {
+            self.classes()
+        }
+    }
+
+    /// Each cell's class (with the second bounce when `secondary`) and the albedos its
+    /// [`ClassTerms`] are multiplied by, by [`CellGrid::index`].
+    pub fn cell_classes_with(&self, secondary: bool) -> Vec<CellClass> {
+        self.cell_units
+            .iter()
+            .zip(&self.bounce_class)
+            .map(|(&(u, var), &b)| {
+                let unit = &self.units[u as usize];
+                let nbs = &unit.neighbours[var as usize].0;
+                CellClass {
+                    class: if secondary {
+                        b
+                    } else {
+                        self.unit_class[u as usize]
+                    },
+                    albedo: unit.seg.material.albedo,
+                    neighbours: nbs.map(|n| n.map_or([0.0; 3], |n| n.material.albedo)),
+                }
+            })
+            .collect()
+    }
+
+    /// As [`AnalyticModel::class_terms`], with the second bounce when `secondary` is given:
+    /// one entry per class of [`AnalyticModel::classes_with`]. For every cell, its
+    /// [`CellClass`]'s albedos and its class's terms give the f_r of
+    /// [`AnalyticModel::intensity_in`] with the same `secondary`.
+    pub fn class_terms_with(
+        &self,
+        wi: UnitVec3,
+        wo: UnitVec3,
+        secondary: Option<&SecondaryOptions>,
+        out: &mut [ClassTerms],
+    ) {
+        let Some(opts) = secondary else {
+            return self.class_terms(wi, wo, out);
+        };
+        assert_eq!(out.len(), self.bounce_unit.len(), "one entry per class");
+        out.fill(ClassTerms::default());
+        if !(wi.above_horizon() && wo.above_horizon()) {
+            return;
+        }
+        let views = Views::both(wi, wo);
+        let (px, py) = self.grid.period();
+        // I_2 of a cell is its piece's, per unit visible length, over the visible width.
+        let f = |x: f64, width: f64| intensity_to_brdf([x / width, 0.0, 0.0], wi)[0];
+        for (o, &(u, var)) in out.iter_mut().zip(&self.bounce_unit) {
+            let u = &self.units[u as usize];
+            let v = &views[u.seg.group as usize];
+            let variants = std::slice::from_ref(&u.neighbours[var as usize]);
+            let Some(t) = self.unit_terms(u, variants, v, wi, wo, Some(opts), true) else {
+                continue;
+            };
+            let s_v = t.l_v * t.width;
+            o.visible = s_v / (px * py * wo.cos_theta());
+            let (mut d, mut s) = (0.0, 0.0);
+            if let Some((l_vi, kd, ks)) = t.lit {
+                let w = l_vi * u.seg.radius / s_v;
+                [d, s, _] = intensity_to_brdf([w * kd, w * ks, 0.0], wi);
+            }
+            // Threads of albedo 1: each component is the same in every channel.
+            let sides = &t.secondary[0].0;
+            let own = f(sides[0].sd[0] + sides[1].sd[0], t.width);
+            let none = f(sides[0].ss[0] + sides[1].ss[0], t.width);
+            // Each is non-negative; rounding near the horizon may leave either sign (as in
+            // `class_terms`), which a table may not hold.
+            o.diffuse = (d + own).max(0.0);
+            o.specular = (s + none).max(0.0);
+            o.neighbour = sides.map(|p| f(p.ds[0], t.width).max(0.0));
+            o.both = sides.map(|p| f(p.dd[0], t.width).max(0.0));
+        }
+    }
+
+    /// A cell's f_r (RGB, 1/sr) from its [`CellClass`] and its class's [`ClassTerms`].
+    pub fn cell_f(cell: &CellClass, t: &ClassTerms) -> [f64; 3] {
+        std::array::from_fn(|c| {
+            let a = cell.albedo[c];
+            let [p, m] = cell.neighbours;
+            a * t.diffuse
+                + t.specular
+                + p[c] * (t.neighbour[0] + a * t.both[0])
+                + m[c] * (t.neighbour[1] + a * t.both[1])
+        })
+    }
+
+    /// The period's averaged f_r (RGB, 1/sr) from the cells' classes (`cells`, of
+    /// [`AnalyticModel::cell_classes_with`]) and their `terms`: each cell's f_r weighted by its
+    /// class's visible area (eq. 4.11 over the pieces, one piece a cell). Equal to the f_r of
+    /// [`AnalyticModel::intensity_with`] to rounding.
+    pub fn average_of_cells(&self, cells: &[CellClass], terms: &[ClassTerms]) -> [f64; 3] {
+        let (mut num, mut den) = ([0.0; 3], 0.0);
+        for c in cells {
+            let t = &terms[c.class as usize];
+            let f = Self::cell_f(c, t);
+            for (n, f) in num.iter_mut().zip(f) {
+                *n += t.visible * f;
+            }
+            den += t.visible;
         }
         if den > 0.0 {
             num.map(|n| n / den)
@@ -1027,8 +1199,10 @@ impl AnalyticModel {
     }
 
     /// Secondary reflection reaching the eye from the visible arc of unit `u`, per unit length,
-    /// from both parallel neighbours `nbs`. The neighbour's lit arc is taken equal to the unit's
-    /// own (exact for the parallel-cylinder surface, where all cylinders are alike).
+    /// from each parallel neighbour of `nbs` (+c side, -c side; zero where there is none), the
+    /// threads of albedo 1 when `white` (the colourless components of
+    /// [`ClassTerms`]). The neighbour's lit arc is taken equal to the unit's own (exact for the
+    /// parallel-cylinder surface, where all cylinders are alike).
     #[allow(clippy::too_many_arguments)]
     fn secondary(
         &self,
@@ -1037,12 +1211,22 @@ impl AnalyticModel {
         opts: &SecondaryOptions,
         l: Vec3,
         e: Vec3,
-        vis: Arc,
-        lit: Arc,
-    ) -> Secondary {
+        (vis, lit): (Arc, Arc),
+        white: bool,
+    ) -> [Secondary; 2] {
         let (c, a) = frame(u.seg.group);
-        let mut out = Secondary::default();
-        for (side, nb) in [(1.0, &nbs[0]), (-1.0, &nbs[1])] {
+        let mut out = [Secondary::default(); 2];
+        let colour = |m: Material| {
+            if white {
+                Material {
+                    albedo: [1.0; 3],
+                    ..m
+                }
+            } else {
+                m
+            }
+        };
+        for (k, (side, nb)) in [(1.0, &nbs[0]), (-1.0, &nbs[1])].into_iter().enumerate() {
             let Some(nb) = nb else { continue };
             let local = |v: Vec3| Vec3::new(side * v.dot(c), v.dot(a), v.z);
             let mirror = |arc: Arc| {
@@ -1061,8 +1245,8 @@ impl AnalyticModel {
                 r2: nb.radius,
                 h2: nb.height,
                 d: nb.d,
-                m1: u.seg.material,
-                m2: nb.material,
+                m1: colour(u.seg.material),
+                m2: colour(nb.material),
                 facet: self.facet,
                 kernel: opts.kernel,
             };
@@ -1079,7 +1263,7 @@ impl AnalyticModel {
                 }
                 SecondaryMethod::Sampling(p) => two_level_sampling(&pair, &setting, p),
             };
-            out.add_scaled(&part, 1.0);
+            out[k] = part;
         }
         out
     }
@@ -1191,6 +1375,15 @@ impl AnalyticModel {
         let s = integrate(&mut f, arc.lo, peak, tol) + integrate(&mut f, peak, arc.hi, tol);
         (kd, s)
     }
+}
+
+/// The secondary reflection from both sides, summed in the order of sec. 5.4's two
+/// neighbours (+c, then -c).
+fn both_sides(s: &[Secondary; 2]) -> Secondary {
+    let mut out = Secondary::default();
+    out.add_scaled(&s[0], 1.0);
+    out.add_scaled(&s[1], 1.0);
+    out
 }
 
 fn meet(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {

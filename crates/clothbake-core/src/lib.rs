@@ -32,7 +32,8 @@ pub mod wif;
 pub mod yarn;
 
 pub use analytic::{
-    AnalyticModel, ClassTerms, LocalReflection, SecondaryMethod, SecondaryOptions, Variant,
+    AnalyticModel, CellClass, ClassTerms, LocalReflection, SecondaryMethod, SecondaryOptions,
+    Variant,
 };
 pub use brdf::{AnalyticBsdf, Component};
 pub use cells::{Cell, CellGrid, PeriodPoint};

@@ -9,6 +9,14 @@ use crate::atomic::write_atomic_as;
 use crate::bytes::{hex, CHUNK_VALUES};
 use crate::error::TableError;
 use crate::spatial::{channel_names, value_index};
+
+/// The channels of `meta`'s table, in [`channel_names`] order.
+fn table_channels(meta: &Metadata) -> Vec<String> {
+    meta.spatial.as_ref().map_or_else(
+        || channel_names(0, 2),
+        |s| channel_names(s.classes, s.lanes()),
+    )
+}
 use crate::stored::{Samples, StoredTable};
 use crate::table::{check_format_version, Grid, Metadata, Precision, Table, FORMAT_VERSION};
 
@@ -66,6 +74,14 @@ pub fn directions_text(g: &Grid) -> String {
 /// What the channels hold, in words.
 pub fn values_text(meta: &Metadata) -> String {
     let classes = match &meta.spatial {
+        Some(s) if s.secondary => format!(
+            "; class<k>.diffuse, class<k>.specular, class<k>.plus_neighbour, class<k>.plus_both, \
+             class<k>.minus_neighbour, class<k>.minus_both (k < {}): each class's f_r at unit \
+             diffuse albedo, its f_r of no albedo, and the second bounce's terms per unit albedo \
+             of the +c and -c neighbours (and of both threads), for the weave period's cells \
+             (clothbake.metadata's \"spatial\" gives each cell's class and albedos)",
+            s.classes
+        ),
         Some(s) => format!(
             "; class<k>.diffuse, class<k>.specular (k < {}): each class's f_r at unit diffuse \
              albedo and its specular f_r, for the weave period's cells (clothbake.metadata's \
@@ -256,7 +272,7 @@ mod exr_io {
         }
         let (width, height) = (width as usize, height as usize);
 
-        let names = channel_names(table.meta.spatial.as_ref().map_or(0, |s| s.classes));
+        let names = table_channels(&table.meta);
         if precision == Precision::F16 {
             let max = half::f16::MAX.to_f32();
             if let Some(v) = table.values.iter().find(|v| v.abs() > max) {
@@ -272,6 +288,7 @@ mod exr_io {
                 values: &table.values,
                 grid,
                 ch,
+                lanes: table.meta.spatial.as_ref().map_or(2, |s| s.lanes()),
                 precision,
             })
             .collect();
@@ -337,6 +354,8 @@ mod exr_io {
         values: &'a [f32],
         grid: Grid,
         ch: usize,
+        /// Values per class and grid cell.
+        lanes: usize,
         precision: Precision,
     }
 
@@ -347,7 +366,7 @@ mod exr_io {
             let (npo, nto) = (g.n_phi_o as usize, g.n_theta_o as usize);
             let (ti, to, pi, po) = (y / nto, y % nto, x / npo, x % npo);
             let c = ((ti * g.n_phi_i as usize + pi) * nto + to) * npo + po;
-            self.values[value_index(self.ch, c, g.len())]
+            self.values[value_index(self.ch, c, g.len(), self.lanes)]
         }
 
         /// The value of pixel `i` as stored (rounded to the precision), widened to f32.
@@ -565,7 +584,7 @@ mod exr_io {
                     grid.exr_height()
                 )));
             }
-            let expected = channel_names(meta.spatial.as_ref().map_or(0, |s| s.classes));
+            let expected = table_channels(&meta);
             let mut names: Vec<String> = header
                 .channels
                 .list
@@ -578,7 +597,8 @@ mod exr_io {
             if names != sorted {
                 return Err(foreign(if meta.spatial.is_some() {
                     format!(
-                        "the EXR has channels {names:?}, but this spatial table has exactly R, G, B and each class's diffuse and specular"
+                        "the EXR has channels {names:?}, but this spatial table has exactly {}",
+                        expected.join(", ")
                     )
                 } else {
                     format!("the EXR has channels {names:?}, but a table has exactly R, G and B")
@@ -655,12 +675,14 @@ mod exr_io {
                     })
                 })
             };
-            // The averaged RGB, interleaved, then each class's (diffuse, specular) pairs.
+            // The averaged RGB, interleaved, then each class's values (diffuse, specular, ...)
+            // cell by cell.
+            let lanes = meta.spatial.as_ref().map_or(2, |s| s.lanes());
             let order = || {
                 let rgb = pixels().flat_map(|x| [(0, x), (1, x), (2, x)]);
-                let classes = (3..planes.len())
-                    .step_by(2)
-                    .flat_map(move |ch| pixels().flat_map(move |x| [(ch, x), (ch + 1, x)]));
+                let classes = (3..planes.len()).step_by(lanes).flat_map(move |ch| {
+                    pixels().flat_map(move |x| (ch..ch + lanes).map(move |c| (c, x)))
+                });
                 rgb.chain(classes)
             };
             let all_f16 = planes.iter().all(|p| matches!(p, Plane::F16(_)));

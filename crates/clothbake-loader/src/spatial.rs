@@ -6,7 +6,8 @@
 //! f_r of the class's diffuse term at unit albedo (D) and of its specular term (S), after the
 //! averaged values, class by class, cell by cell, D then S (`docs/table-format.md`). A cell of
 //! the period whose class is `k` and whose thread has diffuse albedo rho_d reflects
-//! `rho_d D_k + S_k`; its coverage c(x; wo) is the class's visible share of the period
+//! `rho_d D_k + S_k` (with the second bounce six values: its neighbours of albedos rho_+ and
+//! rho_- add `rho_+ (N+ + rho_d B+) + rho_- (N- + rho_d B-)`); its coverage c(x; wo) is the class's visible share of the period
 //! ([`Spatial::visible`], tabulated over the outgoing directions) over the cell's share of the
 //! period's area. The coverage-weighted mean of the cells' f_r is the averaged table
 //! (docs/spatial.md).
@@ -47,27 +48,49 @@ pub struct Spatial {
     /// Each class's visible projected area over the period's projected area, at the grid's
     /// outgoing cell centres: `visible[(k * n_theta_o + to) * n_phi_o + po]`.
     pub visible: Vec<f32>,
+    /// Whether the classes hold the second bounce: six values per class and grid cell
+    /// ([`Spatial::lanes`]) instead of two.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub secondary: bool,
+    /// With `secondary`: the diffuse albedos (RGB) of the parallel neighbours on the +c and
+    /// the -c side of each cell's thread, row-major (0 where there is none); empty otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cell_neighbours: Vec<[[f32; 3]; 2]>,
 }
 
+/// The values a class holds per grid cell: D, S and, with the second bounce, the +c
+/// neighbour's and both threads' terms, then the -c side's.
+const LANE_NAMES: [&str; 6] = [
+    "diffuse",
+    "specular",
+    "plus_neighbour",
+    "plus_both",
+    "minus_neighbour",
+    "minus_both",
+];
+
 /// The names of a table's channels in an OpenEXR file: `R`, `G`, `B` and, for a spatial table
-/// of `classes` classes, `class<k>.diffuse` and `class<k>.specular` for each class `k`.
-pub fn channel_names(classes: u32) -> Vec<String> {
+/// of `classes` classes of `lanes` values ([`Spatial::lanes`]), `class<k>.diffuse`,
+/// `class<k>.specular` and with the second bounce `class<k>.plus_neighbour`,
+/// `class<k>.plus_both`, `class<k>.minus_neighbour`, `class<k>.minus_both` for each class `k`.
+pub fn channel_names(classes: u32, lanes: usize) -> Vec<String> {
     let mut names: Vec<String> = ["R", "G", "B"].map(String::from).to_vec();
     for k in 0..classes {
-        names.push(format!("class{k}.diffuse"));
-        names.push(format!("class{k}.specular"));
+        for lane in &LANE_NAMES[..lanes] {
+            names.push(format!("class{k}.{lane}"));
+        }
     }
     names
 }
 
 /// Index in a table's values of channel `ch` (in [`channel_names`] order) of grid cell `cell`,
-/// for a grid of `n` cells.
-pub fn value_index(ch: usize, cell: usize, n: usize) -> usize {
+/// for a grid of `n` cells and classes of `lanes` values.
+pub fn value_index(ch: usize, cell: usize, n: usize, lanes: usize) -> usize {
     if ch < 3 {
         3 * cell + ch
     } else {
-        let (k, j) = ((ch - 3) / 2, (ch - 3) % 2);
-        3 * n + 2 * (k * n + cell) + j
+        let (k, j) = ((ch - 3) / lanes, (ch - 3) % lanes);
+        3 * n + lanes * (k * n + cell) + j
     }
 }
 
@@ -80,10 +103,20 @@ impl Spatial {
         )
     }
 
-    /// Number of values the classes add to a table on `grid` (2 K per grid cell), saturating.
+    /// Values per class and grid cell: 2 (D, S), or 6 with the second bounce.
+    pub fn lanes(&self) -> usize {
+        if self.secondary {
+            6
+        } else {
+            2
+        }
+    }
+
+    /// Number of values the classes add to a table on `grid` ([`Spatial::lanes`] K per grid
+    /// cell), saturating.
     pub fn values_len(&self, grid: &Grid) -> usize {
         grid.len()
-            .saturating_mul(2)
+            .saturating_mul(self.lanes())
             .saturating_mul(self.classes as usize)
     }
 
@@ -130,6 +163,21 @@ impl Spatial {
         let albedo_ok = |a: &[f32; 3]| a.iter().all(|x| (0.0..=1.0).contains(x));
         if !self.cell_albedo.iter().all(albedo_ok) {
             return bad("every albedo of a spatial table lies in [0, 1]".to_string());
+        }
+        let neighbours = if self.secondary { cells } else { 0 };
+        if self.cell_neighbours.len() != neighbours {
+            return bad(format!(
+                "a spatial table {} has {neighbours} neighbour albedo pairs, not {}",
+                if self.secondary {
+                    "with the second bounce"
+                } else {
+                    "of the direct reflection"
+                },
+                self.cell_neighbours.len()
+            ));
+        }
+        if !self.cell_neighbours.iter().flatten().all(albedo_ok) {
+            return bad("every neighbour albedo of a spatial table lies in [0, 1]".to_string());
         }
         let n_vis = (self.classes as usize)
             .saturating_mul(grid.n_theta_o as usize)
@@ -246,16 +294,18 @@ fn angles(w: [f32; 3]) -> Option<(f32, f32)> {
 /// The classes' values of a spatial table and its layout, for lookups at a point of the period.
 ///
 /// The classes are held two to a node table of the averaged lookup's kind (`crate::nodes`, its
-/// padding, pole rows and kernels): lanes (D, S) of class 2 m and of class 2 m + 1, so that a
-/// point lookup costs one averaged lookup and the cell's location.
+/// padding, pole rows and kernels), two lanes to a slot and two slots to a table: each stored
+/// class's (D, S) and, with the second bounce, each of its sides that has a neighbour (N, B),
+/// slot after slot; without the second bounce lanes (D, S) of class 2 m and of class 2 m + 1,
+/// so that a point lookup costs one averaged lookup and the cell's location.
 #[derive(Clone, Debug)]
 pub struct SpatialLookup {
     layout: Spatial,
     grid: Grid,
-    /// Where each class is held: its stored class and the mirror onto it.
+    /// Where each class is held: its stored class, its slots and the mirror onto it.
     classes: Vec<Held>,
-    /// Stored class pair m's nodes.
-    pairs: Vec<Nodes>,
+    /// The node tables of the slots, two slots each.
+    tables: Vec<Nodes>,
     /// A point's cell along u and along v, found without a search.
     u_bins: Bins,
     v_bins: Bins,
@@ -265,37 +315,62 @@ pub struct SpatialLookup {
     f16: bool,
 }
 
-/// Where a class is held: stored class `2 pair + lane / 2` (its D in lane `lane` of pair
-/// `pair`'s 4, S in the next), read at the directions mirrored by `sign`.
+/// Two lanes of the node tables: lanes `lane` (0 or 2) and `lane + 1` of table `table`
+/// ([`NO_TABLE`]: none).
 #[derive(Clone, Copy, Debug)]
-struct Held {
-    pair: u32,
-    /// 0 or 2.
+struct Slot {
+    table: u32,
     lane: u32,
-    /// The factors (+-1) of x and y of the mirror ([`mirror_signs`]).
-    sign: [f32; 2],
 }
 
-impl Held {
-    fn new(stored: u32, m: Mirror) -> Held {
-        Held {
-            pair: stored / 2,
-            lane: 2 * (stored % 2),
-            sign: mirror_signs(m),
+/// [`Slot::table`] of a slot that is not held (a side without a neighbour).
+const NO_TABLE: u32 = u32::MAX;
+
+impl Slot {
+    /// Slot `q` of the tables: table `q / 2`, lanes `2 (q % 2)` and the next.
+    fn at(q: usize) -> Slot {
+        Slot {
+            table: (q / 2) as u32,
+            lane: 2 * (q % 2) as u32,
         }
     }
 
-    /// Index of the stored class.
-    fn stored(&self) -> usize {
-        (2 * self.pair + self.lane / 2) as usize
+    const NONE: Slot = Slot {
+        table: NO_TABLE,
+        lane: 0,
+    };
+}
+
+/// Where a class is held: stored class `stored`, its D and S in slot `direct` and, with the
+/// second bounce, its +c and -c side terms (N, B) in `sides` (in the stored class's order of
+/// sides), read at the directions mirrored by `sign`; `swap` when the mirror exchanges the
+/// +c and -c neighbours.
+#[derive(Clone, Copy, Debug)]
+struct Held {
+    stored: u32,
+    direct: Slot,
+    sides: [Slot; 2],
+    /// The factors (+-1) of x and y of the mirror ([`mirror_signs`]).
+    sign: [f32; 2],
+    swap: bool,
+}
+
+impl Held {
+    /// Whether either side has terms.
+    #[inline(always)]
+    fn has_sides(&self) -> bool {
+        (self.sides[0].table & self.sides[1].table) != NO_TABLE
     }
 }
 
-/// A point lookup's view of one cell: where its class is held and its thread's albedo.
+/// A point lookup's view of one cell: where its class is held, its thread's albedo and, with
+/// the second bounce, its neighbours' in the order of the stored class's sides (exchanged
+/// when the class is held `swap`ped).
 #[derive(Clone, Copy, Debug)]
 struct PointCell {
     held: Held,
     albedo: [f32; 3],
+    sides: [[f32; 3]; 2],
 }
 
 /// The cell of an axis's `edges` holding a fraction of the period, found from uniform bins
@@ -431,6 +506,52 @@ fn flipped(w: [f32; 3], [sx, sy]: [f32; 2]) -> [f32; 3] {
     [w[0] * sx, w[1] * sy, w[2]]
 }
 
+/// Lanes `slot.lane` and the next of a table's 4.
+#[inline(always)]
+fn lanes_of(f: [f32; 4], slot: Slot) -> [f32; 2] {
+    // The lane is 0 or 2 (`& 2` lets the compiler drop the bound checks).
+    let l = slot.lane as usize & 2;
+    [f[l], f[l + 1]]
+}
+
+/// The side terms (N+, B+, N-, B-) of the class held at `h`, from `main` (the blend of its
+/// direct slot's table) where a side shares that table, else from `blend` of the side's
+/// table (once for both sides in one other table); 0 for a side without terms.
+#[inline(always)]
+fn side_terms(h: &Held, main: [f32; 4], blend: impl Fn(u32) -> [f32; 4]) -> [f32; 4] {
+    let mut other: Option<(u32, [f32; 4])> = None;
+    let mut out = [0.0; 4];
+    for (k, slot) in h.sides.iter().enumerate() {
+        let f = match slot.table {
+            NO_TABLE => continue,
+            t if t == h.direct.table => main,
+            t => match other {
+                Some((o, f)) if o == t => f,
+                _ => {
+                    let f = blend(t);
+                    other = Some((t, f));
+                    f
+                }
+            },
+        };
+        let [n, b] = lanes_of(f, *slot);
+        out[2 * k] = n;
+        out[2 * k + 1] = b;
+    }
+    out
+}
+
+/// A cell's f_r with the second bounce from its class's `d`, `s` and side terms `g` (N+, B+,
+/// N-, B-, in the order of `p.sides`): rho D + S + sum_k rho_k (N_k + rho B_k).
+#[inline(always)]
+fn with_sides(p: &PointCell, d: f32, s: f32, g: [f32; 4]) -> [f32; 3] {
+    std::array::from_fn(|c| {
+        let a = p.albedo[c];
+        let [plus, minus] = p.sides;
+        (a * d + s + plus[c] * (g[0] + a * g[1]) + minus[c] * (g[2] + a * g[3])).max(0.0)
+    })
+}
+
 /// `w` mirrored by `m`.
 #[cfg(test)]
 fn mirrored(w: [f32; 3], m: Mirror) -> [f32; 3] {
@@ -451,14 +572,24 @@ fn mirrored_cell(p: u32, n: u32, m: Mirror) -> Option<u32> {
 
 /// True when class `c`'s values and visible areas equal class `j`'s mirrored by `m` at every
 /// grid cell, to `tol` of the larger (the stored precision: a mirror image evaluates in
-/// another order and rounds apart).
+/// another order and rounds apart); with `swap`, `c`'s +c side's terms equal `j`'s -c side's
+/// and the other way round.
 fn mirror_of(
     layout: &Spatial,
     grid: &Grid,
     values: &Samples,
-    (c, j, m): (usize, usize, Mirror),
+    (c, j, m, swap): (usize, usize, Mirror, bool),
     tol: f32,
 ) -> bool {
+    let lanes = layout.lanes();
+    // Lane of `j` that `c`'s lane `d` is compared with: sides exchanged by `swap`.
+    let other = |d: usize| {
+        if swap && d >= 2 {
+            2 + (d - 2 + 2) % 4
+        } else {
+            d
+        }
+    };
     let n = grid.len();
     let close = |a: f32, b: f32| (a - b).abs() <= tol * a.abs().max(b.abs()) + 1e-12;
     let (npi, npo) = (grid.n_phi_i, grid.n_phi_o);
@@ -487,10 +618,10 @@ fn mirror_of(
                 for po in 0..npo {
                     let a = grid.index(ti, pi, to, po);
                     let b = grid.index(ti, pi_map[pi as usize], to, po_map[po as usize]);
-                    for d in 0..2 {
+                    for d in 0..lanes {
                         if !close(
-                            values.get(2 * (c * n + a) + d),
-                            values.get(2 * (j * n + b) + d),
+                            values.get(lanes * (c * n + a) + d),
+                            values.get(lanes * (j * n + b) + other(d)),
                         ) {
                             return false;
                         }
@@ -508,6 +639,9 @@ struct Seen {
     share: Vec<f32>,
     /// Per class: that share times each cell's albedo, summed (RGB).
     albedo: Vec<[f32; 3]>,
+    /// With the second bounce, per class and stored side: the share times the neighbour's
+    /// albedo, and times both albedos, summed (RGB).
+    sides: Vec<[[[f32; 3]; 2]; 2]>,
 }
 
 impl SpatialLookup {
@@ -526,53 +660,83 @@ impl SpatialLookup {
         } else {
             1e-5
         };
-        // Stored classes (their index in the table) and where each class is held.
+        // Stored classes (their index in the table), and each class's stored class and mirror.
         let mut stored: Vec<usize> = Vec::new();
-        let mut classes = Vec::with_capacity(layout.classes as usize);
+        let mut held: Vec<(usize, Mirror, bool)> = Vec::with_capacity(layout.classes as usize);
+        let swaps: &[bool] = if layout.secondary {
+            &[false, true]
+        } else {
+            &[false]
+        };
         for c in 0..layout.classes as usize {
             let found = stored.iter().enumerate().find_map(|(s, &j)| {
                 [1, 2, 3]
                     .into_iter()
-                    .find(|&m| mirror_of(&layout, &grid, values, (c, j, m), tol))
-                    .map(|m| Held::new(s as u32, m))
+                    .flat_map(|m| swaps.iter().map(move |&w| (m, w)))
+                    .find(|&(m, w)| mirror_of(&layout, &grid, values, (c, j, m, w), tol))
+                    .map(|(m, w)| (s, m, w))
             });
-            classes.push(found.unwrap_or_else(|| {
+            held.push(found.unwrap_or_else(|| {
                 stored.push(c);
-                Held::new((stored.len() - 1) as u32, 0)
+                (stored.len() - 1, 0, false)
             }));
         }
-        let k = stored.len();
-        let pairs = (0..k.div_ceil(2))
-            .map(|m| {
-                let at = |s: usize, c: usize, j: usize| {
-                    if s < k {
-                        values.get(2 * (stored[s] * n + c) + j)
-                    } else {
-                        0.0
+        // Slots, stored class by stored class: (D, S), then each side with terms (N, B) as
+        // (class, its first lane in the values).
+        let lanes = layout.lanes();
+        let lane = |s: usize, c: usize, j: usize| values.get(lanes * (stored[s] * n + c) + j);
+        let mut slots: Vec<(usize, usize)> = Vec::new();
+        let mut where_held: Vec<(Slot, [Slot; 2])> = Vec::with_capacity(stored.len());
+        for s in 0..stored.len() {
+            let direct = Slot::at(slots.len());
+            slots.push((s, 0));
+            let mut sides = [Slot::NONE; 2];
+            if layout.secondary {
+                for (k, side) in sides.iter_mut().enumerate() {
+                    let j = 2 + 2 * k;
+                    if (0..n).any(|c| lane(s, c, j) != 0.0 || lane(s, c, j + 1) != 0.0) {
+                        *side = Slot::at(slots.len());
+                        slots.push((s, j));
                     }
+                }
+            }
+            where_held.push((direct, sides));
+        }
+        let tables = slots
+            .chunks(2)
+            .map(|pair| {
+                let at = |q: usize, c: usize, d: usize| {
+                    pair.get(q).map_or(0.0, |&(s, j)| lane(s, c, j + d))
                 };
                 pad4(
                     &grid,
                     &|ti, pi, to, po| {
                         let c = grid.index(ti, pi, to, po);
-                        [
-                            at(2 * m, c, 0),
-                            at(2 * m, c, 1),
-                            at(2 * m + 1, c, 0),
-                            at(2 * m + 1, c, 1),
-                        ]
+                        [at(0, c, 0), at(0, c, 1), at(1, c, 0), at(1, c, 1)]
                     },
                     f16,
                 )
             })
             .collect();
-        let points = layout
-            .cell_class
+        let classes: Vec<Held> = held
             .iter()
-            .zip(&layout.cell_albedo)
-            .map(|(&k, &albedo)| PointCell {
-                held: classes[k as usize],
-                albedo,
+            .map(|&(s, m, swap)| Held {
+                stored: s as u32,
+                direct: where_held[s].0,
+                sides: where_held[s].1,
+                sign: mirror_signs(m),
+                swap,
+            })
+            .collect();
+        let points = (0..layout.cell_class.len())
+            .map(|c| {
+                let held = classes[layout.cell_class[c] as usize];
+                let nb = layout.cell_neighbours.get(c).copied().unwrap_or_default();
+                PointCell {
+                    held,
+                    albedo: layout.cell_albedo[c],
+                    sides: if held.swap { [nb[1], nb[0]] } else { nb },
+                }
             })
             .collect();
         SpatialLookup {
@@ -582,7 +746,7 @@ impl SpatialLookup {
             layout,
             grid,
             classes,
-            pairs,
+            tables,
             f16,
         }
     }
@@ -591,7 +755,7 @@ impl SpatialLookup {
     pub fn stored_classes(&self) -> usize {
         self.classes
             .iter()
-            .map(|h| h.stored() + 1)
+            .map(|h| h.stored as usize + 1)
             .max()
             .unwrap_or(0)
     }
@@ -603,7 +767,7 @@ impl SpatialLookup {
 
     /// Bytes held by the class values.
     pub fn memory_bytes(&self) -> usize {
-        self.pairs
+        self.tables
             .iter()
             .map(|p| {
                 let lane = match p.values {
@@ -623,14 +787,28 @@ impl SpatialLookup {
         self.held_f(simd, self.classes[k], wi, wo)
     }
 
-    /// The (D, S) of the class held at `h`: its pair's lanes at the mirrored directions.
+    /// The (D, S) of the class held at `h`: its slot's lanes at the mirrored directions.
     #[inline(always)]
     fn held_f(&self, simd: SimdPath, h: Held, wi: [f32; 3], wo: [f32; 3]) -> [f32; 2] {
         let (wi, wo) = (flipped(wi, h.sign), flipped(wo, h.sign));
-        let f = Self::pair_f(&self.pairs[h.pair as usize], simd, wi, wo);
-        // The lane is 0 or 2 (`& 2` lets the compiler drop the bound checks).
-        let l = h.lane as usize & 2;
-        [f[l], f[l + 1]]
+        let f = Self::pair_f(&self.tables[h.direct.table as usize], simd, wi, wo);
+        lanes_of(f, h.direct)
+    }
+
+    /// The (D, S) and the side terms (N+, B+, N-, B-, in the stored class's order of sides)
+    /// of the class held at `h`, at the mirrored directions.
+    #[inline(always)]
+    fn held_all(
+        &self,
+        simd: SimdPath,
+        h: Held,
+        wi: [f32; 3],
+        wo: [f32; 3],
+    ) -> ([f32; 2], [f32; 4]) {
+        let (wi, wo) = (flipped(wi, h.sign), flipped(wo, h.sign));
+        let blend = |t: u32| Self::pair_f(&self.tables[t as usize], simd, wi, wo);
+        let main = blend(h.direct.table);
+        (lanes_of(main, h.direct), side_terms(&h, main, blend))
     }
 
     /// A class pair's 4 lanes (D, S of each) at the directions, by `simd`'s kernel.
@@ -670,12 +848,23 @@ impl SpatialLookup {
         let mut seen = Seen {
             share: vec![0.0; k],
             albedo: vec![[0.0; 3]; k],
+            sides: vec![[[[0.0; 3]; 2]; 2]; if l.secondary { k } else { 0 }],
         };
         for (c, share, _) in self.covered(u, v, width) {
             let class = l.cell_class[c] as usize;
-            seen.share[class] += share as f32;
+            let w = share as f32;
+            seen.share[class] += w;
             for (acc, a) in seen.albedo[class].iter_mut().zip(l.cell_albedo[c]) {
-                *acc += share as f32 * a;
+                *acc += w * a;
+            }
+            if let Some(acc) = seen.sides.get_mut(class) {
+                let p = &self.points[c];
+                for (acc, nb) in acc.iter_mut().zip(&p.sides) {
+                    for ch in 0..3 {
+                        acc[0][ch] += w * nb[ch];
+                        acc[1][ch] += w * nb[ch] * p.albedo[ch];
+                    }
+                }
             }
         }
         seen
@@ -718,14 +907,18 @@ impl SpatialLookup {
         Some(self.eval_footprint(simd, wi, wo, Footprint { u, v, width }))
     }
 
-    /// A point's f_r (u, v finite): its cell's `rho_d D + S` (its coverage cancels; where the
-    /// class is not seen, D and S are 0).
+    /// A point's f_r (u, v finite): its cell's `rho_d D + S` and, with the second bounce, its
+    /// neighbours' terms (its coverage cancels; where the class is not seen, all are 0).
     #[inline(always)]
     fn point(&self, simd: SimdPath, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
         // `eval_at` passes finite u, v only.
         let p = self.point_cell(u, v);
-        let [d, s] = self.held_f(simd, p.held, wi, wo);
-        p.albedo.map(|a| (a * d + s).max(0.0))
+        if !p.held.has_sides() {
+            let [d, s] = self.held_f(simd, p.held, wi, wo);
+            return p.albedo.map(|a| (a * d + s).max(0.0));
+        }
+        let ([d, s], g) = self.held_all(simd, p.held, wi, wo);
+        with_sides(&p, d, s, g)
     }
 
     /// [`SpatialLookup::point`] compiled for AVX2 on lanes `V` (the cell's `floor` one
@@ -738,14 +931,25 @@ impl SpatialLookup {
     unsafe fn point_avx2<V: Lane>(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
         let p = self.point_cell(u, v);
         let h = p.held;
-        let nodes = &self.pairs[h.pair as usize];
+        let nodes = &self.tables[h.direct.table as usize];
         let Some(values) = V::tiles(&nodes.values) else {
             return [0.0; 3];
         };
-        let f = avx2::eval4(nodes, values, flipped(wi, h.sign), flipped(wo, h.sign));
-        let l = h.lane as usize & 2;
-        let (d, s) = (f[l], f[l + 1]);
-        p.albedo.map(|a| (a * d + s).max(0.0))
+        let (wi, wo) = (flipped(wi, h.sign), flipped(wo, h.sign));
+        let f = avx2::eval4(nodes, values, wi, wo);
+        let [d, s] = lanes_of(f, h.direct);
+        if !h.has_sides() {
+            return p.albedo.map(|a| (a * d + s).max(0.0));
+        }
+        let blend = |t: u32| {
+            let nodes = &self.tables[t as usize];
+            match V::tiles(&nodes.values) {
+                // SAFETY: as this function's caller guarantees.
+                Some(values) => unsafe { avx2::eval4(nodes, values, wi, wo) },
+                None => [0.0; 4],
+            }
+        };
+        with_sides(&p, d, s, side_terms(&h, f, blend))
     }
 
     /// The record of the cell holding (u, v) (finite).
@@ -781,6 +985,15 @@ impl SpatialLookup {
             let [d, s] = self.class_f(simd, k, wi, wo);
             for (n, a) in num.iter_mut().zip(a) {
                 *n += vis * (a * d + share * s);
+            }
+            let h = self.classes[k];
+            if let (Some(sides), true) = (seen.sides.get(k), h.has_sides()) {
+                let (_, g) = self.held_all(simd, h, wi, wo);
+                for (ch, n) in num.iter_mut().enumerate() {
+                    let [p, m] = sides;
+                    *n += vis
+                        * (p[0][ch] * g[0] + p[1][ch] * g[1] + m[0][ch] * g[2] + m[1][ch] * g[3]);
+                }
             }
             den += vis * share;
         }

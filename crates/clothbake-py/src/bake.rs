@@ -100,7 +100,8 @@ fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) ->
 /// caps "excluded" or "shaded"). With bounces=2: secondary "analytic" (orders: "default",
 /// "fast" or "T,B,A") or "raytrace" (sampling: "N,STEP,L0,exact|area"); kernel
 /// "radiometric" (default) or "thesis". spatial: True tabulates the weave up close beside the
-/// average (docs/spatial.md; analytic model, bounces=1); look it up with Table.eval_at(wi, wo, uv, width).
+/// average (docs/spatial.md; analytic model, bounces=1 or 2); look it up with Table.eval_at(wi, wo, uv,
+/// width).
 /// Returns the Table (None for a shard).
 #[pyfunction]
 #[pyo3(signature = (fabric, res=(32, 64, 32, 64), bounces=None, facet="huo", progress=None, *,

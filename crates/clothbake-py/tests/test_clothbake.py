@@ -116,6 +116,24 @@ def test_a_spatial_table_shows_the_model_per_cell(twill_path):
         t.eval_at(wi[:1], wo[:1], uv[:1], width=-1.0)
 
 
+def test_a_spatial_table_with_the_second_bounce_shows_the_model_per_cell(twill_path):
+    """bake(spatial=True, bounces=2): each crossing cell of a twill whose warps and wefts are
+    each of their own colour is the model's f_r there with its I_2 (Fabric.eval(uv=...,
+    bounces=2)), the neighbours' colours included."""
+    d = json.loads(twill_path.read_text())
+    d["warp"]["thread_albedo"] = [[0.8, 0.1, 0.1], [0.1, 0.7, 0.2], [0.2, 0.1, 0.9]]
+    d["weft"]["thread_albedo"] = [[0.9, 0.9, 0.9], [0.5, 0.4, 0.1], [0.1, 0.7, 0.2]]
+    fab = clothbake.Fabric(d)
+    t = clothbake.bake(fab, res=(6, 12, 6, 12), bounces=2, spatial=True)
+    wi = np.repeat(dirs([52.5], [15.0]), 9, axis=0)
+    wo = np.repeat(dirs([22.5], [195.0]), 9, axis=0)
+    uv = np.array([[(i + 0.5) / 3, (j + 0.5) / 3] for j in range(3) for i in range(3)])
+    f, _ = t.eval_at(wi, wo, uv)
+    np.testing.assert_allclose(f, fab.eval(wi, wo, uv=uv, bounces=2), rtol=1e-5)
+    # The second bounce is in it: the direct reflection alone is lower.
+    assert (fab.eval(wi, wo, uv=uv) < f - 1e-4).any()
+
+
 def test_brdf_is_linear_in_the_albedo(twill_path):
     """With Lewis facets and no specular part f_r is linear in each channel's albedo:
     f(rho) = rho f(1), channel by channel."""

@@ -185,7 +185,7 @@ pub struct BakeOpts {
 
     /// Also tabulate the weave up close (docs/spatial.md): each class of the period's crossing
     /// cells beside the average, so that renderers show the weave below one period per pixel
-    /// (render --periods, Brdf::eval_at). Analytic model, --bounces 1.
+    /// (render --periods, Brdf::eval_at). Analytic model, --bounces 1 or 2.
     #[arg(long)]
     pub spatial: bool,
 

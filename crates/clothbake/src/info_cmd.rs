@@ -48,9 +48,14 @@ fn spatial_lines(s: &mut String, sp: &clothbake_loader::Spatial) {
     let _ = writeln!(
         s,
         "spatial    {} class{} over {nx} x {ny} crossing cells (warp x weft; docs/spatial.md); \
-         each cell shows its class's f_r at its thread's albedo",
+         each cell shows its class's f_r at its thread's albedo{}",
         sp.classes,
-        if sp.classes == 1 { "" } else { "es" }
+        if sp.classes == 1 { "" } else { "es" },
+        if sp.secondary {
+            ", with the second bounce from its neighbours' albedos"
+        } else {
+            ""
+        }
     );
     if nx <= 32 {
         for j in 0..ny.min(32) {

@@ -188,11 +188,37 @@ fn spatial_bakes_are_the_same_for_any_thread_count_and_shard_split() {
         out.contains(&format!("{} values", 3 * 8 * 16 * 8 * 16)),
         "{out}"
     );
-    // What a spatial table cannot hold yet is refused before anything is written.
+    // With the second bounce too: threads and shards give the same bits.
+    let two = [&base[..], &["--bounces", "2"]].concat();
+    succeeds(&run_in(
+        &d,
+        &[&two[..], &["--threads", "1", "-o", "b2-one.exr"]].concat(),
+    ));
+    for k in 0..2 {
+        let s = format!("{k}/2");
+        succeeds(&run_in(
+            &d,
+            &[&two[..], &["--threads", "2", "--shard", &s]].concat(),
+        ));
+    }
+    succeeds(&run_in(
+        &d,
+        &[
+            "merge",
+            "-o",
+            "b2-merged.exr",
+            "twill-1-of-2.shard",
+            "twill-0-of-2.shard",
+        ],
+    ));
+    identical(&d, "b2-one.exr", "b2-merged.exr");
+    let info = succeeds(&run_in(&d, &["info", "b2-merged.exr"]));
+    assert!(info.contains("with the second bounce"), "{info}");
+    // What a spatial table cannot hold is refused before anything is written.
     fails_with(
         &run_in(
             &d,
-            &[&base[..], &["--bounces", "2", "-o", "b2.exr"]].concat(),
+            &[&base[..], &["--bounces", "all", "-o", "b2.exr"]].concat(),
         ),
         &["--spatial", "--bounces 1"],
     );
