@@ -918,7 +918,7 @@ impl SpatialLookup {
             return p.albedo.map(|a| (a * d + s).max(0.0));
         }
         let ([d, s], g) = self.held_all(simd, p.held, wi, wo);
-        with_sides(&p, d, s, g)
+        with_sides(p, d, s, g)
     }
 
     /// [`SpatialLookup::point`] compiled for AVX2 on lanes `V` (the cell's `floor` one
@@ -930,17 +930,37 @@ impl SpatialLookup {
     #[target_feature(enable = "avx2,fma,f16c")]
     unsafe fn point_avx2<V: Lane>(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
         let p = self.point_cell(u, v);
-        let h = p.held;
+        let h = &p.held;
         let nodes = &self.tables[h.direct.table as usize];
         let Some(values) = V::tiles(&nodes.values) else {
             return [0.0; 3];
         };
-        let (wi, wo) = (flipped(wi, h.sign), flipped(wo, h.sign));
-        let f = avx2::eval4(nodes, values, wi, wo);
+        let f = avx2::eval4(nodes, values, flipped(wi, h.sign), flipped(wo, h.sign));
         let [d, s] = lanes_of(f, h.direct);
         if !h.has_sides() {
             return p.albedo.map(|a| (a * d + s).max(0.0));
         }
+        // The directions as given (not the mirrored ones, which would be kept for this call).
+        self.point_sides_avx2::<V>(p, f, wi, wo)
+    }
+
+    /// The rest of [`SpatialLookup::point_avx2`] for a class with side terms, out of line (so
+    /// that the one-bounce lookup keeps its kernel inline): `main` is the blend of the class's
+    /// direct slot's table at the class's mirror of `wi`, `wo`.
+    ///
+    /// # Safety
+    /// The processor must have AVX2, FMA and F16C.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(never)]
+    #[target_feature(enable = "avx2,fma,f16c")]
+    unsafe fn point_sides_avx2<V: Lane>(
+        &self,
+        p: &PointCell,
+        main: [f32; 4],
+        wi: [f32; 3],
+        wo: [f32; 3],
+    ) -> [f32; 3] {
+        let (wi, wo) = (flipped(wi, p.held.sign), flipped(wo, p.held.sign));
         let blend = |t: u32| {
             let nodes = &self.tables[t as usize];
             match V::tiles(&nodes.values) {
@@ -949,14 +969,15 @@ impl SpatialLookup {
                 None => [0.0; 4],
             }
         };
-        with_sides(&p, d, s, side_terms(&h, f, blend))
+        let [d, s] = lanes_of(main, p.held.direct);
+        with_sides(p, d, s, side_terms(&p.held, main, blend))
     }
 
     /// The record of the cell holding (u, v) (finite).
     #[inline(always)]
-    fn point_cell(&self, u: f64, v: f64) -> PointCell {
+    fn point_cell(&self, u: f64, v: f64) -> &PointCell {
         let (i, j) = (self.u_bins.locate_finite(u), self.v_bins.locate_finite(v));
-        self.points[j * (self.u_bins.edges.len() - 1) + i]
+        &self.points[j * (self.u_bins.edges.len() - 1) + i]
     }
 
     /// [`SpatialLookup::eval_at`] of a footprint whose side is in (0, 1), both directions
