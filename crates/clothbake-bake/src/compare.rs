@@ -87,7 +87,8 @@ impl std::fmt::Display for Cell {
 pub struct Worst {
     /// Where.
     pub cell: Cell,
-    /// Channel (0 R, 1 G, 2 B).
+    /// Channel, in `clothbake_loader::spatial::channel_names` order of table A: 0 R, 1 G, 2 B,
+    /// then a spatial table's class values.
     pub channel: usize,
     /// Value of A.
     pub a: f32,
@@ -185,7 +186,8 @@ pub fn compare(a: &Table, b: &Table, tol: Tolerance) -> Result<Comparison, GridM
     let g = a.meta.grid;
     // A spatial table begins with its averaged values: against an averaged table, or a
     // spatial one of other classes, the averaged parts are compared.
-    let n = if a.values.len() == b.values.len() {
+    let classes = |t: &Table| t.meta.spatial.as_ref().map(|s| (s.classes, s.secondary));
+    let n = if a.values.len() == b.values.len() && classes(a) == classes(b) {
         a.values.len()
     } else {
         3 * g.len()
@@ -236,15 +238,31 @@ pub fn compare(a: &Table, b: &Table, tol: Tolerance) -> Result<Comparison, GridM
         peak: if n > 0 { peak } else { 0.0 },
         mse: sum_sq / nf,
         beyond,
-        worst: worst.map(|(ratio, _, k)| Worst {
-            cell: Cell::of(&g, k / 3),
-            channel: k % 3,
-            a: a.values[k],
-            b: b.values[k],
-            ratio,
+        worst: worst.map(|(ratio, _, k)| {
+            let (cell, channel) = cell_channel(a, k);
+            Worst {
+                cell: Cell::of(&g, cell),
+                channel,
+                a: a.values[k],
+                b: b.values[k],
+                ratio,
+            }
         }),
         tolerance: tol,
     })
+}
+
+/// The grid cell and the channel (in `channel_names` order) of value `k` of table `t`.
+fn cell_channel(t: &Table, k: usize) -> (usize, usize) {
+    let n = t.meta.grid.len();
+    match &t.meta.spatial {
+        Some(s) if k >= 3 * n => {
+            let (lanes, r) = (s.lanes(), k - 3 * n);
+            let (class, within) = (r / (lanes * n), r % (lanes * n));
+            (within / lanes, 3 + class * lanes + within % lanes)
+        }
+        _ => (k / 3, k % 3),
+    }
 }
 
 #[cfg(test)]
@@ -268,6 +286,39 @@ mod tests {
         assert_eq!(c.worst, None);
         assert_eq!(c.psnr(), Some(f64::INFINITY));
         assert_eq!(c.values, 360);
+    }
+
+    #[test]
+    fn a_class_value_is_named_by_its_channel_and_cell() {
+        // A spatial table of 2 classes with the second bounce (6 values each): value k of
+        // class 1, lane 3 (plus_both), grid cell 17 is 3 n + 6 (n + 17) + 3.
+        let spatial = |g: Grid| clothbake_loader::Spatial {
+            classes: 2,
+            u_edges: vec![0.0, 1.0],
+            v_edges: vec![0.0, 1.0],
+            cell_class: vec![0],
+            cell_albedo: vec![[0.5; 3]],
+            visible: vec![0.0; 2 * (g.n_theta_o * g.n_phi_o) as usize],
+            secondary: true,
+            cell_neighbours: vec![[[0.0; 3]; 2]],
+        };
+        let n = G.len();
+        let make = |bump: bool| {
+            let meta = Metadata {
+                spatial: Some(spatial(G)),
+                ..Metadata::new("t", G, "{}", "{}", "none")
+            };
+            let k = 3 * n + 6 * (n + 17) + 3;
+            let values = (0..15 * n)
+                .map(|i| if bump && i == k { 2.0 } else { 1.0 })
+                .collect();
+            Table::new(meta, values).unwrap()
+        };
+        let c = compare(&make(false), &make(true), Tolerance::default()).unwrap();
+        let w = c.worst.unwrap();
+        assert_eq!((w.cell.index, w.channel), (17, 3 + 6 + 3));
+        let names = clothbake_loader::spatial::channel_names(2, 6);
+        assert_eq!(names[w.channel], "class1.plus_both");
     }
 
     #[test]

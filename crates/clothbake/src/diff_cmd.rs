@@ -7,6 +7,7 @@ use crate::cli::DiffArgs;
 use crate::error::CliError;
 use clothbake_bake::compare::{compare, Tolerance, DEFAULT_ABS, DEFAULT_REL};
 use clothbake_loader::read_table;
+use clothbake_loader::spatial::channel_names;
 use std::fmt::Write as _;
 
 /// The text to print and the exit status (0 or 1).
@@ -70,6 +71,10 @@ pub fn run(args: &DiffArgs) -> Result<(String, u8), CliError> {
         Some(p) => format!("{p:.2} dB"),
     };
     let _ = writeln!(s, "PSNR       {psnr}  (peak = max of A = {:.6e})", c.peak);
+    let names = a.meta.spatial.as_ref().map_or_else(
+        || channel_names(0, 2),
+        |sp| channel_names(sp.classes, sp.lanes()),
+    );
     match &c.worst {
         None => {
             let _ = writeln!(s, "worst      none: every value is equal");
@@ -79,7 +84,7 @@ pub fn run(args: &DiffArgs) -> Result<(String, u8), CliError> {
                 s,
                 "worst      {}, {}: A {:.7e}, B {:.7e}, |a - b| {:.3e} = {} the tolerance",
                 w.cell,
-                ["R", "G", "B"][w.channel],
+                names.get(w.channel).map_or("?", String::as_str),
                 w.a,
                 w.b,
                 (f64::from(w.a) - f64::from(w.b)).abs(),
