@@ -89,30 +89,28 @@ fn each_cell_of_the_table_is_the_models_reflection_there() {
     // float two pieces long) mirror one another in x and y, likewise its four weft pieces
     // (8, 2); the gingham's one-piece warp and weft floats, which no mirror maps onto each
     // other (2, 2).
-    for (file, stored) in [
-        ("twill.json", 2),
-        ("satin5.json", 3),
-        ("gingham.wif", 2),
-        ("basket.json", 2),
-    ] {
+    for (file, stored) in HELD {
         cells_are_the_models(file, 1, stored);
     }
 }
 
+/// Fabrics and the classes their spatial tables hold, with one bounce or two.
+const HELD: [(&str, usize); 4] = [
+    ("twill.json", 2),
+    ("satin5.json", 3),
+    ("gingham.wif", 2),
+    ("basket.json", 2),
+];
+
 #[test]
 fn with_the_second_bounce_each_cell_is_the_models_reflection_there() {
     // As above with `--bounces 2`: each cell adds its piece's I_2 from its two parallel
-    // neighbours (docs/spatial.md), whose albedos differ from the cell's own at the gingham's
-    // stripe edges. Classes are apart where the neighbours differ in geometry (none of these:
-    // their direct classes already differ there), and a mirror image is held once with its
-    // sides exchanged where the mirror exchanges them: the basket's threads side by side,
-    // whose pair partner lies on opposite sides, are again 8 classes in 2.
-    for (file, stored) in [
-        ("twill.json", 2),
-        ("satin5.json", 3),
-        ("gingham.wif", 2),
-        ("basket.json", 2),
-    ] {
+    // neighbours (docs/spatial.md; the gingham, a plain weave, has none beside any piece).
+    // Classes are apart where the neighbours differ in geometry (none of these: their direct
+    // classes already differ there), and a mirror image is held once with its sides exchanged
+    // where the mirror exchanges them: the twill's warp pieces, and the basket's threads side
+    // by side, whose pair partner lies on opposite sides, again 8 classes in 2.
+    for (file, stored) in HELD {
         cells_are_the_models(file, 2, stored);
     }
 }
