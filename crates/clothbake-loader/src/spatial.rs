@@ -894,17 +894,49 @@ impl SpatialLookup {
                 // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C
                 // (the table's `SimdPath`, as in `class_f`).
                 #[cfg(target_arch = "x86_64")]
-                SimdPath::Avx2 if self.f16 => unsafe { self.point_avx2::<half::f16>(wi, wo, u, v) },
+                SimdPath::Avx2 if self.f16 => unsafe {
+                    self.point_avx2::<half::f16>(&wi, &wo, u, v)
+                },
                 #[cfg(target_arch = "x86_64")]
-                SimdPath::Avx2 => unsafe { self.point_avx2::<f32>(wi, wo, u, v) },
-                _ if has_value(wi, wo) => self.point(simd, wi, wo, u, v),
-                _ => [0.0; 3],
+                SimdPath::Avx2 => unsafe { self.point_avx2::<f32>(&wi, &wo, u, v) },
+                _ => self.point_portable(simd, wi, wo, u, v),
             });
         }
-        if !has_value(wi, wo) {
-            return Some([0.0; 3]);
+        Some(self.footprint_checked(simd, wi, wo, Footprint { u, v, width }))
+    }
+
+    /// A point's f_r by the portable kernel, out of line (inlined, its registers would be
+    /// saved on every AVX2 point lookup too).
+    #[inline(never)]
+    fn point_portable(
+        &self,
+        simd: SimdPath,
+        wi: [f32; 3],
+        wo: [f32; 3],
+        u: f64,
+        v: f64,
+    ) -> [f32; 3] {
+        if has_value(wi, wo) {
+            self.point(simd, wi, wo, u, v)
+        } else {
+            [0.0; 3]
         }
-        Some(self.eval_footprint(simd, wi, wo, Footprint { u, v, width }))
+    }
+
+    /// [`SpatialLookup::eval_footprint`] of any directions (0 below the horizon).
+    #[inline(never)]
+    fn footprint_checked(
+        &self,
+        simd: SimdPath,
+        wi: [f32; 3],
+        wo: [f32; 3],
+        at: Footprint,
+    ) -> [f32; 3] {
+        if has_value(wi, wo) {
+            self.eval_footprint(simd, wi, wo, at)
+        } else {
+            [0.0; 3]
+        }
     }
 
     /// A point's f_r (u, v finite): its cell's `rho_d D + S` and, with the second bounce, its
@@ -928,20 +960,20 @@ impl SpatialLookup {
     /// The processor must have AVX2, FMA and F16C.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,f16c")]
-    unsafe fn point_avx2<V: Lane>(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
+    unsafe fn point_avx2<V: Lane>(&self, wi: &[f32; 3], wo: &[f32; 3], u: f64, v: f64) -> [f32; 3] {
         let p = self.point_cell(u, v);
         let h = &p.held;
         let nodes = &self.tables[h.direct.table as usize];
         let Some(values) = V::tiles(&nodes.values) else {
             return [0.0; 3];
         };
-        let f = avx2::eval4(nodes, values, flipped(wi, h.sign), flipped(wo, h.sign));
+        let f = avx2::eval4(nodes, values, flipped(*wi, h.sign), flipped(*wo, h.sign));
         let [d, s] = lanes_of(f, h.direct);
         if !h.has_sides() {
             return p.albedo.map(|a| (a * d + s).max(0.0));
         }
         // The directions as given (not the mirrored ones, which would be kept for this call).
-        self.point_sides_avx2::<V>(p, f, wi, wo)
+        self.point_sides_avx2::<V>(p, f, *wi, *wo)
     }
 
     /// The rest of [`SpatialLookup::point_avx2`] for a class with side terms, out of line (so
