@@ -779,15 +779,8 @@ impl SpatialLookup {
             .sum()
     }
 
-    /// Class `k`'s (D, S) at the directions, interpolated as the averaged table is (16 nodes,
-    /// pole rows), by `simd`'s kernel; a shared class's from its stored class at the mirrored
-    /// directions.
-    #[inline]
-    fn class_f(&self, simd: SimdPath, k: usize, wi: [f32; 3], wo: [f32; 3]) -> [f32; 2] {
-        self.held_f(simd, self.classes[k], wi, wo)
-    }
-
-    /// The (D, S) of the class held at `h`: its slot's lanes at the mirrored directions.
+    /// The (D, S) of the class held at `h`: its slot's lanes at the mirrored directions,
+    /// interpolated as the averaged table is (16 nodes, pole rows), by `simd`'s kernel.
     #[inline(always)]
     fn held_f(&self, simd: SimdPath, h: Held, wi: [f32; 3], wo: [f32; 3]) -> [f32; 2] {
         let (wi, wo) = (flipped(wi, h.sign), flipped(wo, h.sign));
@@ -892,7 +885,7 @@ impl SpatialLookup {
             // albedos are finite); the portable blend does not.
             return Some(match simd {
                 // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C
-                // (the table's `SimdPath`, as in `class_f`).
+                // (the table's `SimdPath`, as in `pair_f`).
                 #[cfg(target_arch = "x86_64")]
                 SimdPath::Avx2 if self.f16 => unsafe {
                     self.point_avx2::<half::f16>(&wi, &wo, u, v)
@@ -1035,13 +1028,17 @@ impl SpatialLookup {
             if vis <= 0.0 {
                 continue;
             }
-            let [d, s] = self.class_f(simd, k, wi, wo);
+            let h = self.classes[k];
+            let sides = seen.sides.get(k).filter(|_| h.has_sides());
+            // With sides, one call blends the direct slot's table once for both.
+            let ([d, s], g) = match sides {
+                Some(_) => self.held_all(simd, h, wi, wo),
+                None => (self.held_f(simd, h, wi, wo), [0.0; 4]),
+            };
             for (n, a) in num.iter_mut().zip(a) {
                 *n += vis * (a * d + share * s);
             }
-            let h = self.classes[k];
-            if let (Some(sides), true) = (seen.sides.get(k), h.has_sides()) {
-                let (_, g) = self.held_all(simd, h, wi, wo);
+            if let Some(sides) = sides {
                 for (ch, n) in num.iter_mut().enumerate() {
                     let [p, m] = sides;
                     *n += vis
