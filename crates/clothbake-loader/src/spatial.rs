@@ -892,50 +892,21 @@ impl SpatialLookup {
                 },
                 #[cfg(target_arch = "x86_64")]
                 SimdPath::Avx2 => unsafe { self.point_avx2::<f32>(&wi, &wo, u, v) },
-                _ => self.point_portable(simd, wi, wo, u, v),
+                _ => self.point(simd, wi, wo, u, v),
             });
         }
-        Some(self.footprint_checked(simd, wi, wo, Footprint { u, v, width }))
+        Some(self.eval_footprint(simd, wi, wo, Footprint { u, v, width }))
     }
 
-    /// A point's f_r by the portable kernel, out of line (inlined, its registers would be
-    /// saved on every AVX2 point lookup too).
+    /// A point's f_r (u, v finite) by the portable kernel: its cell's `rho_d D + S` and, with
+    /// the second bounce, its neighbours' terms (its coverage cancels; where the class is not
+    /// seen, all are 0; 0 below the horizon). Out of line: inlined, its registers would be
+    /// saved on every AVX2 point lookup too.
     #[inline(never)]
-    fn point_portable(
-        &self,
-        simd: SimdPath,
-        wi: [f32; 3],
-        wo: [f32; 3],
-        u: f64,
-        v: f64,
-    ) -> [f32; 3] {
-        if has_value(wi, wo) {
-            self.point(simd, wi, wo, u, v)
-        } else {
-            [0.0; 3]
-        }
-    }
-
-    /// [`SpatialLookup::eval_footprint`] of any directions (0 below the horizon).
-    #[inline(never)]
-    fn footprint_checked(
-        &self,
-        simd: SimdPath,
-        wi: [f32; 3],
-        wo: [f32; 3],
-        at: Footprint,
-    ) -> [f32; 3] {
-        if has_value(wi, wo) {
-            self.eval_footprint(simd, wi, wo, at)
-        } else {
-            [0.0; 3]
-        }
-    }
-
-    /// A point's f_r (u, v finite): its cell's `rho_d D + S` and, with the second bounce, its
-    /// neighbours' terms (its coverage cancels; where the class is not seen, all are 0).
-    #[inline(always)]
     fn point(&self, simd: SimdPath, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
+        if !has_value(wi, wo) {
+            return [0.0; 3];
+        }
         // `eval_at` passes finite u, v only.
         let p = self.point_cell(u, v);
         if !p.held.has_sides() {
@@ -1005,8 +976,8 @@ impl SpatialLookup {
         &self.points[j * (self.u_bins.edges.len() - 1) + i]
     }
 
-    /// [`SpatialLookup::eval_at`] of a footprint whose side is in (0, 1), both directions
-    /// above the horizon.
+    /// [`SpatialLookup::eval_at`] of a footprint whose side is in (0, 1) (0 below the horizon),
+    /// out of line.
     #[inline(never)]
     fn eval_footprint(
         &self,
@@ -1015,7 +986,7 @@ impl SpatialLookup {
         wo: [f32; 3],
         at: Footprint,
     ) -> [f32; 3] {
-        let Some(o) = angles(wo) else {
+        let (true, Some(o)) = (has_value(wi, wo), angles(wo)) else {
             return [0.0; 3];
         };
         let seen = self.seen(at.u, at.v, at.width);
