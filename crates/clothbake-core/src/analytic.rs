@@ -986,18 +986,6 @@ impl AnalyticModel {
         self.class_unit.len()
     }
 
-    /// The class of the unit each cell shows and that unit's thread's diffuse albedo, by
-    /// [`CellGrid::index`].
-    pub fn cell_classes(&self) -> Vec<(u32, [f64; 3])> {
-        self.cell_units
-            .iter()
-            .map(|&(u, _)| {
-                let unit = &self.units[u as usize];
-                (self.unit_class[u as usize], unit.seg.material.albedo)
-            })
-            .collect()
-    }
-
     /// Each class's direct reflection for light from `wi` seen from `wo`, written to `out`
     /// (one entry per class; zero below the horizon). For every cell, rho_d `diffuse` +
     /// `specular` is the f_r of [`AnalyticModel::intensity_in`] without secondary reflection,

@@ -343,8 +343,8 @@ impl Slot {
 
 /// Where a class is held: stored class `stored`, its D and S in slot `direct` and, with the
 /// second bounce, its +c and -c side terms (N, B) in `sides` (in the stored class's order of
-/// sides), read at the directions mirrored by `sign`; `swap` when the mirror exchanges the
-/// +c and -c neighbours.
+/// sides: a mirror that exchanges the neighbours is taken care of by the cells' records),
+/// read at the directions mirrored by `sign`.
 #[derive(Clone, Copy, Debug)]
 struct Held {
     stored: u32,
@@ -352,7 +352,6 @@ struct Held {
     sides: [Slot; 2],
     /// The factors (+-1) of x and y of the mirror ([`mirror_signs`]).
     sign: [f32; 2],
-    swap: bool,
 }
 
 impl Held {
@@ -365,7 +364,7 @@ impl Held {
 
 /// A point lookup's view of one cell: where its class is held, its thread's albedo and, with
 /// the second bounce, its neighbours' in the order of the stored class's sides (exchanged
-/// when the class is held `swap`ped).
+/// when the class is held as a mirror image that exchanges them).
 #[derive(Clone, Copy, Debug)]
 struct PointCell {
     held: Held,
@@ -660,7 +659,8 @@ impl SpatialLookup {
         } else {
             1e-5
         };
-        // Stored classes (their index in the table), and each class's stored class and mirror.
+        // Stored classes (their index in the table), and each class's stored class, mirror and
+        // whether the mirror exchanges the +c and -c neighbours.
         let mut stored: Vec<usize> = Vec::new();
         let mut held: Vec<(usize, Mirror, bool)> = Vec::with_capacity(layout.classes as usize);
         let swaps: &[bool] = if layout.secondary {
@@ -720,22 +720,21 @@ impl SpatialLookup {
             .collect();
         let classes: Vec<Held> = held
             .iter()
-            .map(|&(s, m, swap)| Held {
+            .map(|&(s, m, _)| Held {
                 stored: s as u32,
                 direct: where_held[s].0,
                 sides: where_held[s].1,
                 sign: mirror_signs(m),
-                swap,
             })
             .collect();
         let points = (0..layout.cell_class.len())
             .map(|c| {
-                let held = classes[layout.cell_class[c] as usize];
+                let k = layout.cell_class[c] as usize;
                 let nb = layout.cell_neighbours.get(c).copied().unwrap_or_default();
                 PointCell {
-                    held,
+                    held: classes[k],
                     albedo: layout.cell_albedo[c],
-                    sides: if held.swap { [nb[1], nb[0]] } else { nb },
+                    sides: if held[k].2 { [nb[1], nb[0]] } else { nb },
                 }
             })
             .collect();
