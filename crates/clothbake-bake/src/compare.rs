@@ -254,15 +254,8 @@ pub fn compare(a: &Table, b: &Table, tol: Tolerance) -> Result<Comparison, GridM
 
 /// The grid cell and the channel (in `channel_names` order) of value `k` of table `t`.
 fn cell_channel(t: &Table, k: usize) -> (usize, usize) {
-    let n = t.meta.grid.len();
-    match &t.meta.spatial {
-        Some(s) if k >= 3 * n => {
-            let (lanes, r) = (s.lanes(), k - 3 * n);
-            let (class, within) = (r / (lanes * n), r % (lanes * n));
-            (within / lanes, 3 + class * lanes + within % lanes)
-        }
-        _ => (k / 3, k % 3),
-    }
+    let lanes = t.meta.spatial.as_ref().map_or(2, |s| s.lanes());
+    clothbake_loader::spatial::value_cell_channel(k, t.meta.grid.len(), lanes)
 }
 
 #[cfg(test)]

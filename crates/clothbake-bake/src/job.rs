@@ -488,7 +488,7 @@ pub fn check_memory(
         let two = job.options.bounces == 2;
         let k = clothbake_core::AnalyticModel::with_variant(job.fabric, job.options.facet, variant)
             .classes_with(two) as u64;
-        3 + if two { 6 } else { 2 } * k
+        3 + clothbake_loader::spatial::lanes(two) as u64 * k
     } else {
         3
     };

@@ -71,7 +71,7 @@ pub fn layout(
 /// an entry: per class diffuse and specular and, with the second bounce (`secondary`), its +c
 /// side's neighbour and both terms, then the -c side's; the last entry padded with 0.
 pub fn class_values(terms: &[ClassTerms], secondary: bool, out: &mut Vec<[f32; 3]>) {
-    let lanes = if secondary { 6 } else { 2 };
+    let lanes = clothbake_loader::spatial::lanes(secondary);
     let mut flat = terms.iter().flat_map(|t| {
         [
             t.diffuse,

@@ -83,6 +83,15 @@ pub fn channel_names(classes: u32, lanes: usize) -> Vec<String> {
     names
 }
 
+/// Values per class and grid cell: 2 (D, S), or 6 with the second bounce (`secondary`).
+pub fn lanes(secondary: bool) -> usize {
+    if secondary {
+        6
+    } else {
+        2
+    }
+}
+
 /// Index in a table's values of channel `ch` (in [`channel_names`] order) of grid cell `cell`,
 /// for a grid of `n` cells and classes of `lanes` values.
 pub fn value_index(ch: usize, cell: usize, n: usize, lanes: usize) -> usize {
@@ -91,6 +100,18 @@ pub fn value_index(ch: usize, cell: usize, n: usize, lanes: usize) -> usize {
     } else {
         let (k, j) = ((ch - 3) / lanes, (ch - 3) % lanes);
         3 * n + lanes * (k * n + cell) + j
+    }
+}
+
+/// The grid cell and the channel (in [`channel_names`] order) of value `k` of a table's
+/// values: the inverse of [`value_index`].
+pub fn value_cell_channel(k: usize, n: usize, lanes: usize) -> (usize, usize) {
+    if k < 3 * n {
+        (k / 3, k % 3)
+    } else {
+        let r = k - 3 * n;
+        let (class, within) = (r / (lanes * n), r % (lanes * n));
+        (within / lanes, 3 + class * lanes + within % lanes)
     }
 }
 
@@ -103,13 +124,9 @@ impl Spatial {
         )
     }
 
-    /// Values per class and grid cell: 2 (D, S), or 6 with the second bounce.
+    /// Values per class and grid cell ([`lanes`]).
     pub fn lanes(&self) -> usize {
-        if self.secondary {
-            6
-        } else {
-            2
-        }
+        lanes(self.secondary)
     }
 
     /// Number of values the classes add to a table on `grid` ([`Spatial::lanes`] K per grid
@@ -1078,6 +1095,25 @@ impl SpatialLookup {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn value_cell_channel_inverts_value_index() {
+        // Every value of a table of 7 grid cells and 3 classes, with one bounce and two: each
+        // index once, and back to its cell and channel.
+        let n = 7;
+        for lanes in [lanes(false), lanes(true)] {
+            let channels = 3 + 3 * lanes;
+            let mut seen = vec![false; n * channels];
+            for ch in 0..channels {
+                for cell in 0..n {
+                    let k = value_index(ch, cell, n, lanes);
+                    assert!(!seen[k], "{k} twice");
+                    seen[k] = true;
+                    assert_eq!(value_cell_channel(k, n, lanes), (cell, ch));
+                }
+            }
+        }
+    }
 
     #[test]
     fn bins_find_the_cell_that_the_search_finds() {
