@@ -3,7 +3,7 @@
 //! diffuse and specular f_r and with the second bounce its neighbours' terms
 //! ([`class_values`]), packed three to a [`crate::Row`] entry after the averaged RGB.
 
-use clothbake_core::{AnalyticModel, ClassTerms, SecondaryOptions, UnitVec3};
+use clothbake_core::{AnalyticModel, ClassTerms};
 use clothbake_loader::spatial::MAX_SPATIAL_CELLS;
 use clothbake_loader::{Grid, Spatial};
 
@@ -17,12 +17,8 @@ pub fn stride(class_values: usize) -> usize {
 }
 
 /// The layout of `model`'s period on grid `g`, with the second bounce's classes and neighbour
-/// albedos when `secondary` is given, or why it cannot be baked.
-pub fn layout(
-    model: &AnalyticModel,
-    g: &Grid,
-    secondary: Option<&SecondaryOptions>,
-) -> Result<Spatial, String> {
+/// albedos when `secondary`, or why it cannot be baked.
+pub fn layout(model: &AnalyticModel, g: &Grid, secondary: bool) -> Result<Spatial, String> {
     let cells = model.cells();
     let (nx, ny) = cells.dims();
     if nx * ny > MAX_SPATIAL_CELLS {
@@ -32,17 +28,17 @@ pub fn layout(
         ));
     }
     let (u_edges, v_edges) = cells.edge_fractions();
-    let classes = model.classes_with(secondary.is_some());
-    let cell_classes = model.cell_classes_with(secondary.is_some());
+    let classes = model.classes_with(secondary);
+    let cell_classes = model.cell_classes_with(secondary);
     let mut visible = vec![0.0f32; classes * g.n_theta_o as usize * g.n_phi_o as usize];
-    let mut terms = vec![ClassTerms::default(); classes];
+    let mut vis = vec![0.0; classes];
     for to in 0..g.n_theta_o {
         for po in 0..g.n_phi_o {
             let wo = direction(to, g.n_theta_o, po, g.n_phi_o);
-            model.class_terms_with(UnitVec3::Z, wo, secondary, &mut terms);
-            for (k, t) in terms.iter().enumerate() {
+            model.class_visible(wo, secondary, &mut vis);
+            for (k, v) in vis.iter().enumerate() {
                 let n = (k * g.n_theta_o as usize + to as usize) * g.n_phi_o as usize + po as usize;
-                visible[n] = t.visible as f32;
+                visible[n] = *v as f32;
             }
         }
     }
@@ -56,13 +52,14 @@ pub fn layout(
             .map(|c| c.albedo.map(|a| a as f32))
             .collect(),
         visible,
-        secondary: secondary.is_some(),
-        cell_neighbours: match secondary {
-            Some(_) => cell_classes
+        secondary,
+        cell_neighbours: if secondary {
+            cell_classes
                 .iter()
                 .map(|c| c.neighbours.map(|n| n.map(|a| a as f32)))
-                .collect(),
-            None => Vec::new(),
+                .collect()
+        } else {
+            Vec::new()
         },
     })
 }

@@ -501,7 +501,7 @@ impl Baker {
         let eval: CellFn = match (opts.method, multiple.clone()) {
             (Method::Analytic { variant }, None) if opts.spatial => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
-                let layout = crate::spatial::layout(&m, &g, secondary.as_ref())
+                let layout = crate::spatial::layout(&m, &g, secondary.is_some())
                     .map_err(BakeError::Invalid)?;
                 syms.clear();
                 let classes = layout.classes as usize;

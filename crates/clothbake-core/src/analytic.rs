@@ -1003,17 +1003,50 @@ impl AnalyticModel {
             let Some(t) = self.unit_terms(u, &[], v, wi, wo, None, false) else {
                 continue;
             };
-            let s_v = t.l_v * t.width;
-            let (px, py) = self.grid.period();
-            o.visible = s_v / (px * py * wo.cos_theta());
-            if let Some((l_vi, kd, ks)) = t.lit {
-                let w = l_vi * u.seg.radius / s_v;
-                let [d, s, _] = intensity_to_brdf([w * kd, w * ks, 0.0], wi);
-                // Each is a non-negative quantity; near the horizon a lit arc of almost no
-                // length leaves rounding of either sign (-1.2e-28 seen on the taffeta at
-                // 87 degrees), which a table may not hold.
-                o.diffuse = d.max(0.0);
-                o.specular = s.max(0.0);
+            let (visible, d, s) = self.direct_terms(u, &t, wi, wo);
+            o.visible = visible;
+            // Each is a non-negative quantity; near the horizon a lit arc of almost no length
+            // leaves rounding of either sign (-1.2e-28 seen on the taffeta at 87 degrees),
+            // which a table may not hold.
+            o.diffuse = d.max(0.0);
+            o.specular = s.max(0.0);
+        }
+    }
+
+    /// A class's visible share of the period and its direct f_r at unit diffuse albedo and
+    /// specular, not yet clamped at 0, from its unit `u`'s terms `t` ([`ClassTerms`]).
+    fn direct_terms(&self, u: &Unit, t: &UnitTerms, wi: UnitVec3, wo: UnitVec3) -> (f64, f64, f64) {
+        let s_v = t.l_v * t.width;
+        let (px, py) = self.grid.period();
+        let visible = s_v / (px * py * wo.cos_theta());
+        let (d, s) = t.lit.map_or((0.0, 0.0), |(l_vi, kd, ks)| {
+            let w = l_vi * u.seg.radius / s_v;
+            let [d, s, _] = intensity_to_brdf([w * kd, w * ks, 0.0], wi);
+            (d, s)
+        });
+        (visible, d, s)
+    }
+
+    /// Each class's visible share of the period seen from `wo`, as [`ClassTerms::visible`]
+    /// (the classes of [`AnalyticModel::classes_with`] `secondary`), without the facet terms or
+    /// the second bounce (0 below the horizon).
+    pub fn class_visible(&self, wo: UnitVec3, secondary: bool, out: &mut [f64]) {
+        let units: Vec<u32> = if secondary {
+            self.bounce_unit.iter().map(|&(u, _)| u).collect()
+        } else {
+            self.class_unit.clone()
+        };
+        assert_eq!(out.len(), units.len(), "one entry per class");
+        out.fill(0.0);
+        if !wo.above_horizon() {
+            return;
+        }
+        let views = View::both(wo.get());
+        let (px, py) = self.grid.period();
+        for (o, &u) in out.iter_mut().zip(&units) {
+            let u = &self.units[u as usize];
+            if let Some(v) = self.visible(u, &views[u.seg.group as usize]) {
+                *o = v.l_v * v.width / (px * py * wo.cos_theta());
             }
         }
     }
@@ -1092,7 +1125,6 @@ impl AnalyticModel {
             return;
         }
         let views = Views::both(wi, wo);
-        let (px, py) = self.grid.period();
         // I_2 of a cell is its piece's, per unit visible length, over the visible width.
         let f = |x: f64, width: f64| intensity_to_brdf([x / width, 0.0, 0.0], wi)[0];
         for (o, &(u, var)) in out.iter_mut().zip(&self.bounce_unit) {
@@ -1102,13 +1134,8 @@ impl AnalyticModel {
             let Some(t) = self.unit_terms(u, variants, v, wi, wo, Some(opts), true) else {
                 continue;
             };
-            let s_v = t.l_v * t.width;
-            o.visible = s_v / (px * py * wo.cos_theta());
-            let (mut d, mut s) = (0.0, 0.0);
-            if let Some((l_vi, kd, ks)) = t.lit {
-                let w = l_vi * u.seg.radius / s_v;
-                [d, s, _] = intensity_to_brdf([w * kd, w * ks, 0.0], wi);
-            }
+            let (visible, d, s) = self.direct_terms(u, &t, wi, wo);
+            o.visible = visible;
             // Threads of albedo 1: each component is the same in every channel.
             let sides = &t.secondary[0].0;
             let own = f(sides[0].sd[0] + sides[1].sd[0], t.width);
