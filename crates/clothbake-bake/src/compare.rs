@@ -254,8 +254,7 @@ pub fn compare(a: &Table, b: &Table, tol: Tolerance) -> Result<Comparison, GridM
 
 /// The grid cell and the channel (in `channel_names` order) of value `k` of table `t`.
 fn cell_channel(t: &Table, k: usize) -> (usize, usize) {
-    let lanes = t.meta.spatial.as_ref().map_or(2, |s| s.lanes());
-    clothbake_loader::spatial::value_cell_channel(k, t.meta.grid.len(), lanes)
+    clothbake_loader::spatial::value_cell_channel(k, t.meta.grid.len(), t.meta.class_lanes())
 }
 
 #[cfg(test)]

@@ -8,15 +8,7 @@ use std::path::Path;
 use crate::atomic::write_atomic_as;
 use crate::bytes::{hex, CHUNK_VALUES};
 use crate::error::TableError;
-use crate::spatial::{channel_names, value_index};
-
-/// The channels of `meta`'s table, in [`channel_names`] order.
-fn table_channels(meta: &Metadata) -> Vec<String> {
-    meta.spatial.as_ref().map_or_else(
-        || channel_names(0, 2),
-        |s| channel_names(s.classes, s.lanes()),
-    )
-}
+use crate::spatial::value_index;
 use crate::stored::{Samples, StoredTable};
 use crate::table::{check_format_version, Grid, Metadata, Precision, Table, FORMAT_VERSION};
 
@@ -272,7 +264,7 @@ mod exr_io {
         }
         let (width, height) = (width as usize, height as usize);
 
-        let names = table_channels(&table.meta);
+        let names = table.meta.channel_names();
         if precision == Precision::F16 {
             let max = half::f16::MAX.to_f32();
             if let Some(v) = table.values.iter().find(|v| v.abs() > max) {
@@ -288,7 +280,7 @@ mod exr_io {
                 values: &table.values,
                 grid,
                 ch,
-                lanes: table.meta.spatial.as_ref().map_or(2, |s| s.lanes()),
+                lanes: table.meta.class_lanes(),
                 precision,
             })
             .collect();
@@ -584,7 +576,7 @@ mod exr_io {
                     grid.exr_height()
                 )));
             }
-            let expected = table_channels(&meta);
+            let expected = meta.channel_names();
             let mut names: Vec<String> = header
                 .channels
                 .list
@@ -677,7 +669,7 @@ mod exr_io {
             };
             // The averaged RGB, interleaved, then each class's values (diffuse, specular, ...)
             // cell by cell.
-            let lanes = meta.spatial.as_ref().map_or(2, |s| s.lanes());
+            let lanes = meta.class_lanes();
             let order = || {
                 let rgb = pixels().flat_map(|x| [(0, x), (1, x), (2, x)]);
                 let classes = (3..planes.len()).step_by(lanes).flat_map(move |ch| {
@@ -725,7 +717,7 @@ mod exr_io {
     }
 
     /// The [`ATTR_CRC32`] checksum of a metadata text and `pixels` pixels of `channels`
-    /// row-major planes (in [`channel_names`] order), pixel by pixel, sample `(ch, i)` widened
+    /// row-major planes (in [`Metadata::channel_names`] order), pixel by pixel, sample `(ch, i)` widened
     /// to f32 by `sample`, chunk by chunk (no full copy).
     fn values_crc(
         meta_json: &[u8],

@@ -212,6 +212,21 @@ pub struct Metadata {
 }
 
 impl Metadata {
+    /// Values per class and grid cell of a spatial table ([`crate::spatial::lanes`]; that of
+    /// the direct reflection for an averaged table, which has no classes).
+    pub fn class_lanes(&self) -> usize {
+        self.spatial
+            .as_ref()
+            .map_or(crate::spatial::lanes(false), Spatial::lanes)
+    }
+
+    /// The names of the table's channels, in [`crate::spatial::channel_names`] order (as its
+    /// OpenEXR file holds them).
+    pub fn channel_names(&self) -> Vec<String> {
+        let classes = self.spatial.as_ref().map_or(0, |s| s.classes);
+        crate::spatial::channel_names(classes, self.class_lanes())
+    }
+
     /// Metadata of the current format version for a cell-centred table of `f_r` in `1/sr`.
     pub fn new(
         tool: impl Into<String>,
@@ -235,7 +250,8 @@ impl Metadata {
     }
 
     /// Number of values of a table with this metadata: 3 per grid cell (the averaged RGB), and
-    /// for a spatial table 2 per grid cell and class after them. Saturates.
+    /// for a spatial table [`Metadata::class_lanes`] per grid cell and class after them.
+    /// Saturates.
     pub fn values_len(&self) -> usize {
         let extra = self
             .spatial

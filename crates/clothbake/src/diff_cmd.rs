@@ -7,7 +7,6 @@ use crate::cli::DiffArgs;
 use crate::error::CliError;
 use clothbake_bake::compare::{compare, Tolerance, DEFAULT_ABS, DEFAULT_REL};
 use clothbake_loader::read_table;
-use clothbake_loader::spatial::channel_names;
 use std::fmt::Write as _;
 
 /// The text to print and the exit status (0 or 1).
@@ -71,10 +70,7 @@ pub fn run(args: &DiffArgs) -> Result<(String, u8), CliError> {
         Some(p) => format!("{p:.2} dB"),
     };
     let _ = writeln!(s, "PSNR       {psnr}  (peak = max of A = {:.6e})", c.peak);
-    let names = a.meta.spatial.as_ref().map_or_else(
-        || channel_names(0, 2),
-        |sp| channel_names(sp.classes, sp.lanes()),
-    );
+    let names = a.meta.channel_names();
     match &c.worst {
         None => {
             let _ = writeln!(s, "worst      none: every value is equal");
