@@ -144,9 +144,9 @@ pub fn scan(root: &Path) {
                 }
             }
         }
-        for theta in [4, 5, 6, 7, 8, 11] {
-            for beta in [2, 3, 4, 5] {
-                for axial in [2, 3] {
+        for theta in [4, 5, 6, 7, 8, 9, 11, 13] {
+            for beta in [2, 3, 4, 5, 6] {
+                for axial in [1, 2, 3, 4] {
                     let o = Orders {
                         theta,
                         tol: 0.0,
