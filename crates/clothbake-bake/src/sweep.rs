@@ -64,7 +64,7 @@ pub struct BakeOptions {
     /// How I_2 is computed; used only when `bounces == 2`.
     pub secondary: SecondaryOptions,
     /// A spatially varying table (docs/spatial.md): the classes of the period's cells beside
-    /// the average. Analytic model, one bounce.
+    /// the average. Analytic model, one or two bounces.
     pub spatial: bool,
 }
 

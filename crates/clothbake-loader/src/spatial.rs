@@ -589,13 +589,15 @@ fn mirrored_cell(p: u32, n: u32, m: Mirror) -> Option<u32> {
 /// True when class `c`'s values and visible areas equal class `j`'s mirrored by `m` at every
 /// grid cell, to `tol` of the larger (the stored precision: a mirror image evaluates in
 /// another order and rounds apart); with `swap`, `c`'s +c side's terms equal `j`'s -c side's
-/// and the other way round.
+/// and the other way round. Each value compared takes one from `budget`; false once it is
+/// spent.
 fn mirror_of(
     layout: &Spatial,
     grid: &Grid,
     values: &Samples,
     (c, j, m, swap): (usize, usize, Mirror, bool),
     tol: f32,
+    budget: &mut u64,
 ) -> bool {
     let lanes = layout.lanes();
     // Lane of `j` that `c`'s lane `d` is compared with: sides exchanged by `swap`.
@@ -607,7 +609,10 @@ fn mirror_of(
         }
     };
     let n = grid.len();
-    let close = |a: f32, b: f32| (a - b).abs() <= tol * a.abs().max(b.abs()) + 1e-12;
+    let mut close = |a: f32, b: f32| {
+        *budget = budget.saturating_sub(1);
+        *budget > 0 && (a - b).abs() <= tol * a.abs().max(b.abs()) + 1e-12
+    };
     let (npi, npo) = (grid.n_phi_i, grid.n_phi_o);
     let (Some(pi_map), Some(po_map)) = (
         (0..npi)
@@ -649,6 +654,57 @@ fn mirror_of(
     true
 }
 
+/// The classes held, and how every class is held: the stored classes (their index in the
+/// table) and, per class, its stored class, mirror and whether the mirror exchanges the +c
+/// and -c neighbours (see [`SpatialLookup::new`]); and how many values the search compared.
+///
+/// A comparison stops at the first difference, but classes that differ only in their last
+/// values (a crafted file) would each be compared in full with every stored class: classes^2
+/// scans, hours for a large table. So the search compares at most 8 times the classes'
+/// values; from there on, classes are held as they are (more memory, the same lookups).
+#[allow(clippy::type_complexity)]
+fn mirror_images(
+    layout: &Spatial,
+    grid: &Grid,
+    values: &Samples,
+) -> ((Vec<usize>, Vec<(usize, Mirror, bool)>), u64) {
+    let tol = if matches!(values, Samples::F16(_)) {
+        1.5e-3
+    } else {
+        1e-5
+    };
+    let start = 8 * (layout.values_len(grid) as u64 + layout.visible.len() as u64);
+    let mut budget = start;
+    let mut stored: Vec<usize> = Vec::new();
+    let mut held: Vec<(usize, Mirror, bool)> = Vec::with_capacity(layout.classes as usize);
+    let swaps: &[bool] = if layout.secondary {
+        &[false, true]
+    } else {
+        &[false]
+    };
+    for c in 0..layout.classes as usize {
+        let mut found = None;
+        'search: for (s, &j) in stored.iter().enumerate() {
+            for m in [1, 2, 3] {
+                for &w in swaps {
+                    if budget == 0 {
+                        break 'search;
+                    }
+                    if mirror_of(layout, grid, values, (c, j, m, w), tol, &mut budget) {
+                        found = Some((s, m, w));
+                        break 'search;
+                    }
+                }
+            }
+        }
+        held.push(found.unwrap_or_else(|| {
+            stored.push(c);
+            (stored.len() - 1, 0, false)
+        }));
+    }
+    ((stored, held), start - budget)
+}
+
 /// What a footprint of the period sees of each class.
 struct Seen {
     /// Per class: the summed share of its cells the footprint covers.
@@ -671,33 +727,7 @@ impl SpatialLookup {
     pub(crate) fn new(layout: Spatial, grid: Grid, values: &Samples, f16: bool) -> SpatialLookup {
         debug_assert_eq!(values.len(), layout.values_len(&grid));
         let n = grid.len();
-        let tol = if matches!(values, Samples::F16(_)) {
-            1.5e-3
-        } else {
-            1e-5
-        };
-        // Stored classes (their index in the table), and each class's stored class, mirror and
-        // whether the mirror exchanges the +c and -c neighbours.
-        let mut stored: Vec<usize> = Vec::new();
-        let mut held: Vec<(usize, Mirror, bool)> = Vec::with_capacity(layout.classes as usize);
-        let swaps: &[bool] = if layout.secondary {
-            &[false, true]
-        } else {
-            &[false]
-        };
-        for c in 0..layout.classes as usize {
-            let found = stored.iter().enumerate().find_map(|(s, &j)| {
-                [1, 2, 3]
-                    .into_iter()
-                    .flat_map(|m| swaps.iter().map(move |&w| (m, w)))
-                    .find(|&(m, w)| mirror_of(&layout, &grid, values, (c, j, m, w), tol))
-                    .map(|(m, w)| (s, m, w))
-            });
-            held.push(found.unwrap_or_else(|| {
-                stored.push(c);
-                (stored.len() - 1, 0, false)
-            }));
-        }
+        let (stored, held) = mirror_images(&layout, &grid, values).0;
         // Slots, stored class by stored class: (D, S), then each side with terms (N, B) as
         // (class, its first lane in the values).
         let lanes = layout.lanes();
@@ -1151,6 +1181,67 @@ mod tests {
                 assert_eq!(bins.locate(t), Spatial::locate(&edges, t), "{edges:?} {t}");
             }
         }
+    }
+
+    /// A one-bounce layout of `classes` classes over 2 x 1 cells, every class seen alike.
+    fn layout(classes: u32, grid: &Grid) -> Spatial {
+        Spatial {
+            classes,
+            u_edges: vec![0.0, 0.5, 1.0],
+            v_edges: vec![0.0, 1.0],
+            cell_class: vec![0, classes - 1],
+            cell_albedo: vec![[0.5; 3]; 2],
+            visible: vec![0.3; classes as usize * (grid.n_theta_o * grid.n_phi_o) as usize],
+            secondary: false,
+            cell_neighbours: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn mirror_images_are_found_and_the_search_is_bounded() {
+        let grid = Grid::new(2, 4, 2, 4);
+        let n = grid.len();
+        // Class 1 is class 0 mirrored in y (phi -> -phi), class 2 is neither.
+        let l = layout(3, &grid);
+        let mut r = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            r ^= r << 13;
+            r ^= r >> 7;
+            r ^= r << 17;
+            (r >> 40) as f32 / (1u64 << 24) as f32 + 0.1
+        };
+        let c0: Vec<f32> = (0..2 * n).map(|_| next()).collect();
+        let mut values = c0.clone();
+        for ti in 0..2 {
+            for pi in 0..4 {
+                for to in 0..2 {
+                    for po in 0..4 {
+                        let b = grid.index(ti, mirrored_cell(pi, 4, 2).unwrap(), to, {
+                            mirrored_cell(po, 4, 2).unwrap()
+                        });
+                        values.extend_from_slice(&c0[2 * b..2 * b + 2]);
+                    }
+                }
+            }
+        }
+        values.extend((0..2 * n).map(|_| next()));
+        let ((stored, held), _) = mirror_images(&l, &grid, &Samples::F32(values));
+        assert_eq!(stored, [0, 2]);
+        assert_eq!(held, [(0, 0, false), (0, 2, false), (1, 0, false)]);
+
+        // Classes alike but for their last value (a crafted file): each would be compared
+        // nearly in full with every class before it, 256^2 / 2 x 3 mirrors x about 64 values;
+        // the search stops at 8 times the values.
+        let k = 256u32;
+        let l = layout(k, &grid);
+        let values: Vec<f32> = (0..k as usize)
+            .flat_map(|c| (0..2 * n).map(move |i| if i + 1 == 2 * n { c as f32 } else { 0.5 }))
+            .collect();
+        let budget = 8 * (values.len() + l.visible.len()) as u64;
+        let ((stored, held), compared) = mirror_images(&l, &grid, &Samples::F32(values));
+        assert!(compared <= budget, "{compared} values compared");
+        assert_eq!(stored.len(), k as usize);
+        assert!(held.iter().enumerate().all(|(c, h)| *h == (c, 0, false)));
     }
 
     #[test]

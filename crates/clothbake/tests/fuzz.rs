@@ -1,6 +1,7 @@
 //! Fuzzing every reader of the project's files, on stable Rust, in the normal test suite: the
 //! fabric file (JSON), the WIF draft, the table as OpenEXR, the binary table (version 2
-//! container and version 1), and shard and checkpoint files.
+//! container and version 1), each averaged and spatial (one bounce and two), and shard and
+//! checkpoint files.
 //!
 //! Each target first replays every file of its corpus, `tests/fuzz-corpus/<target>/` (inputs
 //! that once failed, kept as regressions, and hand-made ones), then mutates valid seed files
@@ -21,10 +22,12 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use clothbake_bake::job::{self, Hooks, Job, Target};
 use clothbake_bake::shard::{read_part, ShardId};
+use clothbake_bake::{bake, BakeOptions};
 use clothbake_core::Fabric;
 use clothbake_loader::{
     read_table, write_binary, write_exr, Brdf, Grid, Metadata, Options, Precision, Table,
@@ -386,14 +389,54 @@ fn small_table() -> Table {
     .unwrap()
 }
 
-/// A table that was read is used as renderers use it: looked up and sampled.
+/// Small spatial tables (docs/spatial.md), baked: the gingham's colour map with one bounce,
+/// the twill with the second bounce (side terms, mirror images held once).
+fn spatial_tables() -> Vec<Table> {
+    [("gingham.wif", 1), ("twill.json", 2)]
+        .into_iter()
+        .map(|(name, bounces)| {
+            let fabric = Fabric::from_path(&tables().join(name)).unwrap();
+            let opts = BakeOptions {
+                grid: GRID,
+                spatial: true,
+                bounces,
+                ..BakeOptions::default()
+            };
+            bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false))
+                .unwrap()
+                .table
+        })
+        .collect()
+}
+
+/// A table that was read is used as renderers use it: looked up and sampled and, when
+/// spatial, looked up at points and footprints of the period (wrapped, not finite, wide).
 fn use_table(t: Table) {
     if let Ok(b) = Brdf::from_table(t, Options::default()) {
+        let ok = |f: [f32; 3]| f.iter().all(|v| v.is_finite() && *v >= 0.0);
         for (wo, u) in [([0.0f32, 0.0, 1.0], 0.3f32), ([0.6, 0.0, 0.8], 0.9)] {
-            let f = b.eval([0.0, 0.6, 0.8], wo);
-            assert!(f.iter().all(|v| v.is_finite() && *v >= 0.0), "{f:?}");
+            let wi = [0.0, 0.6, 0.8];
+            let f = b.eval(wi, wo);
+            assert!(ok(f), "{f:?}");
             let s = b.sample(wo, u, 1.0 - u);
             assert!(s.weight.iter().all(|v| v.is_finite()), "{s:?}");
+            if b.spatial().is_none() {
+                continue;
+            }
+            for (x, y) in [
+                (0.1, 0.7),
+                (-3.4, 12.9),
+                (f64::NAN, 0.5),
+                (f64::INFINITY, 0.0),
+            ] {
+                for width in [0.0, 0.3, 0.999, 2.0, f64::NAN] {
+                    let f = b.eval_at(wi, wo, x, y, width);
+                    assert!(ok(f), "{f:?} at {x}, {y}, {width}");
+                    // Slightly above 1 is possible (docs/spatial.md): no upper bound here.
+                    let c = b.coverage_at(wo, x, y, width);
+                    assert!(c.is_finite() && c >= 0.0, "{c} at {x}, {y}, {width}");
+                }
+            }
         }
     }
 }
@@ -473,11 +516,15 @@ fn fuzz_table_exr() {
 
 fn run_table_exr() {
     let d = scratch();
-    let t = small_table();
     let mut seeds = Vec::new();
     for (k, precision) in [Precision::F16, Precision::F32].into_iter().enumerate() {
         let p = d.join(format!("seed-{k}.exr"));
-        write_exr(&p, &t, precision, true).unwrap();
+        write_exr(&p, &small_table(), precision, true).unwrap();
+        seeds.push(std::fs::read(&p).unwrap());
+    }
+    for (k, t) in spatial_tables().iter().enumerate() {
+        let p = d.join(format!("seed-spatial-{k}.exr"));
+        write_exr(&p, t, Precision::F16, true).unwrap();
         seeds.push(std::fs::read(&p).unwrap());
     }
     let tokens: &[&[u8]] = &[
@@ -490,6 +537,12 @@ fn run_table_exr() {
         b"channels\0",
         b"chlist\0",
         b"\0",
+        b"class1.diffuse\0",
+        b"class0.plus_both\0",
+        b"\"u_edges\":",
+        b"\"cell_class\":",
+        b"\"classes\":",
+        b"\"secondary\":true",
     ];
     fuzz(
         &Reader {
@@ -561,12 +614,24 @@ fn run_table_bin() {
     // The version-1 seed is what the loader reads (the layout is right).
     std::fs::write(d.join("seed-v1.bin"), &v1).unwrap();
     assert_eq!(read_table(&d.join("seed-v1.bin")).unwrap(), t);
-    let seeds = vec![std::fs::read(&p).unwrap(), v1];
+    let mut seeds = vec![std::fs::read(&p).unwrap(), v1];
+    for (k, t) in spatial_tables().iter().enumerate() {
+        let p = d.join(format!("seed-spatial-{k}.bin"));
+        write_binary(&p, t, true).unwrap();
+        seeds.push(std::fs::read(&p).unwrap());
+    }
     let tokens: &[&[u8]] = &[
         b"CLTHBAKE",
         b"\"grid\":",
         b"\"n_phi_o\":",
         b"\"format_version\":",
+        b"\"u_edges\":",
+        b"\"v_edges\":",
+        b"\"cell_class\":",
+        b"\"cell_neighbours\":",
+        b"\"classes\":",
+        b"\"secondary\":true",
+        b"\"visible\":",
         b"4294967297",
         b"1e39",
         b"-0",
@@ -603,13 +668,13 @@ fn fuzz_shard_and_checkpoint() {
 fn run_shard_and_checkpoint() {
     let d = scratch();
     let fabric = Fabric::from_path(&tables().join("twill.json")).unwrap();
-    let options = clothbake_bake::BakeOptions {
+    let options = BakeOptions {
         grid: GRID,
         ..Default::default()
     };
     let no = |_: u64, _: u64| {};
     let quiet = |_: &str| {};
-    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let cancel = AtomicBool::new(false);
     let hooks = Hooks {
         progress: &no,
         note: &quiet,
