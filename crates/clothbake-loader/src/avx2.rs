@@ -15,7 +15,9 @@
 use std::arch::x86_64::*;
 
 use crate::angles::HORIZON_COS;
-use crate::nodes::{column_offset, next_column, one_line_tiles, Lane, Nodes, SpanLanes};
+use crate::nodes::{
+    column_offset, next_column, one_line_tiles, Lane, MirrorLanes, Nodes, SpanLanes,
+};
 
 /// True when this processor runs the kernel.
 pub(crate) fn available() -> bool {
@@ -131,6 +133,32 @@ unsafe fn octant(wi: [f32; 3], wo: [f32; 3]) -> (Octant, bool) {
     // Lanes: theta_i = atan2(rho_i, z_i), phi_i = atan2(y_i, x_i), and the same for wo.
     let x = _mm_setr_ps(wi[2], wi[0], wo[2], wo[0]);
     let a = _mm_setr_ps(wi[0], wi[1], wo[0], wo[1]);
+    octant_of(x, a, wi, wo)
+}
+
+/// [`octant`] of the pair mirrored by `m`: the same bits as [`octant`] of the directions with
+/// x and y multiplied by the mirror's signs (exact), without forming them.
+///
+/// # Safety
+/// The processor must have AVX2, FMA and F16C.
+#[inline]
+#[target_feature(enable = "avx2,fma,f16c")]
+unsafe fn octant_mirrored(wi: &[f32; 3], wo: &[f32; 3], m: &MirrorLanes) -> (Octant, bool) {
+    let ld = |v: &[f32; 4]| _mm_loadu_ps(v.as_ptr()); // 4 f32, unaligned
+    let x = _mm_mul_ps(_mm_setr_ps(wi[2], wi[0], wo[2], wo[0]), ld(&m.x));
+    let a = _mm_mul_ps(_mm_setr_ps(wi[0], wi[1], wo[0], wo[1]), ld(&m.a));
+    // y enters `b` only squared: its sign does not matter there.
+    octant_of(x, a, *wi, *wo)
+}
+
+/// [`octant`] from its lanes `x` and `a` (the directions' components, as [`octant`] forms
+/// them) and `b`'s components from `wi`, `wo`.
+///
+/// # Safety
+/// The processor must have AVX2, FMA and F16C.
+#[inline]
+#[target_feature(enable = "avx2,fma,f16c")]
+unsafe fn octant_of(x: __m128, a: __m128, wi: [f32; 3], wo: [f32; 3]) -> (Octant, bool) {
     let b = _mm_setr_ps(wi[1], 0.0, wo[1], 0.0);
     let y2 = _mm_fmadd_ps(a, a, _mm_mul_ps(b, b)); // rho^2 (lanes 0, 2), y^2 (lanes 1, 3)
     let zero = _mm_setzero_ps();
@@ -290,6 +318,27 @@ pub(crate) unsafe fn eval4<V: Lane>(
         return [0.0; 4];
     }
     gather4(nodes, v, &corner(nodes, pos))
+}
+
+/// [`eval4`] at the pair mirrored by `m` (the same bits as [`eval4`] of the mirrored
+/// directions).
+///
+/// # Safety
+/// The processor must have AVX2, FMA and F16C ([`available`]).
+#[inline]
+#[target_feature(enable = "avx2,fma,f16c")]
+pub(crate) unsafe fn eval4_mirrored<V: Lane>(
+    nodes: &Nodes,
+    v: &[V],
+    wi: &[f32; 3],
+    wo: &[f32; 3],
+    m: &MirrorLanes,
+) -> [f32; 4] {
+    let (o, ok) = octant_mirrored(wi, wo, m);
+    if !ok {
+        return [0.0; 4];
+    }
+    gather4(nodes, v, &corner(nodes, cells(&nodes.lanes, o)))
 }
 
 /// Swaps the incident and outgoing angles: `[theta_o, phi_o, theta_i, phi_i]`.
@@ -605,6 +654,49 @@ mod tests {
                 (f64::from(got[1]) - position(1, n[1], phi)).abs() < 1e-4,
                 "{w:?} {got:?}"
             );
+        }
+    }
+
+    #[test]
+    #[cfg_attr(
+        missing_avx2,
+        ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
+    )]
+    fn a_mirrored_octant_is_the_octant_of_the_mirrored_pair() {
+        probe::AVX2.require();
+        let bits = |v: __m128| {
+            let mut out = [0f32; 4];
+            // SAFETY: SSE is part of x86-64.
+            unsafe { _mm_storeu_ps(out.as_mut_ptr(), v) };
+            out.map(f32::to_bits)
+        };
+        let mut dirs: Vec<[f32; 3]> = vec![
+            [0.0, 0.0, 1.0],
+            [-0.0, 0.0, 1.0],
+            [0.0, -0.0, 1.0],
+            [0.6, -0.0, 0.8],
+            [-0.6, 0.0, 0.8],
+            [0.3, 0.4, -0.2],
+            [f32::NAN, 0.1, 0.9],
+            [0.1, f32::NAN, 0.9],
+        ];
+        for k in 0..200 {
+            let (t, p) = (0.0077 * k as f32, 0.37 * k as f32);
+            dirs.push([t.sin() * p.cos(), t.sin() * p.sin(), t.cos()]);
+        }
+        for m in [[1.0f32, 1.0], [-1.0, 1.0], [1.0, -1.0], [-1.0, -1.0]] {
+            let lanes = MirrorLanes::new(m);
+            let flip = |w: [f32; 3]| [w[0] * m[0], w[1] * m[1], w[2]];
+            for w in dirs.windows(2) {
+                let (wi, wo) = (w[0], w[1]);
+                // SAFETY: AVX2, FMA and F16C were detected.
+                let (got, ok) = unsafe { octant_mirrored(&wi, &wo, &lanes) };
+                let (want, want_ok) = unsafe { octant(flip(wi), flip(wo)) };
+                assert_eq!(ok, want_ok, "{wi:?} {wo:?} {m:?}");
+                for (g, w) in [(got.s, want.s), (got.a, want.a), (got.off, want.off)] {
+                    assert_eq!(bits(g), bits(w), "{wi:?} {wo:?} {m:?}");
+                }
+            }
         }
     }
 }

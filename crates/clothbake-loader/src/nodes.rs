@@ -565,6 +565,29 @@ pub(crate) fn angles(wi: [f32; 3], wo: [f32; 3]) -> [f32; 4] {
     std::array::from_fn(|k| atan2(y[k], x[k]))
 }
 
+/// The signs that mirror a pair's lanes in the AVX2 kernel's `octant_mirrored`: `x` for
+/// `[z_i, x_i, z_o, x_o]`, `a` for `[x_i, y_i, x_o, y_o]`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MirrorLanes {
+    pub(crate) x: [f32; 4],
+    pub(crate) a: [f32; 4],
+}
+
+impl MirrorLanes {
+    /// The lanes of a mirror whose factors of x and y are `[sx, sy]` (each +-1).
+    pub(crate) fn new([sx, sy]: [f32; 2]) -> MirrorLanes {
+        MirrorLanes {
+            x: [1.0, sx, 1.0, sx],
+            a: [sx, sy, sx, sy],
+        }
+    }
+
+    /// The factors of x and y.
+    pub(crate) fn signs(&self) -> [f32; 2] {
+        [self.a[0], self.a[1]]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -19,7 +19,7 @@ use crate::angles::{above_horizon, theta_phi};
 use crate::avx2;
 use crate::error::TableError;
 use crate::lookup::{has_value, pad4, SimdPath};
-use crate::nodes::{Lane, Nodes, Values};
+use crate::nodes::{Lane, MirrorLanes, Nodes, Values};
 use crate::stored::Samples;
 use crate::table::Grid;
 use clothbake_bsdf::Footprint;
@@ -326,6 +326,10 @@ pub struct SpatialLookup {
     /// A point's cell along u and along v, found without a search.
     u_bins: Bins,
     v_bins: Bins,
+    /// Cells along u.
+    columns: usize,
+    /// Whether both axes' bins split their cells ([`Bins::split`]).
+    split: bool,
     /// What a point lookup reads of each cell (row-major), in one place.
     points: Vec<PointCell>,
     /// Whether the node tables hold half floats.
@@ -367,8 +371,8 @@ struct Held {
     stored: u32,
     direct: Slot,
     sides: [Slot; 2],
-    /// The factors (+-1) of x and y of the mirror ([`mirror_signs`]).
-    sign: [f32; 2],
+    /// The mirror's factors (+-1) of x and y ([`mirror_signs`]), as the kernels apply them.
+    mirror: MirrorLanes,
 }
 
 impl Held {
@@ -406,8 +410,11 @@ struct Bins {
     /// Bins per period.
     n: f64,
     /// Per bin: the edge from which the point lies in the next cell (infinite when the bin
-    /// has none), and the cell holding the bin's start; one more for f = 1 (by rounding).
+    /// has none), and the cell holding the bin's start; one more for f = 1 (by rounding), and
+    /// copies of that one up to 2 n, so that a bin index masked by `mask` is in bounds.
     bins: Vec<(f64, u32)>,
+    /// 2 n - 1.
+    mask: usize,
     /// Whether every bin holds at most one edge (else the walk corrects the cell).
     split: bool,
 }
@@ -451,8 +458,10 @@ impl Bins {
             // most that.
             let split = first.windows(2).all(|w| w[1] <= w[0] + 1);
             if split || n >= MAX_BINS {
+                let last = first[n];
                 let bins = first
                     .iter()
+                    .chain(std::iter::repeat_n(&last, n - 1))
                     .map(|&i| {
                         let next = if i + 1 < cells {
                             edges[i + 1]
@@ -467,6 +476,7 @@ impl Bins {
                     edges: edges.to_vec(),
                     n: n as f64,
                     bins,
+                    mask: 2 * n - 1,
                     split,
                 };
             }
@@ -483,24 +493,42 @@ impl Bins {
     /// [`Bins::locate`] of a finite `t`.
     #[inline(always)]
     fn locate_finite(&self, t: f64) -> usize {
+        let (i, x) = self.bin_cell(t);
+        if self.split {
+            i
+        } else {
+            self.walk(i, x)
+        }
+    }
+
+    /// The cell of finite `t` from its bin alone (right when [`Bins::split`]), and the wrapped
+    /// fraction x it was found for.
+    #[inline(always)]
+    fn bin_cell(&self, t: f64) -> (usize, f64) {
         let e0 = self.e0;
         let d = t - e0;
         let f = d - d.floor();
         let x = e0 + f;
-        // f in [0, 1] (1 by rounding): bin n holds f = 1 alone, and the clamp only keeps
-        // the index in bounds.
-        let b = (truncate(f * self.n) as usize).min(self.bins.len() - 1);
-        let (next, first) = self.bins[b];
-        let mut i = first as usize + usize::from(x >= next);
-        if !self.split {
-            let e = &self.edges;
-            let last = e.len() - 2;
-            while i > 0 && e[i] > x {
-                i -= 1;
-            }
-            while i < last && e[i + 1] <= x {
-                i += 1;
-            }
+        // f in [0, 1] (1 by rounding): bin n holds f = 1 alone; the mask only keeps any index
+        // (a NaN's) in bounds.
+        let b = truncate(f * self.n) as usize & self.mask;
+        // SAFETY: b <= mask = 2 n - 1 < bins.len() = 2 n (`new`).
+        let (next, first) = unsafe { *self.bins.get_unchecked(b) };
+        (first as usize + usize::from(x >= next), x)
+    }
+
+    /// The cell holding `x` from cell `i` on, by the edges (bins that hold more than one edge),
+    /// out of line.
+    #[cold]
+    #[inline(never)]
+    fn walk(&self, mut i: usize, x: f64) -> usize {
+        let e = &self.edges;
+        let last = e.len() - 2;
+        while i > 0 && e[i] > x {
+            i -= 1;
+        }
+        while i < last && e[i + 1] <= x {
+            i += 1;
         }
         i
     }
@@ -564,8 +592,26 @@ fn with_sides(p: &PointCell, d: f32, s: f32, g: [f32; 4]) -> [f32; 3] {
     std::array::from_fn(|c| {
         let a = p.albedo[c];
         let [plus, minus] = p.sides;
-        (a * d + s + plus[c] * (g[0] + a * g[1]) + minus[c] * (g[2] + a * g[3])).max(0.0)
+        non_negative(a * d + s + plus[c] * (g[0] + a * g[1]) + minus[c] * (g[2] + a * g[3]))
     })
+}
+
+/// Whether `u` and `v` are both finite, in one test: x - x is 0 for a finite x and NaN for
+/// an infinite one or NaN.
+#[inline(always)]
+#[allow(clippy::eq_op)]
+fn both_finite(u: f64, v: f64) -> bool {
+    (u - u) + (v - v) == 0.0
+}
+
+/// `x`, or 0 where it is below 0 or NaN (as `x.max(0.0)`, in one instruction on x86-64).
+#[inline(always)]
+fn non_negative(x: f32) -> f32 {
+    if x > 0.0 {
+        x
+    } else {
+        0.0
+    }
 }
 
 /// `w` mirrored by `m`.
@@ -771,9 +817,10 @@ impl SpatialLookup {
                 stored: s as u32,
                 direct: where_held[s].0,
                 sides: where_held[s].1,
-                sign: mirror_signs(m),
+                mirror: MirrorLanes::new(mirror_signs(m)),
             })
             .collect();
+        let (u_bins, v_bins) = (Bins::new(&layout.u_edges), Bins::new(&layout.v_edges));
         let points = (0..layout.cell_class.len())
             .map(|c| {
                 let k = layout.cell_class[c] as usize;
@@ -786,8 +833,10 @@ impl SpatialLookup {
             })
             .collect();
         SpatialLookup {
-            u_bins: Bins::new(&layout.u_edges),
-            v_bins: Bins::new(&layout.v_edges),
+            columns: u_bins.edges.len() - 1,
+            split: u_bins.split && v_bins.split,
+            u_bins,
+            v_bins,
             points,
             layout,
             grid,
@@ -829,7 +878,8 @@ impl SpatialLookup {
     /// interpolated as the averaged table is (16 nodes, pole rows), by `simd`'s kernel.
     #[inline(always)]
     fn held_f(&self, simd: SimdPath, h: Held, wi: [f32; 3], wo: [f32; 3]) -> [f32; 2] {
-        let (wi, wo) = (flipped(wi, h.sign), flipped(wo, h.sign));
+        let sign = h.mirror.signs();
+        let (wi, wo) = (flipped(wi, sign), flipped(wo, sign));
         let f = Self::pair_f(&self.tables[h.direct.table as usize], simd, wi, wo);
         lanes_of(f, h.direct)
     }
@@ -844,7 +894,8 @@ impl SpatialLookup {
         wi: [f32; 3],
         wo: [f32; 3],
     ) -> ([f32; 2], [f32; 4]) {
-        let (wi, wo) = (flipped(wi, h.sign), flipped(wo, h.sign));
+        let sign = h.mirror.signs();
+        let (wi, wo) = (flipped(wi, sign), flipped(wo, sign));
         let blend = |t: u32| Self::pair_f(&self.tables[t as usize], simd, wi, wo);
         let main = blend(h.direct.table);
         (lanes_of(main, h.direct), side_terms(&h, main, blend))
@@ -923,7 +974,7 @@ impl SpatialLookup {
         v: f64,
         width: f64,
     ) -> Option<[f32; 3]> {
-        if width >= 1.0 || !(u.is_finite() && v.is_finite()) {
+        if width >= 1.0 || !both_finite(u, v) {
             return None;
         }
         if width.is_nan() || width <= 0.0 {
@@ -957,7 +1008,7 @@ impl SpatialLookup {
         let p = self.point_cell(u, v);
         if !p.held.has_sides() {
             let [d, s] = self.held_f(simd, p.held, wi, wo);
-            return p.albedo.map(|a| (a * d + s).max(0.0));
+            return p.albedo.map(|a| non_negative(a * d + s));
         }
         let ([d, s], g) = self.held_all(simd, p.held, wi, wo);
         with_sides(p, d, s, g)
@@ -973,17 +1024,17 @@ impl SpatialLookup {
     unsafe fn point_avx2<V: Lane>(&self, wi: &[f32; 3], wo: &[f32; 3], u: f64, v: f64) -> [f32; 3] {
         let p = self.point_cell(u, v);
         let h = &p.held;
-        let nodes = &self.tables[h.direct.table as usize];
+        // SAFETY: every held class's slots name tables that `new` made.
+        let nodes = unsafe { self.tables.get_unchecked(h.direct.table as usize) };
         let Some(values) = V::tiles(&nodes.values) else {
             return [0.0; 3];
         };
-        let f = avx2::eval4(nodes, values, flipped(*wi, h.sign), flipped(*wo, h.sign));
+        let f = avx2::eval4_mirrored(nodes, values, wi, wo, &h.mirror);
         let [d, s] = lanes_of(f, h.direct);
         if !h.has_sides() {
-            return p.albedo.map(|a| (a * d + s).max(0.0));
+            return p.albedo.map(|a| non_negative(a * d + s));
         }
-        // The directions as given (not the mirrored ones, which would be kept for this call).
-        self.point_sides_avx2::<V>(p, f, *wi, *wo)
+        self.point_sides_avx2::<V>(p, f, wi, wo)
     }
 
     /// The rest of [`SpatialLookup::point_avx2`] for a class with side terms, out of line (so
@@ -999,15 +1050,16 @@ impl SpatialLookup {
         &self,
         p: &PointCell,
         main: [f32; 4],
-        wi: [f32; 3],
-        wo: [f32; 3],
+        wi: &[f32; 3],
+        wo: &[f32; 3],
     ) -> [f32; 3] {
-        let (wi, wo) = (flipped(wi, p.held.sign), flipped(wo, p.held.sign));
         let blend = |t: u32| {
             let nodes = &self.tables[t as usize];
             match V::tiles(&nodes.values) {
                 // SAFETY: as this function's caller guarantees.
-                Some(values) => unsafe { avx2::eval4(nodes, values, wi, wo) },
+                Some(values) => unsafe {
+                    avx2::eval4_mirrored(nodes, values, wi, wo, &p.held.mirror)
+                },
                 None => [0.0; 4],
             }
         };
@@ -1018,8 +1070,24 @@ impl SpatialLookup {
     /// The record of the cell holding (u, v) (finite).
     #[inline(always)]
     fn point_cell(&self, u: f64, v: f64) -> &PointCell {
-        let (i, j) = (self.u_bins.locate_finite(u), self.v_bins.locate_finite(v));
-        &self.points[j * (self.u_bins.edges.len() - 1) + i]
+        let (i, j) = if self.split {
+            (self.u_bins.bin_cell(u).0, self.v_bins.bin_cell(v).0)
+        } else {
+            self.walked_cell(u, v)
+        };
+        let k = j * self.columns + i;
+        debug_assert!(k < self.points.len());
+        // SAFETY: the bins give i < the cells along u and j < those along v, and `new` makes
+        // one record per cell (the layout's cells, checked by `Spatial::validate`).
+        unsafe { self.points.get_unchecked(k) }
+    }
+
+    /// The cell (along u, along v) holding (u, v) (finite) where an axis's bins do not split
+    /// its cells, out of line.
+    #[cold]
+    #[inline(never)]
+    fn walked_cell(&self, u: f64, v: f64) -> (usize, usize) {
+        (self.u_bins.locate_finite(u), self.v_bins.locate_finite(v))
     }
 
     /// [`SpatialLookup::eval_at`] of a footprint whose side is in (0, 1) (0 below the horizon),
@@ -1074,7 +1142,7 @@ impl SpatialLookup {
     /// The footprint's coverage: the share of its projected area in which the eye meets yarn
     /// seen from `wo`. `None` for a footprint of a whole period or more.
     pub fn coverage_at(&self, wo: [f32; 3], u: f64, v: f64, width: f64) -> Option<f32> {
-        if width >= 1.0 || !(u.is_finite() && v.is_finite()) {
+        if width >= 1.0 || !both_finite(u, v) {
             return None;
         }
         let Some(o) = angles(wo) else {
@@ -1242,6 +1310,25 @@ mod tests {
         assert!(compared <= budget, "{compared} values compared");
         assert_eq!(stored.len(), k as usize);
         assert!(held.iter().enumerate().all(|(c, h)| *h == (c, 0, false)));
+    }
+
+    #[test]
+    fn both_finite_is_both_is_finite() {
+        let xs = [
+            0.0,
+            -0.0,
+            1.5,
+            -1e308,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            f64::INFINITY,
+        ];
+        let xs: Vec<f64> = xs.iter().flat_map(|&x| [x, -x]).chain([f64::NAN]).collect();
+        for &u in &xs {
+            for &v in &xs {
+                assert_eq!(both_finite(u, v), u.is_finite() && v.is_finite(), "{u} {v}");
+            }
+        }
     }
 
     #[test]
