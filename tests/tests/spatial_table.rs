@@ -347,6 +347,30 @@ fn footprints_of_fabric(f: &Fabric, file: &str, bounces: u32) {
             }
         }
     }
+    // Which answers: a point not finite and a footprint of a period or more take the averaged
+    // table; a NaN width is a point; a point wraps.
+    let (wi, wo) = (
+        f32s(UnitVec3::from_degrees(40.0, 20.0)),
+        f32s(UnitVec3::from_degrees(30.0, 200.0)),
+    );
+    for b in [&brdf, &portable] {
+        let averaged = b.eval(wi, wo);
+        for (u, v) in [
+            (f64::NAN, 0.3),
+            (0.3, f64::INFINITY),
+            (f64::NEG_INFINITY, 0.0),
+        ] {
+            for w in [0.0, 0.2, f64::NAN] {
+                assert_eq!(b.eval_at(wi, wo, u, v, w), averaged, "{u} {v} {w}");
+            }
+        }
+        for w in [1.0, 7.5, f64::INFINITY] {
+            assert_eq!(b.eval_at(wi, wo, 0.3, 0.6, w), averaged, "{w}");
+        }
+        let point = b.eval_at(wi, wo, 0.3, 0.6, 0.0);
+        assert_eq!(b.eval_at(wi, wo, 0.3, 0.6, f64::NAN), point);
+        assert_eq!(b.eval_at(wi, wo, -2.7, 5.6, 0.0), point);
+    }
     // The twill's cells differ: warp floats against weft floats.
     let (wi, wo) = (
         f32s(UnitVec3::from_degrees(52.5, 15.0)),

@@ -225,10 +225,13 @@ impl Brdf {
     /// [`Brdf::eval`].
     #[inline]
     pub fn eval_at(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64, width: f64) -> [f32; 3] {
-        self.spatial
-            .as_ref()
-            .and_then(|s| s.eval_at(self.simd, wi, wo, u, v, width))
-            .unwrap_or_else(|| self.eval(wi, wo))
+        // One call takes the directions on each path (no copies kept for another).
+        match &self.spatial {
+            Some(s) if SpatialLookup::answers(u, v, width) => {
+                s.eval_within(self.simd, wi, wo, u, v, width)
+            }
+            _ => self.eval(wi, wo),
+        }
     }
 
     /// The share of a footprint's projected area in which the eye meets yarn, seen from `wo`

@@ -962,8 +962,7 @@ impl SpatialLookup {
 
     /// f_r through the footprint: the mean of the covered cells' f_r, each weighted by its
     /// covered share times its coverage. `None` for a footprint of a whole period or more
-    /// (the averaged table answers), `Some(0)` below the horizon. Inline: the checks and a
-    /// point's lookup; footprints out of line.
+    /// (the averaged table answers) or a point not finite, `Some(0)` below the horizon.
     #[inline]
     pub fn eval_at(
         &self,
@@ -974,25 +973,43 @@ impl SpatialLookup {
         v: f64,
         width: f64,
     ) -> Option<[f32; 3]> {
-        if width >= 1.0 || !both_finite(u, v) {
-            return None;
-        }
+        Self::answers(u, v, width).then(|| self.eval_within(simd, wi, wo, u, v, width))
+    }
+
+    /// Whether [`SpatialLookup::eval_at`] answers at (u, v) through a footprint of side
+    /// `width` (below a period, NaN a point), rather than the averaged table.
+    #[inline(always)]
+    pub fn answers(u: f64, v: f64, width: f64) -> bool {
+        (width < 1.0 || width.is_nan()) && both_finite(u, v)
+    }
+
+    /// [`SpatialLookup::eval_at`] where it [`answers`](SpatialLookup::answers). Inline: a
+    /// point's lookup (one call); footprints out of line. The directions are used once on
+    /// each path, so that a caller's are passed on without copies.
+    #[inline]
+    pub(crate) fn eval_within(
+        &self,
+        simd: SimdPath,
+        wi: [f32; 3],
+        wo: [f32; 3],
+        u: f64,
+        v: f64,
+        width: f64,
+    ) -> [f32; 3] {
         if width.is_nan() || width <= 0.0 {
             // A point. The AVX2 kernel tells the horizon and NaN itself (D = S = 0 then, and
             // albedos are finite); the portable blend does not.
-            return Some(match simd {
+            return match simd {
                 // SAFETY: the kernel is AVX2 only when the processor has AVX2, FMA and F16C
                 // (the table's `SimdPath`, as in `pair_f`).
                 #[cfg(target_arch = "x86_64")]
-                SimdPath::Avx2 if self.f16 => unsafe {
-                    self.point_avx2::<half::f16>(&wi, &wo, u, v)
-                },
+                SimdPath::Avx2 if self.f16 => unsafe { self.point_avx2::<half::f16>(wi, wo, u, v) },
                 #[cfg(target_arch = "x86_64")]
-                SimdPath::Avx2 => unsafe { self.point_avx2::<f32>(&wi, &wo, u, v) },
+                SimdPath::Avx2 => unsafe { self.point_avx2::<f32>(wi, wo, u, v) },
                 _ => self.point(simd, wi, wo, u, v),
-            });
+            };
         }
-        Some(self.eval_footprint(simd, wi, wo, Footprint { u, v, width }))
+        self.eval_footprint(simd, wi, wo, Footprint { u, v, width })
     }
 
     /// A point's f_r (u, v finite) by the portable kernel: its cell's `rho_d D + S` and, with
@@ -1021,7 +1038,7 @@ impl SpatialLookup {
     /// The processor must have AVX2, FMA and F16C.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,f16c")]
-    unsafe fn point_avx2<V: Lane>(&self, wi: &[f32; 3], wo: &[f32; 3], u: f64, v: f64) -> [f32; 3] {
+    unsafe fn point_avx2<V: Lane>(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64) -> [f32; 3] {
         let p = self.point_cell(u, v);
         let h = &p.held;
         // SAFETY: every held class's slots name tables that `new` made.
@@ -1029,12 +1046,12 @@ impl SpatialLookup {
         let Some(values) = V::tiles(&nodes.values) else {
             return [0.0; 3];
         };
-        let f = avx2::eval4_mirrored(nodes, values, wi, wo, &h.mirror);
+        let f = avx2::eval4_mirrored(nodes, values, &wi, &wo, &h.mirror);
         let [d, s] = lanes_of(f, h.direct);
         if !h.has_sides() {
             return p.albedo.map(|a| non_negative(a * d + s));
         }
-        self.point_sides_avx2::<V>(p, f, wi, wo)
+        self.point_sides_avx2::<V>(p, f, &wi, &wo)
     }
 
     /// The rest of [`SpatialLookup::point_avx2`] for a class with side terms, out of line (so
