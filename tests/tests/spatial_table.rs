@@ -370,6 +370,18 @@ fn footprints_of_fabric(f: &Fabric, file: &str, bounces: u32) {
         let point = b.eval_at(wi, wo, 0.3, 0.6, 0.0);
         assert_eq!(b.eval_at(wi, wo, 0.3, 0.6, f64::NAN), point);
         assert_eq!(b.eval_at(wi, wo, -2.7, 5.6, 0.0), point);
+        // The coverage alike: the directional coverage where the average answers.
+        let whole = b.coverage_at(wo, 0.3, 0.6, 1.0);
+        assert!((0.5..=1.01).contains(&whole), "{whole}");
+        for (u, v) in [(f64::NAN, 0.3), (0.3, f64::INFINITY)] {
+            // A whole period wherever it lies, summed in another order.
+            let c = b.coverage_at(wo, u, v, 0.0);
+            assert!((c - whole).abs() <= 1e-5 * whole, "{u} {v}: {c} vs {whole}");
+        }
+        assert_eq!(
+            b.coverage_at(wo, 0.3, 0.6, f64::NAN),
+            b.coverage_at(wo, 0.3, 0.6, 0.0)
+        );
     }
     // The twill's cells differ: warp floats against weft floats.
     let (wi, wo) = (

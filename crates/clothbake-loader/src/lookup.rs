@@ -235,12 +235,21 @@ impl Brdf {
     }
 
     /// The share of a footprint's projected area in which the eye meets yarn, seen from `wo`
-    /// (see [`Brdf::eval_at`]); for a footprint of a whole period or more, the directional
-    /// coverage C(wo). An averaged table carries no coverage and answers 1 (opaque).
+    /// (see [`Brdf::eval_at`]); for a footprint of a whole period or more, or a point not
+    /// finite (where `eval_at` answers the average), the directional coverage C(wo). An
+    /// averaged table carries no coverage and answers 1 (opaque).
     pub fn coverage_at(&self, wo: [f32; 3], u: f64, v: f64, width: f64) -> f32 {
+        // As `eval_at`: a NaN width is a point (`f64::min` would make it a period).
+        let (u, v, width) = if !crate::spatial::both_finite(u, v) {
+            (0.0, 0.0, 0.999_999)
+        } else if width.is_nan() {
+            (u, v, 0.0)
+        } else {
+            (u, v, width.min(0.999_999))
+        };
         self.spatial
             .as_ref()
-            .and_then(|s| s.coverage_at(wo, u, v, width.min(0.999_999)))
+            .and_then(|s| s.coverage_at(wo, u, v, width))
             .unwrap_or(1.0)
     }
 

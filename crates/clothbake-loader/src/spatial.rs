@@ -600,7 +600,7 @@ fn with_sides(p: &PointCell, d: f32, s: f32, g: [f32; 4]) -> [f32; 3] {
 /// an infinite one or NaN.
 #[inline(always)]
 #[allow(clippy::eq_op)]
-fn both_finite(u: f64, v: f64) -> bool {
+pub(crate) fn both_finite(u: f64, v: f64) -> bool {
     (u - u) + (v - v) == 0.0
 }
 
