@@ -239,13 +239,12 @@ impl Brdf {
     /// finite (where `eval_at` answers the average), the directional coverage C(wo). An
     /// averaged table carries no coverage and answers 1 (opaque).
     pub fn coverage_at(&self, wo: [f32; 3], u: f64, v: f64, width: f64) -> f32 {
-        // As `eval_at`: a NaN width is a point (`f64::min` would make it a period).
-        let (u, v, width) = if !crate::spatial::both_finite(u, v) {
-            (0.0, 0.0, 0.999_999)
-        } else if width.is_nan() {
-            (u, v, 0.0)
+        // Where `eval_at` answers the average, the whole period (just under, which the
+        // spatial table still answers).
+        let (u, v, width) = if SpatialLookup::answers(u, v, width) {
+            (u, v, width)
         } else {
-            (u, v, width.min(0.999_999))
+            (0.0, 0.0, 0.999_999)
         };
         self.spatial
             .as_ref()

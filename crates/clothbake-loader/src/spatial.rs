@@ -960,32 +960,18 @@ impl SpatialLookup {
         seen
     }
 
-    /// f_r through the footprint: the mean of the covered cells' f_r, each weighted by its
-    /// covered share times its coverage. `None` for a footprint of a whole period or more
-    /// (the averaged table answers) or a point not finite, `Some(0)` below the horizon.
-    #[inline]
-    pub fn eval_at(
-        &self,
-        simd: SimdPath,
-        wi: [f32; 3],
-        wo: [f32; 3],
-        u: f64,
-        v: f64,
-        width: f64,
-    ) -> Option<[f32; 3]> {
-        Self::answers(u, v, width).then(|| self.eval_within(simd, wi, wo, u, v, width))
-    }
-
-    /// Whether [`SpatialLookup::eval_at`] answers at (u, v) through a footprint of side
-    /// `width` (below a period, NaN a point), rather than the averaged table.
+    /// Whether this table answers f_r and coverage at (u, v) through a footprint of side
+    /// `width` ([`crate::Brdf::eval_at`]): below a period (NaN a point) at a finite point;
+    /// elsewhere the averaged table answers.
     #[inline(always)]
-    pub fn answers(u: f64, v: f64, width: f64) -> bool {
+    pub(crate) fn answers(u: f64, v: f64, width: f64) -> bool {
         (width < 1.0 || width.is_nan()) && both_finite(u, v)
     }
 
-    /// [`SpatialLookup::eval_at`] where it [`answers`](SpatialLookup::answers). Inline: a
-    /// point's lookup (one call); footprints out of line. The directions are used once on
-    /// each path, so that a caller's are passed on without copies.
+    /// f_r through the footprint, where the table [`answers`](SpatialLookup::answers): the
+    /// mean of the covered cells' f_r, each weighted by its covered share times its coverage;
+    /// 0 below the horizon. Inline: a point's lookup (one call); footprints out of line. The
+    /// directions are used once on each path, so that a caller's are passed on without copies.
     #[inline]
     pub(crate) fn eval_within(
         &self,
@@ -1107,7 +1093,7 @@ impl SpatialLookup {
         (self.u_bins.locate_finite(u), self.v_bins.locate_finite(v))
     }
 
-    /// [`SpatialLookup::eval_at`] of a footprint whose side is in (0, 1) (0 below the horizon),
+    /// [`SpatialLookup::eval_within`] of a footprint whose side is in (0, 1) (0 below the horizon),
     /// out of line.
     #[inline(never)]
     fn eval_footprint(
@@ -1157,9 +1143,10 @@ impl SpatialLookup {
     }
 
     /// The footprint's coverage: the share of its projected area in which the eye meets yarn
-    /// seen from `wo`. `None` for a footprint of a whole period or more.
+    /// seen from `wo`. `None` where the averaged table answers (as for `Brdf::eval_at`): a
+    /// footprint of a whole period or more, a point not finite.
     pub fn coverage_at(&self, wo: [f32; 3], u: f64, v: f64, width: f64) -> Option<f32> {
-        if width >= 1.0 || !both_finite(u, v) {
+        if !Self::answers(u, v, width) {
             return None;
         }
         let Some(o) = angles(wo) else {
