@@ -1,4 +1,5 @@
-//! Probes the optional dependencies of these tests (Python packages, Mitsuba's llvm variant, SLURM) and sets
+//! Probes the optional dependencies of these tests (Python packages, Mitsuba's llvm variant, SLURM,
+//! AVX2 for the direct model's batch) and sets
 //! `missing_<name>` for each one absent, so that the tests needing it show as ignored, with the
 //! reason, instead of passing without running (and fail under `CI`); see the shared probes in
 //! crates/clothbake-loader/build/probe.rs.
@@ -19,5 +20,6 @@ fn main() {
         OPENEXR,
         SLURM,
         PKG_CONFIG,
+        AVX2,
     ]);
 }

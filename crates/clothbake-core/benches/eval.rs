@@ -52,6 +52,22 @@ fn analytic(c: &mut Criterion) {
             );
         }
     }
+    // The batch: 64 consecutive pairs of the pool an iteration (time per iteration / 64 is the
+    // time per pair), the walk wrapping round the pool.
+    let m = AnalyticModel::new(&fabric, FacetModel::Huo);
+    let mut out = vec![clothbake_core::Reflection::default(); 64];
+    for (name, mask) in [("random", dirs.len() - 1), ("coherent", 63)] {
+        c.bench_function(&format!("analytic_direct/twill/huo_batch_64/{name}"), |b| {
+            let mut k = 0;
+            b.iter(|| {
+                k = (k + 64) & mask;
+                let end = (k + 64).min(dirs.len());
+                let pairs = &dirs[k.min(end - 64)..end];
+                m.intensity_batch(black_box(pairs), &mut out);
+                black_box(&out);
+            })
+        });
+    }
     c.bench_function("analytic_preprocess/twill", |b| {
         b.iter(|| black_box(AnalyticModel::new(black_box(&fabric), FacetModel::Huo)))
     });

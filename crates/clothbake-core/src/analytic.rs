@@ -1410,6 +1410,8 @@ fn overlap(a: (f64, f64), b: (f64, f64)) -> f64 {
     (hi - lo).max(0.0)
 }
 
+mod batch;
+
 #[cfg(test)]
 mod reference;
 

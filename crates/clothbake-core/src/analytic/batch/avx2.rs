@@ -1,0 +1,704 @@
+//! The lanes of [`super`]: every function the lane form of the scalar one it names, inlined
+//! into [`run_avx2`], the one function compiled for AVX2.
+
+use crate::analytic::{AnalyticModel, Unit, Variant, EPS};
+use crate::geometry::equal_area_height;
+use crate::lanes::{F64x4 as F, Mask4 as M};
+use crate::reflect::Reflection;
+use crate::shadowing::ActiveTable;
+use crate::trig::{atan2_x4, sin_cos_x4};
+use crate::vec3::UnitVec3;
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// Lanes of an elevation (`shadowing::Elevation`).
+#[derive(Clone, Copy)]
+struct Elevation {
+    psi: F,
+    sin: F,
+    cos: F,
+}
+
+impl Elevation {
+    /// `Elevation::of`.
+    #[inline(always)]
+    fn of(rise: F, run: F) -> Elevation {
+        let inv = 1.0 / (rise * rise + run * run).sqrt();
+        Elevation {
+            psi: atan2_x4(rise, run),
+            sin: rise * inv,
+            cos: run * inv,
+        }
+    }
+}
+
+/// Lanes of an occluder (`shadowing::Occluder`).
+#[derive(Clone, Copy)]
+struct Occluder {
+    u: F,
+    z: F,
+    rho: F,
+}
+
+impl Occluder {
+    /// `Occluder::support`.
+    #[inline(always)]
+    fn support(&self, sin_psi: F, cos_psi: F) -> F {
+        self.rho - self.u * sin_psi + self.z * cos_psi
+    }
+}
+
+/// `ActiveTable::active` per lane: which lanes have an occluder, and each lane's. The entries'
+/// bounds decrease, so the active entry is the first whose bound is at most psi (the last
+/// where none is).
+#[inline(always)]
+fn active(t: &ActiveTable, psi: F) -> (M, Occluder) {
+    let Some(((_, last), rest)) = t.entries.split_last() else {
+        let z = F::splat(0.0);
+        return (M::splat(false), Occluder { u: z, z, rho: z });
+    };
+    let mut o = Occluder {
+        u: F::splat(last.u),
+        z: F::splat(last.z),
+        rho: F::splat(last.rho),
+    };
+    for (lo, e) in rest.iter().rev() {
+        let here = F::splat(*lo).le(psi);
+        o = Occluder {
+            u: here.select(F::splat(e.u), o.u),
+            z: here.select(F::splat(e.z), o.z),
+            rho: here.select(F::splat(e.rho), o.rho),
+        };
+    }
+    (M::splat(true), o)
+}
+
+/// Per lane, `a`'s occluder where `which` holds, else `b`'s.
+#[inline(always)]
+fn either(which: M, a: (M, Occluder), b: (M, Occluder)) -> (M, Occluder) {
+    let m = (which & a.0) | (!which & b.0);
+    let (a, b) = (a.1, b.1);
+    (
+        m,
+        Occluder {
+            u: which.select(a.u, b.u),
+            z: which.select(a.z, b.z),
+            rho: which.select(a.rho, b.rho),
+        },
+    )
+}
+
+/// Lanes of a direction as one group's units see it (`analytic::View`).
+#[derive(Clone, Copy)]
+struct View {
+    /// The projection on the cross-section plane.
+    c: F,
+    z: F,
+    /// Its polar form.
+    angle: F,
+    norm: F,
+    cos: F,
+    sin: F,
+    /// The side elevation; valid where `side`.
+    side: M,
+    psi: Elevation,
+    mirrored: M,
+    /// The axial component, and the end elevation valid where `end`.
+    va: F,
+    end: M,
+    end_psi: Elevation,
+}
+
+impl View {
+    /// `View::both`.
+    #[inline(always)]
+    fn both(v: [F; 3]) -> [View; 2] {
+        let [x, y, z] = v;
+        let (ex, ey) = (Elevation::of(z, x.abs()), Elevation::of(z, y.abs()));
+        [View::new(x, y, z, ex, ey), View::new(y, x, z, ey, ex)]
+    }
+
+    /// `View::new`.
+    #[inline(always)]
+    fn new(vc: F, va: F, vz: F, ec: Elevation, ea: Elevation) -> View {
+        let mirrored = vc.lt(F::splat(0.0));
+        let eps = F::splat(EPS);
+        View {
+            c: vc,
+            z: vz,
+            angle: mirrored.select(PI - ec.psi, ec.psi),
+            norm: (vc * vc + vz * vz).sqrt(),
+            cos: mirrored.select(-ec.cos, ec.cos),
+            sin: ec.sin,
+            side: vc.abs().gt(eps),
+            psi: ec,
+            mirrored,
+            va,
+            end: va.abs().gt(eps),
+            end_psi: ea,
+        }
+    }
+}
+
+/// Lanes of a unit half vector's projection (`arc::Heading`).
+#[derive(Clone, Copy)]
+struct Heading {
+    norm: F,
+    cos: F,
+    sin: F,
+}
+
+impl Heading {
+    /// `Heading::new`.
+    #[inline(always)]
+    fn new(c: F, z: F) -> Heading {
+        let norm = (c * c + z * z).sqrt();
+        let inv = 1.0 / norm;
+        Heading {
+            norm,
+            cos: c * inv,
+            sin: z * inv,
+        }
+    }
+}
+
+/// Lanes of light, eye and half vector for one group (`analytic::Views`).
+#[derive(Clone, Copy)]
+struct Views {
+    l: View,
+    e: View,
+    h: Heading,
+}
+
+impl Views {
+    /// `Views::both`.
+    #[inline(always)]
+    fn both(l: [F; 3], e: [F; 3]) -> [Views; 2] {
+        let [lw, lf] = View::both(l);
+        let [ew, ef] = View::both(e);
+        let h = [l[0] + e[0], l[1] + e[1], l[2] + e[2]];
+        let inv = 1.0 / (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+        let h = [h[0] * inv, h[1] * inv, h[2] * inv];
+        [
+            Views {
+                l: lw,
+                e: ew,
+                h: Heading::new(h[0], h[2]),
+            },
+            Views {
+                l: lf,
+                e: ef,
+                h: Heading::new(h[1], h[2]),
+            },
+        ]
+    }
+}
+
+/// Lanes of an arc with its ends' sines and cosines (`arc::ArcTrig`).
+#[derive(Clone, Copy)]
+struct Arc {
+    lo: F,
+    hi: F,
+    lo_sc: (F, F),
+    hi_sc: (F, F),
+}
+
+impl Arc {
+    /// `ArcTrig::facing`.
+    #[inline(always)]
+    fn facing(v: &View) -> Arc {
+        Arc {
+            lo: v.angle - FRAC_PI_2,
+            hi: v.angle + FRAC_PI_2,
+            lo_sc: (-v.cos, v.sin),
+            hi_sc: (v.cos, -v.sin),
+        }
+    }
+
+    /// `ArcTrig::meet`.
+    #[inline(always)]
+    fn meet(self, o: &Arc) -> Arc {
+        let lo = o.lo.gt(self.lo);
+        let hi = o.hi.lt(self.hi);
+        Arc {
+            lo: lo.select(o.lo, self.lo),
+            hi: hi.select(o.hi, self.hi),
+            lo_sc: (
+                lo.select(o.lo_sc.0, self.lo_sc.0),
+                lo.select(o.lo_sc.1, self.lo_sc.1),
+            ),
+            hi_sc: (
+                hi.select(o.hi_sc.0, self.hi_sc.0),
+                hi.select(o.hi_sc.1, self.hi_sc.1),
+            ),
+        }
+    }
+
+    /// `Arc::is_empty`.
+    #[inline(always)]
+    fn empty(&self) -> M {
+        self.lo.ge(self.hi)
+    }
+
+    /// Every lane the scalar arc `a`.
+    #[inline(always)]
+    fn splat(a: &crate::arc::ArcTrig) -> Arc {
+        Arc {
+            lo: F::splat(a.arc.lo),
+            hi: F::splat(a.arc.hi),
+            lo_sc: (F::splat(a.lo.0), F::splat(a.lo.1)),
+            hi_sc: (F::splat(a.hi.0), F::splat(a.hi.1)),
+        }
+    }
+}
+
+/// `meet` of two intervals.
+#[inline(always)]
+fn meet(a: (F, F), b: (F, F)) -> (F, F) {
+    (a.0.max(b.0), a.1.min(b.1))
+}
+
+/// `overlap` of two intervals.
+#[inline(always)]
+fn overlap(a: (F, F), b: (F, F)) -> F {
+    let (lo, hi) = meet(a, b);
+    (hi - lo).max(F::splat(0.0))
+}
+
+/// `shadowing::occluded_length` (eq. 3.6).
+#[inline(always)]
+fn occluded_length(top: f64, o: &Occluder, psi: &Elevation) -> F {
+    let num = o.support(psi.sin, psi.cos) - top * psi.cos;
+    let zero = F::splat(0.0);
+    num.le(zero).select(
+        zero,
+        psi.sin
+            .le(zero)
+            .select(F::splat(f64::INFINITY), num / psi.sin),
+    )
+}
+
+/// A break point of an arc in `mean_occluded_length`: its sort key (-cos of its angle from the
+/// arc's start; infinite where the point is not one), sine and cosine.
+#[derive(Clone, Copy)]
+struct Cut {
+    key: F,
+    s: F,
+    c: F,
+}
+
+/// `shadowing::mean_occluded_length` (eq. 3.6 averaged over the arc, the refined variant).
+#[inline(always)]
+fn mean_occluded_length(
+    r: f64,
+    h: f64,
+    o: &Occluder,
+    psi: &Elevation,
+    arc: &Arc,
+    e: (F, F),
+    max_len: f64,
+) -> F {
+    let zero = F::splat(0.0);
+    let (sp, cp) = (psi.sin, psi.cos);
+    let fallback = arc.empty() | sp.le(zero);
+    let short = occluded_length(equal_area_height(r, h), o, psi).min(F::splat(max_len));
+    let num0 = o.support(sp, cp) - h * cp;
+    let rc = r * cp;
+    let inv_sp = 1.0 / sp;
+    let inv_rc = 1.0 / rc;
+    let (a, b) = (num0 * inv_sp, rc * inv_sp);
+    let (s0, c0) = arc.lo_sc;
+    let from_lo = |(s, c): (F, F)| (s * c0 - c * s0, c * c0 + s * s0);
+    let cos_len = from_lo(arc.hi_sc).1;
+    // The four break points in the scalar's order, each with its validity.
+    let b_pos = b.gt(zero);
+    let one = F::splat(1.0);
+    let mut cand = [Cut {
+        key: zero,
+        s: zero,
+        c: zero,
+    }; 4];
+    for (j, x) in [num0 * inv_rc, (num0 - max_len * sp) * inv_rc]
+        .into_iter()
+        .enumerate()
+    {
+        let ok = b_pos & x.abs().lt(one);
+        let x = ok.select(x, zero);
+        let c = ((1.0 - x) * (1.0 + x)).sqrt();
+        for (i, point) in [(x, c), (x, -c)].into_iter().enumerate() {
+            let (sf, cf) = from_lo(point);
+            let v = ok & sf.gt(zero) & cf.gt(cos_len);
+            cand[2 * j + i] = Cut {
+                key: v.select(-cf, F::splat(f64::INFINITY)),
+                s: point.0,
+                c: point.1,
+            };
+        }
+    }
+    let inf = F::splat(f64::INFINITY);
+    let any_cut =
+        (cand[0].key.lt(inf) | cand[1].key.lt(inf)) | (cand[2].key.lt(inf) | cand[3].key.lt(inf));
+    let mut sorted = [Cut {
+        key: inf,
+        s: zero,
+        c: one,
+    }; 4];
+    if any_cut.any() {
+        // The stable order of the insertion sort: rank = keys below, plus equal keys before.
+        let mut rank = [zero; 4];
+        for i in 0..4 {
+            for j in 0..4 {
+                if j == i {
+                    continue;
+                }
+                let before = if j < i {
+                    cand[j].key.le(cand[i].key)
+                } else {
+                    cand[j].key.lt(cand[i].key)
+                };
+                rank[i] = rank[i] + before.select(one, zero);
+            }
+        }
+        for (pos, slot) in sorted.iter_mut().enumerate() {
+            let pos = F::splat(pos as f64);
+            for i in 0..4 {
+                let here = rank[i].ge(pos) & rank[i].le(pos);
+                *slot = Cut {
+                    key: here.select(cand[i].key, slot.key),
+                    s: here.select(cand[i].s, slot.s),
+                    c: here.select(cand[i].c, slot.c),
+                };
+            }
+        }
+    }
+    let valid = [
+        sorted[0].key.lt(inf),
+        sorted[1].key.lt(inf),
+        sorted[2].key.lt(inf),
+        sorted[3].key.lt(inf),
+    ];
+    // Points 0..=5: the arc's start, the sorted break points, the arc's end; a break point's
+    // angle from its offset, computed where a window needs it.
+    let mut theta = [arc.lo, zero, zero, zero, zero, arc.hi];
+    let mut have = [true, false, false, false, false, true];
+    let sc = |k: usize| match k {
+        0 => (s0, c0),
+        5 => arc.hi_sc,
+        _ => (sorted[k - 1].s, sorted[k - 1].c),
+    };
+    let pw = |(s, c): (F, F)| e.0 * s - e.1 * c;
+    let psw = |(s, c): (F, F), t: F| e.0 * 0.5 * s * s + e.1 * 0.5 * (t - s * c);
+    let tol = 1e-9 * (a.abs() + b.abs() + max_len);
+    let clear = |l: F| (l.abs().gt(tol)) & ((l - max_len).abs().gt(tol));
+    let max = F::splat(max_len);
+    let (mut num, mut den) = (zero, zero);
+    for k in 0..5 {
+        // Window k runs from point k to point k + 1, or to the arc's end after the last valid
+        // break point; it exists where point k does.
+        let live = if k == 0 { M::splat(true) } else { valid[k - 1] };
+        if !live.any() {
+            break;
+        }
+        let next = if k < 4 { valid[k] } else { M::splat(false) };
+        let (p0, p1, pe) = (sc(k), sc(k + 1), arc.hi_sc);
+        let q1 = (next.select(p1.0, pe.0), next.select(p1.1, pe.1));
+        let l_end_at = a - b * q1.0;
+        let end_clear = !next & clear(l_end_at);
+        let (known, l_known) = if k == 0 {
+            let l0 = a - b * p0.0;
+            let c0 = clear(l0);
+            (c0 | end_clear, c0.select(l0, l_end_at))
+        } else {
+            (end_clear, l_end_at)
+        };
+        let wsum = pw(q1) - pw(p0);
+        den = den + live.select(wsum, zero);
+        // Where l is known to be 0 or the whole length, the window needs no angle.
+        let flat = known & (l_known.le(zero) | l_known.ge(max));
+        let mut l_mid = l_known;
+        let mut inner = zero;
+        if (live & !flat).any() {
+            for j in [k, k + 1] {
+                if !have[j] {
+                    let (sf, cf) = from_lo((sorted[j - 1].s, sorted[j - 1].c));
+                    theta[j] = arc.lo + atan2_x4(sf, cf);
+                    have[j] = true;
+                }
+            }
+            let t0 = theta[k];
+            let t1 = next.select(theta[k + 1], arc.hi);
+            l_mid = known.select(l_known, a - b * sin_cos_x4(0.5 * (t0 + t1)).0);
+            inner = a * wsum - b * (psw(q1, t1) - psw(p0, t0));
+        }
+        let term = l_mid
+            .le(zero)
+            .select(zero, l_mid.ge(max).select(max_len * wsum, inner));
+        num = num + live.select(term, zero);
+    }
+    let mean = den.le(zero).select(zero, (num / den).clamp(0.0, max_len));
+    fallback.select(short, mean)
+}
+
+/// The lanes' arc of a unit's cross-section that faces `v`, less what the side neighbour
+/// hides (`AnalyticModel::side_arc`).
+#[inline(always)]
+fn side_arc(u: &Unit, v: &View) -> Arc {
+    let mut arc = Arc::facing(v);
+    let (some, o) = either(
+        v.mirrored,
+        active(&u.side_minus, v.psi.psi),
+        active(&u.side_plus, v.psi.psi),
+    );
+    let some = some & v.side;
+    if !some.any() {
+        return arc;
+    }
+    // `occluded_arc_at`: theta = psi + alpha, sin(alpha) = s / r1.
+    let (r1, h1) = (u.seg.radius, u.seg.height);
+    let psi = &v.psi;
+    let s = o.support(psi.sin, psi.cos) - h1 * psi.cos;
+    let all = s.ge(F::splat(r1));
+    let up_to = s.gt(F::splat(-r1)) & !all;
+    let sa = up_to.select(s / r1, F::splat(0.0));
+    let ca = ((1.0 - sa) * (1.0 + sa)).sqrt();
+    let t = psi.psi + atan2_x4(sa, ca);
+    let (ts, tc) = (psi.sin * ca + psi.cos * sa, psi.cos * ca - psi.sin * sa);
+    let all = some & all;
+    let up_to = some & up_to;
+    // Mirrored: the arc ends at pi - t; else it starts at t.
+    let pt = PI - t;
+    let cut_hi = up_to & v.mirrored & pt.lt(arc.hi);
+    let cut_lo = up_to & !v.mirrored & t.gt(arc.lo);
+    arc.hi = cut_hi.select(pt, arc.hi);
+    arc.hi_sc = (
+        cut_hi.select(ts, arc.hi_sc.0),
+        cut_hi.select(-tc, arc.hi_sc.1),
+    );
+    arc.lo = cut_lo.select(t, arc.lo);
+    arc.lo_sc = (
+        cut_lo.select(ts, arc.lo_sc.0),
+        cut_lo.select(tc, arc.lo_sc.1),
+    );
+    arc.hi = all.select(arc.lo, arc.hi);
+    arc.hi_sc = (
+        all.select(arc.lo_sc.0, arc.hi_sc.0),
+        all.select(arc.lo_sc.1, arc.hi_sc.1),
+    );
+    arc
+}
+
+/// The lanes' interval along the axis the ends' occluders leave (`AnalyticModel::end_interval`).
+#[inline(always)]
+fn end_interval(m: &AnalyticModel, u: &Unit, v: &View, arc: &Arc, e: (F, F)) -> (F, F) {
+    let seg = &u.seg;
+    let Some((y0, y1)) = seg.extent else {
+        return (F::splat(f64::NEG_INFINITY), F::splat(f64::INFINITY));
+    };
+    let (y0, y1) = (F::splat(y0), F::splat(y1));
+    let plus = v.va.gt(F::splat(0.0));
+    let psi = &v.end_psi;
+    let (some, o) = either(
+        plus,
+        active(&seg.end_plus, psi.psi),
+        active(&seg.end_minus, psi.psi),
+    );
+    let some = some & v.end;
+    if !some.any() {
+        return (y0, y1);
+    }
+    let max_len = seg.extent.map_or(0.0, |(a, b)| b - a);
+    let hidden = match m.variant {
+        Variant::Thesis => occluded_length(seg.top, &o, psi),
+        Variant::Refined => mean_occluded_length(seg.radius, seg.height, &o, psi, arc, e, max_len),
+    };
+    let hidden = some.select(hidden, F::splat(0.0));
+    (plus.select(y0, y0 + hidden), plus.select(y1 - hidden, y1))
+}
+
+/// `arc::projected_width` on a nonempty arc.
+#[inline(always)]
+fn projected_width(r: f64, arc: &Arc, e: (F, F)) -> F {
+    let f = |(s, c): (F, F)| e.0 * s - e.1 * c;
+    r * (f(arc.hi_sc) - f(arc.lo_sc))
+}
+
+/// `arc::diffuse_integral` on a nonempty arc.
+#[inline(always)]
+fn diffuse_integral(arc: &Arc, l: (F, F), e: (F, F)) -> F {
+    let half_t = 0.5 * (arc.hi - arc.lo);
+    let sc2 = 0.5 * (arc.hi_sc.0 * arc.hi_sc.1 - arc.lo_sc.0 * arc.lo_sc.1);
+    let s2 = 0.5 * (arc.hi_sc.0 * arc.hi_sc.0 - arc.lo_sc.0 * arc.lo_sc.0);
+    l.0 * e.0 * (half_t + sc2) + (l.0 * e.1 + l.1 * e.0) * s2 + l.1 * e.1 * (half_t - sc2)
+}
+
+/// `f64::powi` as compiler-rt's `__powidf2` computes it (square and multiply from the low bit).
+#[inline(always)]
+fn powi(mut a: F, mut n: u32) -> F {
+    let mut r = F::splat(1.0);
+    loop {
+        if n & 1 != 0 {
+            r = r * a;
+        }
+        n /= 2;
+        if n == 0 {
+            return r;
+        }
+        a = a * a;
+    }
+}
+
+/// `arc::huo_specular_integral` (eq. 4.10) on a nonempty arc, for a whole exponent `n`.
+#[inline(always)]
+fn huo_specular_integral(arc: &Arc, h: &Heading, e: &Heading, n: u32) -> F {
+    let sd = h.sin * e.cos - h.cos * e.sin;
+    let cd = h.cos * e.cos + h.sin * e.sin;
+    let su_cu = |(st, ct): (F, F)| [st * h.cos - ct * h.sin, ct * h.cos + st * h.sin];
+    let ([s0, c0], [s1, c1]) = (su_cu(arc.lo_sc), su_cu(arc.hi_sc));
+    let m = n + 1;
+    // `cos_power_integral(m, ...)`.
+    let even = m.is_multiple_of(2);
+    let (su, cu) = ([s0, s1], [c0, c1]);
+    let mut acc = if even {
+        let th = atan2_x4(h.sin, h.cos);
+        [arc.lo - th, arc.hi - th]
+    } else {
+        su
+    };
+    let mut k = if even { 2 } else { 3 };
+    let c2 = [cu[0] * cu[0], cu[1] * cu[1]];
+    let mut cp = if even { cu } else { c2 };
+    let mut power = if even { [F::splat(1.0); 2] } else { cu };
+    while k <= m {
+        let inv = 1.0 / k as f64;
+        let w = (k as f64 - 1.0) * inv;
+        for j in 0..2 {
+            acc[j] = cp[j] * su[j] * inv + w * acc[j];
+            power[j] = cp[j] * cu[j];
+            cp[j] = cp[j] * c2[j];
+        }
+        k += 2;
+    }
+    let ([p0, p1], [q0, q1]) = (acc, power);
+    let prim = |p: F, q: F| cd * p + sd * q / (n as f64 + 1.0);
+    let v = prim(p1, q1) - prim(p0, q0);
+    powi(h.norm, n) * e.norm * v
+}
+
+/// Eq. 4.11 for four pairs (`AnalyticModel::intensity_with` without I_2), given each unit's
+/// whole exponent.
+#[inline(always)]
+fn intensity4(m: &AnalyticModel, exps: &[u32], wi: [F; 3], wo: [F; 3]) -> [Reflection; 4] {
+    let zero = F::splat(0.0);
+    let views = Views::both(wi, wo);
+    let mut s_total = zero;
+    let mut i_d = [zero; 3];
+    let mut i_s = zero;
+    for (u, &n) in m.units.iter().zip(exps) {
+        let v = &views[u.seg.group as usize];
+        let seg = &u.seg;
+        let floor = Arc::splat(&seg.floor);
+        let seen = side_arc(u, &v.e).meet(&floor);
+        let lit = side_arc(u, &v.l).meet(&floor);
+        // `visible_of`.
+        let ep = (v.e.c, v.e.z);
+        let mut vis = !seen.empty();
+        if !vis.any() {
+            continue;
+        }
+        let along = end_interval(m, u, &v.e, &seen, ep);
+        let range = (F::splat(u.range.0), F::splat(u.range.1));
+        let l_v = overlap(range, along);
+        vis = vis & l_v.gt(zero);
+        if !vis.any() {
+            continue;
+        }
+        let width = projected_width(seg.radius, &seen, ep);
+        let vi = seen.meet(&lit);
+        let lit_len = end_interval(m, u, &v.l, &vi, ep);
+        let l_vi = overlap(range, meet(along, lit_len));
+        let d = f64::from(u.count);
+        s_total = s_total + vis.select(d * l_v * width, zero);
+        let lit = vis & !vi.empty() & l_vi.gt(zero);
+        if !lit.any() {
+            continue;
+        }
+        // `arc_integral`.
+        let kd = diffuse_integral(&vi, (v.l.c, v.l.z), ep);
+        let ks = if seg.material.specular == 0.0 {
+            zero
+        } else {
+            let e = Heading {
+                norm: v.e.norm,
+                cos: v.e.cos,
+                sin: v.e.sin,
+            };
+            seg.material.specular * huo_specular_integral(&vi, &v.h, &e, n)
+        };
+        let w = d * l_vi * seg.radius;
+        for (acc, a) in i_d.iter_mut().zip(seg.material.albedo) {
+            *acc = *acc + lit.select(w * kd * a, zero);
+        }
+        i_s = i_s + lit.select(w * ks, zero);
+    }
+    let (s_total, i_s) = (s_total.to_array(), i_s.to_array());
+    let i_d = i_d.map(F::to_array);
+    [0, 1, 2, 3].map(|k| {
+        let s = s_total[k];
+        if s <= 0.0 {
+            Reflection::default()
+        } else {
+            Reflection {
+                i_d: [i_d[0][k] / s, i_d[1][k] / s, i_d[2][k] / s],
+                i_s: [i_s[k] / s; 3],
+                secondary: None,
+            }
+        }
+    })
+}
+
+/// Runs [`intensity4`] over the pairs, four at a time (the last group padded with a pair
+/// above the horizon whose result is dropped); pairs below the horizon give 0.
+#[inline(always)]
+fn run(m: &AnalyticModel, exps: &[u32], pairs: &[(UnitVec3, UnitVec3)], out: &mut [Reflection]) {
+    let up = UnitVec3::Z;
+    for (p, o) in pairs.chunks(4).zip(out.chunks_mut(4)) {
+        let pair = |k: usize| {
+            p.get(k)
+                .filter(|(wi, wo)| wi.above_horizon() && wo.above_horizon())
+                .map_or((up, up), |&q| q)
+        };
+        let q = [pair(0), pair(1), pair(2), pair(3)].map(|(wi, wo)| (wi.get(), wo.get()));
+        let wi = [
+            F::from_array(q.map(|p| p.0.x)),
+            F::from_array(q.map(|p| p.0.y)),
+            F::from_array(q.map(|p| p.0.z)),
+        ];
+        let wo = [
+            F::from_array(q.map(|p| p.1.x)),
+            F::from_array(q.map(|p| p.1.y)),
+            F::from_array(q.map(|p| p.1.z)),
+        ];
+        let r = intensity4(m, exps, wi, wo);
+        for (k, slot) in o.iter_mut().enumerate() {
+            let (wi, wo) = p[k];
+            *slot = if wi.above_horizon() && wo.above_horizon() {
+                r[k]
+            } else {
+                Reflection::default()
+            };
+        }
+    }
+}
+
+/// [`run`] compiled for AVX2.
+///
+/// # Safety
+/// The processor must have AVX2.
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn run_avx2(
+    m: &AnalyticModel,
+    exps: &[u32],
+    pairs: &[(UnitVec3, UnitVec3)],
+    out: &mut [Reflection],
+) {
+    run(m, exps, pairs, out)
+}
