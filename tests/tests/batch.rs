@@ -4,7 +4,10 @@
 //! symmetry planes (the projections' zero branches), grazing, below the horizon, and a group
 //! of pairs padded to four.
 
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, Reflection, UnitVec3, Variant};
+use clothbake_core::{
+    AnalyticBsdf, AnalyticModel, Bsdf, Component, Fabric, FacetModel, Reflection, SecondaryOptions,
+    UnitVec3, Variant,
+};
 use clothbake_tests::accuracy::random_pairs;
 use clothbake_tests::fixtures::shipped_files;
 use clothbake_tests::probe;
@@ -95,6 +98,41 @@ fn other_facets_are_evaluated_pair_by_pair() {
         m.intensity_batch(&p, &mut out);
         for (&(wi, wo), got) in p.iter().zip(&out) {
             assert_eq!(bits(got), bits(&m.intensity(wi, wo)), "{facet:?}");
+        }
+    }
+}
+
+/// `AnalyticBsdf::f_batch` (what a one-bounce bake evaluates) against `Bsdf::f`: the same bits,
+/// for the total and the direct component, and with the second bounce (pair by pair).
+#[test]
+#[cfg_attr(
+    missing_avx2,
+    ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
+)]
+fn the_bsdf_batch_gives_the_bits_of_f() {
+    probe::AVX2.require();
+    let twill = Fabric::from_path(&clothbake_tests::fixtures::tables().join("twill.json")).unwrap();
+    let p = pairs(9);
+    let model = || AnalyticModel::new(&twill, FacetModel::Huo);
+    let cases = [
+        (AnalyticBsdf::new(model(), None), p.len()),
+        (
+            AnalyticBsdf::new(model(), None)
+                .with_component(Component::Direct)
+                .unwrap(),
+            p.len(),
+        ),
+        (
+            AnalyticBsdf::new(model(), Some(SecondaryOptions::default())),
+            61,
+        ),
+    ];
+    for (bsdf, n) in cases {
+        let p = &p[..n];
+        let mut out = vec![[0.0; 3]; n];
+        bsdf.f_batch(p, &mut out);
+        for (&(wi, wo), got) in p.iter().zip(&out) {
+            assert_eq!(got.map(f64::to_bits), bsdf.f(wi, wo).map(f64::to_bits));
         }
     }
 }

@@ -473,8 +473,21 @@ pub fn tool_name() -> String {
     format!("clothbake {}", env!("CARGO_PKG_VERSION"))
 }
 
-/// Appends a cell's row entries (see [`Orbits::stride`]) for cell index, wi, wo.
-type CellFn = Box<dyn Fn(usize, UnitVec3, UnitVec3, &mut Row) + Sync + Send>;
+/// Appends the row entries (see [`Orbits::stride`]) of cells of one row, given its wi and
+/// each cell's index and wo, in that order.
+type CellFn = Box<dyn Fn(UnitVec3, &[(usize, UnitVec3)], &mut Row) + Sync + Send>;
+
+/// Cells a row hands its evaluator at once (the cancel flag is read between them).
+const CELLS_AT_ONCE: usize = 256;
+
+/// The evaluator of a row's cells from that of one cell (index, wi, wo).
+fn per_cell(f: impl Fn(usize, UnitVec3, UnitVec3, &mut Row) + Sync + Send + 'static) -> CellFn {
+    Box::new(move |wi, cells, out| {
+        for &(c, wo) in cells {
+            f(c, wi, wo, out);
+        }
+    })
+}
 
 /// A prepared bake: the cell evaluator, the orbits and the metadata of the table it makes.
 /// Rows are evaluated independently ([`Baker::eval_row`]), by one process ([`bake`]) or by
@@ -507,7 +520,7 @@ impl Baker {
                 let classes = layout.classes as usize;
                 let cells = secondary.map(|_| m.cell_classes_with(true));
                 spatial = Some(layout);
-                Box::new(move |_, wi, wo, out| {
+                per_cell(move |_, wi, wo, out| {
                     // The average from the classes: each unit (with the second bounce, each
                     // unit beside each neighbour pair) is evaluated once.
                     let mut terms = vec![ClassTerms::default(); classes];
@@ -522,12 +535,18 @@ impl Baker {
             }
             (Method::Analytic { variant }, Some(mb)) => {
                 let ft = crate::transport::FullTransport::with(fabric, opts.facet, variant, mb);
-                Box::new(move |_, wi, wo, out| out.push(ft.f(wi, wo).map(|x| x as f32)))
+                per_cell(move |_, wi, wo, out| out.push(ft.f(wi, wo).map(|x| x as f32)))
             }
             (Method::Analytic { variant }, None) => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
                 let bsdf = AnalyticBsdf::new(m, secondary);
-                Box::new(move |_, wi, wo, out| out.push(bsdf.f(wi, wo).map(|x| x as f32)))
+                // One bounce: four pairs at a time (AnalyticBsdf::f_batch), the same bits.
+                Box::new(move |wi, cells, out| {
+                    let pairs: Vec<_> = cells.iter().map(|&(_, wo)| (wi, wo)).collect();
+                    let mut f = vec![[0.0; 3]; pairs.len()];
+                    bsdf.f_batch(&pairs, &mut f);
+                    out.extend(f.iter().map(|f| f.map(|x| x as f32)));
+                })
             }
             (
                 Method::Raytrace {
@@ -538,7 +557,7 @@ impl Baker {
                 _,
             ) => {
                 let rt = RayTracer::new(fabric, opts.facet).with_caps(caps);
-                Box::new(move |c, wi, wo, out| {
+                per_cell(move |c, wi, wo, out| {
                     let f = rt
                         .render(wi, wo, samples, seed.wrapping_add(c as u64))
                         .reflection
@@ -595,20 +614,27 @@ impl Baker {
         let (ti, pi) = row_cell(&g, row);
         let wi = direction(ti, nti, pi, npi);
         let mut out = Vec::with_capacity(self.orbits.row_evaluations(row));
+        let mut cells = Vec::with_capacity(CELLS_AT_ONCE);
         for to in 0..nto {
             for po in 0..npo {
-                // Checked per cell: a row may hold millions of cells (a relaxed load costs
-                // nothing beside an evaluation).
-                if cancel.load(Ordering::Relaxed) {
-                    return None;
-                }
                 if !self.orbits.canonical(pi as usize, po as usize) {
                     continue;
                 }
-                let c = g.index(ti, pi, to, po);
-                (self.eval)(c, wi, direction(to, nto, po, npo), &mut out);
+                cells.push((g.index(ti, pi, to, po), direction(to, nto, po, npo)));
+                if cells.len() == CELLS_AT_ONCE {
+                    // Checked between groups of cells: a row may hold millions of them.
+                    if cancel.load(Ordering::Relaxed) {
+                        return None;
+                    }
+                    (self.eval)(wi, &cells, &mut out);
+                    cells.clear();
+                }
             }
         }
+        if cancel.load(Ordering::Relaxed) {
+            return None;
+        }
+        (self.eval)(wi, &cells, &mut out);
         Some(out)
     }
 

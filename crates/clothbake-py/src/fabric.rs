@@ -228,6 +228,21 @@ impl PyFabric {
                         .collect()
                 })
             }
+            ("analytic", None) if secondary.is_none() => {
+                // One bounce: four pairs at a time (AnalyticModel::intensity_batch, the same
+                // bits as intensity).
+                let m = self.model(facet);
+                py.detach(|| {
+                    let mut r = vec![Reflection::default(); pairs.len()];
+                    r.par_chunks_mut(256)
+                        .zip(pairs.par_chunks(256))
+                        .for_each(|(r, p)| m.intensity_batch(p, r));
+                    r.iter()
+                        .zip(&pairs)
+                        .map(|(r, &(a, _))| parts(r, a))
+                        .collect()
+                })
+            }
             ("analytic", None) => {
                 let m = self.model(facet);
                 py.detach(|| {
