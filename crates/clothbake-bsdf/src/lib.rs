@@ -60,6 +60,19 @@ pub trait Bsdf: Sync {
     /// cloth, the average over the weave period (eq. 4.11).
     fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb;
 
+    /// [`Bsdf::f`] of each pair (light, eye): `out[k]` is `f(pairs[k])`, bit for bit. The
+    /// default evaluates them one by one; a BSDF that evaluates several pairs faster at once
+    /// (the analytic model, four pairs in AVX2 lanes) overrides it.
+    ///
+    /// # Panics
+    /// If `out` and `pairs` differ in length.
+    fn f_batch(&self, pairs: &[(UnitVec3, UnitVec3)], out: &mut [Rgb]) {
+        assert_eq!(pairs.len(), out.len(), "one output per pair");
+        for (o, &(wi, wo)) in out.iter_mut().zip(pairs) {
+            *o = self.f(wi, wo);
+        }
+    }
+
     /// f_r seen through a footprint of the weave period: the coverage-weighted mean of the
     /// local f_r over the footprint, which is [`Bsdf::f`] once the footprint spans the period.
     /// The default is spatially uniform.

@@ -81,35 +81,6 @@ impl AnalyticBsdf {
     pub fn intensity(&self, wi: UnitVec3, wo: UnitVec3) -> Reflection {
         self.model.intensity_with(wi, wo, self.secondary.as_ref())
     }
-
-    /// [`Bsdf::f`] of each pair: `out[k]` is `f(pairs[k])`, bit for bit. With one bounce the
-    /// pairs go through [`AnalyticModel::intensity_batch`] (four at a time in AVX2 lanes); with
-    /// two, one at a time.
-    ///
-    /// # Panics
-    /// If `out` and `pairs` differ in length.
-    pub fn f_batch(&self, pairs: &[(UnitVec3, UnitVec3)], out: &mut [Rgb]) {
-        assert_eq!(pairs.len(), out.len(), "one output per pair");
-        if self.secondary.is_some() {
-            for (o, &(wi, wo)) in out.iter_mut().zip(pairs) {
-                *o = self.f(wi, wo);
-            }
-            return;
-        }
-        const CHUNK: usize = 64;
-        let mut r = [Reflection::default(); CHUNK];
-        for (p, o) in pairs.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
-            let r = &mut r[..p.len()];
-            self.model.intensity_batch(p, r);
-            for ((&(wi, wo), r), o) in p.iter().zip(r.iter()).zip(o) {
-                *o = if wi.above_horizon() && wo.above_horizon() {
-                    intensity_to_brdf(self.component.of(r), wi)
-                } else {
-                    [0.0; 3]
-                };
-            }
-        }
-    }
 }
 
 impl AnalyticBsdf {
@@ -134,6 +105,31 @@ impl Bsdf for AnalyticBsdf {
             return [0.0; 3];
         }
         intensity_to_brdf(self.component.of(&self.intensity(wi, wo)), wi)
+    }
+
+    /// With one bounce the pairs go through [`AnalyticModel::intensity_batch`] (four at a time
+    /// in AVX2 lanes, the same bits); with two, one at a time.
+    fn f_batch(&self, pairs: &[(UnitVec3, UnitVec3)], out: &mut [Rgb]) {
+        assert_eq!(pairs.len(), out.len(), "one output per pair");
+        if self.secondary.is_some() {
+            for (o, &(wi, wo)) in out.iter_mut().zip(pairs) {
+                *o = self.f(wi, wo);
+            }
+            return;
+        }
+        const CHUNK: usize = 64;
+        let mut r = [Reflection::default(); CHUNK];
+        for (p, o) in pairs.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+            let r = &mut r[..p.len()];
+            self.model.intensity_batch(p, r);
+            for ((&(wi, wo), r), o) in p.iter().zip(r.iter()).zip(o) {
+                *o = if wi.above_horizon() && wo.above_horizon() {
+                    intensity_to_brdf(self.component.of(r), wi)
+                } else {
+                    [0.0; 3]
+                };
+            }
+        }
     }
 
     /// The box filter over the footprint of the cells' f_r (thesis units, docs/spatial.md),

@@ -75,15 +75,22 @@ pub fn cell_value(
     } else {
         phi_samples
     };
-    let mut sum = [0.0; 3];
-    let (mut s1, mut s2) = (0.0, 0.0);
+    // Both orders of every rotation's pair, evaluated in one batch: (a, b), (b, a), ...
+    let mut pairs = Vec::with_capacity(2 * evaluated);
     for s in 0..evaluated {
         let ph = 2.0 * PI * s as f64 / phi_samples as f64;
         let (a, b) = half_diff_to_pair(th, ph, td, pd);
         let (Some(a), Some(b)) = (UnitVec3::new(a), UnitVec3::new(b)) else {
             continue;
         };
-        let (f, g) = (brdf.f(a, b), brdf.f(b, a));
+        pairs.extend([(a, b), (b, a)]);
+    }
+    let mut fs = vec![[0.0; 3]; pairs.len()];
+    brdf.f_batch(&pairs, &mut fs);
+    let mut sum = [0.0; 3];
+    let (mut s1, mut s2) = (0.0, 0.0);
+    for fg in fs.chunks_exact(2) {
+        let (f, g) = (fg[0], fg[1]);
         let v: [f64; 3] = std::array::from_fn(|c| 0.5 * (f[c] + g[c]));
         for c in 0..3 {
             sum[c] += v[c];

@@ -203,6 +203,9 @@ pub fn slice_half_vector(x: usize, y: usize, n: usize) -> (UnitVec3, f64) {
 fn slice(brdf: &dyn Bsdf, v: UnitVec3, n: usize) -> (Vec<f32>, Vec<f32>) {
     let mut rgb = vec![0f32; 3 * n * n];
     let mut lum = vec![0f64; n * n];
+    // The slice's texels that reflect into the upper hemisphere, evaluated in one batch.
+    let mut texels = Vec::with_capacity(n * n);
+    let mut pairs = Vec::with_capacity(n * n);
     for y in 0..n {
         for x in 0..n {
             let (m, ux) = slice_half_vector(x, y, n);
@@ -210,15 +213,21 @@ fn slice(brdf: &dyn Bsdf, v: UnitVec3, n: usize) -> (Vec<f32>, Vec<f32>) {
             let Some(l) = reflect(v, m).filter(|l| cos_vm > 0.0 && l.above_horizon()) else {
                 continue;
             };
-            // What the reader returns: f_r(light, view) cos(theta_light).
-            let f = brdf.f(l, v).map(|c| c * l.cos_theta());
-            for (c, fc) in f.iter().enumerate() {
-                rgb[(c * n + y) * n + x] = *fc as f32;
-            }
-            // d omega_light / d u_m (the readers' Jacobian): 2 pi^2 u_x sin(theta_m) 4 (v.m).
-            let sin_m = (1.0 - m.cos_theta().powi(2)).max(0.0).sqrt();
-            lum[y * n + x] = luminance(f).max(0.0) * 2.0 * PI * PI * ux * sin_m * 4.0 * cos_vm;
+            texels.push((x, y, m, ux, cos_vm));
+            pairs.push((l, v));
         }
+    }
+    let mut fs = vec![[0.0; 3]; pairs.len()];
+    brdf.f_batch(&pairs, &mut fs);
+    for (&(x, y, m, ux, cos_vm), (&(l, _), f)) in texels.iter().zip(pairs.iter().zip(&fs)) {
+        // What the reader returns: f_r(light, view) cos(theta_light).
+        let f = f.map(|c| c * l.cos_theta());
+        for (c, fc) in f.iter().enumerate() {
+            rgb[(c * n + y) * n + x] = *fc as f32;
+        }
+        // d omega_light / d u_m (the readers' Jacobian): 2 pi^2 u_x sin(theta_m) 4 (v.m).
+        let sin_m = (1.0 - m.cos_theta().powi(2)).max(0.0).sqrt();
+        lum[y * n + x] = luminance(f).max(0.0) * 2.0 * PI * PI * ux * sin_m * 4.0 * cos_vm;
     }
     let mean = lum.iter().sum::<f64>() / lum.len() as f64;
     let floor = if mean > 0.0 { 0.01 * mean } else { 1.0 };
