@@ -1,12 +1,13 @@
-//! The direct model's batch (`AnalyticModel::intensity_batch`, four pairs in the lanes of an
-//! AVX2 register) against single evaluations (`AnalyticModel::intensity`): the same bits, on
-//! every shipped fabric, both end-length variants, pairs uniform in solid angle, on the
-//! symmetry planes (the projections' zero branches), grazing, below the horizon, and a group
-//! of pairs padded to four.
+//! The direct model's batches (four pairs in the lanes of an AVX2 register:
+//! `AnalyticModel::intensity_batch`, `AnalyticModel::class_terms_batch`, `Bsdf::f_batch`)
+//! against single evaluations (`intensity`, `class_terms`, `f`): the same bits, on every
+//! shipped fabric, both end-length variants, pairs uniform in solid angle, on the symmetry
+//! planes (the projections' zero branches), grazing, below the horizon, and a group of pairs
+//! padded to four.
 
 use clothbake_core::{
-    AnalyticBsdf, AnalyticModel, Bsdf, Component, Fabric, FacetModel, Reflection, SecondaryOptions,
-    UnitVec3, Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, ClassTerms, Component, Fabric, FacetModel, Reflection,
+    SecondaryOptions, UnitVec3, Variant,
 };
 use clothbake_tests::accuracy::random_pairs;
 use clothbake_tests::fixtures::shipped_files;
@@ -135,4 +136,35 @@ fn the_bsdf_batch_gives_the_bits_of_f() {
             assert_eq!(got.map(f64::to_bits), bsdf.f(wi, wo).map(f64::to_bits));
         }
     }
+}
+
+/// `AnalyticModel::class_terms_batch` (what a one-bounce spatial bake evaluates) against
+/// `class_terms`: the same bits on every shipped fabric.
+#[test]
+#[cfg_attr(
+    missing_avx2,
+    ignore = "needs an x86-64 processor with AVX2, FMA and F16C: nothing to install, run on such a processor"
+)]
+fn the_class_batch_gives_the_bits_of_class_terms() {
+    probe::AVX2.require();
+    let mut compared = 0;
+    for (k, (name, fabric)) in shipped().iter().enumerate() {
+        let m = AnalyticModel::new(fabric, FacetModel::Huo);
+        let n = m.classes();
+        let p = &pairs(100 + k as u64)[..403];
+        let mut out = vec![ClassTerms::default(); n * p.len()];
+        m.class_terms_batch(p, &mut out);
+        let mut want = vec![ClassTerms::default(); n];
+        for (&(wi, wo), got) in p.iter().zip(out.chunks(n)) {
+            m.class_terms(wi, wo, &mut want);
+            for (g, w) in got.iter().zip(&want) {
+                let b = |t: &ClassTerms| {
+                    [t.visible, t.diffuse, t.specular, t.neighbour[0], t.both[1]].map(f64::to_bits)
+                };
+                assert_eq!(b(g), b(w), "{name} {wi:?} {wo:?}: {g:?} vs {w:?}");
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared > 10_000, "{compared}");
 }

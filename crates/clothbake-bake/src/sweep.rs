@@ -520,17 +520,30 @@ impl Baker {
                 let classes = layout.classes as usize;
                 let cells = secondary.map(|_| m.cell_classes_with(true));
                 spatial = Some(layout);
-                per_cell(move |_, wi, wo, out| {
+                Box::new(move |wi, group, out| {
                     // The average from the classes: each unit (with the second bounce, each
-                    // unit beside each neighbour pair) is evaluated once.
-                    let mut terms = vec![ClassTerms::default(); classes];
-                    m.class_terms_with(wi, wo, secondary.as_ref(), &mut terms);
-                    let average = match &cells {
-                        Some(cells) => m.average_of_cells(cells, &terms),
-                        None => m.average_of_classes(&terms),
-                    };
-                    out.push(average.map(|x| x as f32));
-                    crate::spatial::class_values(&terms, cells.is_some(), out);
+                    // unit beside each neighbour pair) is evaluated once; with one bounce, four
+                    // pairs at a time (class_terms_batch, the same bits).
+                    let mut terms = vec![ClassTerms::default(); classes * group.len()];
+                    match &cells {
+                        Some(_) => {
+                            for (t, &(_, wo)) in terms.chunks_mut(classes).zip(group) {
+                                m.class_terms_with(wi, wo, secondary.as_ref(), t);
+                            }
+                        }
+                        None => {
+                            let pairs: Vec<_> = group.iter().map(|&(_, wo)| (wi, wo)).collect();
+                            m.class_terms_batch(&pairs, &mut terms);
+                        }
+                    }
+                    for t in terms.chunks(classes) {
+                        let average = match &cells {
+                            Some(cells) => m.average_of_cells(cells, t),
+                            None => m.average_of_classes(t),
+                        };
+                        out.push(average.map(|x| x as f32));
+                        crate::spatial::class_values(t, cells.is_some(), out);
+                    }
                 })
             }
             (Method::Analytic { variant }, Some(mb)) => {

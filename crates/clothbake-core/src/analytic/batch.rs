@@ -15,6 +15,7 @@
 //! [`AnalyticModel::intensity`].
 
 use super::AnalyticModel;
+use crate::analytic::ClassTerms;
 #[cfg(target_arch = "x86_64")]
 use crate::facet::FacetModel;
 use crate::reflect::Reflection;
@@ -66,6 +67,35 @@ impl AnalyticModel {
         }
         for (o, &(wi, wo)) in out.iter_mut().zip(pairs) {
             *o = self.intensity(wi, wo);
+        }
+    }
+
+    /// [`AnalyticModel::class_terms`] of each pair: pair `k`'s entries (one per class) are
+    /// `out[k * classes..(k + 1) * classes]`, bit for bit; four pairs at a time in AVX2 lanes
+    /// where [`AnalyticModel::intensity_batch`] takes them, else pair by pair.
+    ///
+    /// # Panics
+    /// If `out` does not hold one entry per class for each pair.
+    pub fn class_terms_batch(&self, pairs: &[(UnitVec3, UnitVec3)], out: &mut [ClassTerms]) {
+        let classes = self.classes();
+        assert_eq!(
+            out.len(),
+            pairs.len() * classes,
+            "one entry per class and pair"
+        );
+        if classes == 0 {
+            return;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if let Some(exps) = whole_exponents(self) {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: AVX2 was detected.
+                unsafe { avx2::run_classes_avx2(self, &exps, pairs, out) };
+                return;
+            }
+        }
+        for (o, &(wi, wo)) in out.chunks_mut(classes).zip(pairs) {
+            self.class_terms(wi, wo, o);
         }
     }
 }

@@ -1,7 +1,7 @@
 //! The lanes of [`super`]: every function the lane form of the scalar one it names, inlined
 //! into [`run_avx2`], the one function compiled for AVX2.
 
-use crate::analytic::{AnalyticModel, Unit, Variant, EPS};
+use crate::analytic::{AnalyticModel, ClassTerms, Unit, Variant, EPS};
 use crate::geometry::equal_area_height;
 use crate::lanes::{F64x4 as F, Mask4 as M};
 use crate::reflect::Reflection;
@@ -583,6 +583,72 @@ fn huo_specular_integral(arc: &Arc, h: &Heading, e: &Heading, n: u32) -> F {
     powi(h.norm, n) * e.norm * v
 }
 
+/// A unit's terms in each lane (`AnalyticModel::unit_terms` without I_2).
+struct Terms {
+    /// Visible length l_v and projected width of the visible arc (eq. 4.3).
+    l_v: F,
+    width: F,
+    /// Lit and visible length l_vi and the arc integrals of the diffuse factor and of the
+    /// specular intensity (times rho_s), valid where `lit`.
+    l_vi: F,
+    kd: F,
+    ks: F,
+    /// Lanes where the unit is visible, and where it is also lit.
+    visible: M,
+    lit: M,
+}
+
+/// Unit `u`'s terms for the views of its group, `n` its whole exponent: `None` where no lane
+/// sees it.
+#[inline(always)]
+fn unit_terms(m: &AnalyticModel, u: &Unit, v: &Views, n: u32) -> Option<Terms> {
+    let zero = F::splat(0.0);
+    let seg = &u.seg;
+    let floor = Arc::splat(&seg.floor);
+    let seen = side_arc(u, &v.e).meet(&floor);
+    let lit = side_arc(u, &v.l).meet(&floor);
+    // `visible_of`.
+    let ep = (v.e.c, v.e.z);
+    let mut visible = !seen.empty();
+    if !visible.any() {
+        return None;
+    }
+    let along = end_interval(m, u, &v.e, &seen, ep);
+    let range = (F::splat(u.range.0), F::splat(u.range.1));
+    let l_v = overlap(range, along);
+    visible = visible & l_v.gt(zero);
+    if !visible.any() {
+        return None;
+    }
+    let width = projected_width(seg.radius, &seen, ep);
+    let vi = seen.meet(&lit);
+    let lit_len = end_interval(m, u, &v.l, &vi, ep);
+    let l_vi = overlap(range, meet(along, lit_len));
+    let lit = visible & !vi.empty() & l_vi.gt(zero);
+    let mut t = Terms {
+        l_v,
+        width,
+        l_vi,
+        kd: zero,
+        ks: zero,
+        visible,
+        lit,
+    };
+    if lit.any() {
+        // `arc_integral`.
+        t.kd = diffuse_integral(&vi, (v.l.c, v.l.z), ep);
+        if seg.material.specular != 0.0 {
+            let e = Heading {
+                norm: v.e.norm,
+                cos: v.e.cos,
+                sin: v.e.sin,
+            };
+            t.ks = seg.material.specular * huo_specular_integral(&vi, &v.h, &e, n);
+        }
+    }
+    Some(t)
+}
+
 /// Eq. 4.11 for four pairs (`AnalyticModel::intensity_with` without I_2), given each unit's
 /// whole exponent.
 #[inline(always)]
@@ -593,51 +659,16 @@ fn intensity4(m: &AnalyticModel, exps: &[u32], wi: [F; 3], wo: [F; 3]) -> [Refle
     let mut i_d = [zero; 3];
     let mut i_s = zero;
     for (u, &n) in m.units.iter().zip(exps) {
-        let v = &views[u.seg.group as usize];
-        let seg = &u.seg;
-        let floor = Arc::splat(&seg.floor);
-        let seen = side_arc(u, &v.e).meet(&floor);
-        let lit = side_arc(u, &v.l).meet(&floor);
-        // `visible_of`.
-        let ep = (v.e.c, v.e.z);
-        let mut vis = !seen.empty();
-        if !vis.any() {
+        let Some(t) = unit_terms(m, u, &views[u.seg.group as usize], n) else {
             continue;
-        }
-        let along = end_interval(m, u, &v.e, &seen, ep);
-        let range = (F::splat(u.range.0), F::splat(u.range.1));
-        let l_v = overlap(range, along);
-        vis = vis & l_v.gt(zero);
-        if !vis.any() {
-            continue;
-        }
-        let width = projected_width(seg.radius, &seen, ep);
-        let vi = seen.meet(&lit);
-        let lit_len = end_interval(m, u, &v.l, &vi, ep);
-        let l_vi = overlap(range, meet(along, lit_len));
-        let d = f64::from(u.count);
-        s_total = s_total + vis.select(d * l_v * width, zero);
-        let lit = vis & !vi.empty() & l_vi.gt(zero);
-        if !lit.any() {
-            continue;
-        }
-        // `arc_integral`.
-        let kd = diffuse_integral(&vi, (v.l.c, v.l.z), ep);
-        let ks = if seg.material.specular == 0.0 {
-            zero
-        } else {
-            let e = Heading {
-                norm: v.e.norm,
-                cos: v.e.cos,
-                sin: v.e.sin,
-            };
-            seg.material.specular * huo_specular_integral(&vi, &v.h, &e, n)
         };
-        let w = d * l_vi * seg.radius;
-        for (acc, a) in i_d.iter_mut().zip(seg.material.albedo) {
-            *acc = *acc + lit.select(w * kd * a, zero);
+        let d = f64::from(u.count);
+        s_total = s_total + t.visible.select(d * t.l_v * t.width, zero);
+        let w = d * t.l_vi * u.seg.radius;
+        for (acc, a) in i_d.iter_mut().zip(u.seg.material.albedo) {
+            *acc = *acc + t.lit.select(w * t.kd * a, zero);
         }
-        i_s = i_s + lit.select(w * ks, zero);
+        i_s = i_s + t.lit.select(w * t.ks, zero);
     }
     let (s_total, i_s) = (s_total.to_array(), i_s.to_array());
     let i_d = i_d.map(F::to_array);
@@ -655,31 +686,98 @@ fn intensity4(m: &AnalyticModel, exps: &[u32], wi: [F; 3], wo: [F; 3]) -> [Refle
     })
 }
 
+/// Each class's terms for four pairs (`AnalyticModel::class_terms`), pair `k`'s into
+/// `out[k * classes..]` (zero where the class is not seen).
+#[inline(always)]
+fn class_terms4(m: &AnalyticModel, exps: &[u32], wi: [F; 3], wo: [F; 3], out: &mut [ClassTerms]) {
+    let zero = F::splat(0.0);
+    let classes = m.class_unit.len();
+    let views = Views::both(wi, wo);
+    let (px, py) = m.grid.period();
+    // `direct_terms`: the visible share, and f_r = I / (pi cos theta_i) (`intensity_to_brdf`).
+    let (area, cos_i) = (px * py * wo[2], PI * wi[2]);
+    for (c, &u) in m.class_unit.iter().enumerate() {
+        let (u, n) = (&m.units[u as usize], exps[u as usize]);
+        let Some(t) = unit_terms(m, u, &views[u.seg.group as usize], n) else {
+            continue;
+        };
+        let s_v = t.l_v * t.width;
+        let w = t.l_vi * u.seg.radius / s_v;
+        let d = t.lit.select((w * t.kd / cos_i).max(zero), zero);
+        let s = t.lit.select((w * t.ks / cos_i).max(zero), zero);
+        let (visible, share) = (t.visible.to_array(), (s_v / area).to_array());
+        let (d, s) = (d.to_array(), s.to_array());
+        for k in 0..4 {
+            if visible[k] {
+                out[k * classes + c] = ClassTerms {
+                    visible: share[k],
+                    diffuse: d[k],
+                    specular: s[k],
+                    ..ClassTerms::default()
+                };
+            }
+        }
+    }
+}
+
+/// The lanes of four pairs (the missing ones and those below the horizon replaced by a pair
+/// above it, whose results the caller drops).
+#[inline(always)]
+fn lanes_of(q: &[(UnitVec3, UnitVec3)]) -> ([F; 3], [F; 3]) {
+    let up = UnitVec3::Z;
+    let pair = |k: usize| {
+        q.get(k)
+            .filter(|(wi, wo)| wi.above_horizon() && wo.above_horizon())
+            .map_or((up, up), |&q| q)
+    };
+    let v = [pair(0), pair(1), pair(2), pair(3)].map(|(wi, wo)| (wi.get(), wo.get()));
+    (
+        [
+            F::from_array(v.map(|p| p.0.x)),
+            F::from_array(v.map(|p| p.0.y)),
+            F::from_array(v.map(|p| p.0.z)),
+        ],
+        [
+            F::from_array(v.map(|p| p.1.x)),
+            F::from_array(v.map(|p| p.1.y)),
+            F::from_array(v.map(|p| p.1.z)),
+        ],
+    )
+}
+
+/// Runs [`class_terms4`] over the pairs, four at a time; pairs below the horizon give 0.
+#[inline(always)]
+fn run_classes(
+    m: &AnalyticModel,
+    exps: &[u32],
+    pairs: &[(UnitVec3, UnitVec3)],
+    out: &mut [ClassTerms],
+) {
+    let classes = m.class_unit.len();
+    out.fill(ClassTerms::default());
+    let mut four = vec![ClassTerms::default(); 4 * classes];
+    for (q, o) in pairs.chunks(4).zip(out.chunks_mut(4 * classes)) {
+        let (wi, wo) = lanes_of(q);
+        four.fill(ClassTerms::default());
+        class_terms4(m, exps, wi, wo, &mut four);
+        for (k, &(wi, wo)) in q.iter().enumerate() {
+            if wi.above_horizon() && wo.above_horizon() {
+                o[k * classes..(k + 1) * classes]
+                    .copy_from_slice(&four[k * classes..(k + 1) * classes]);
+            }
+        }
+    }
+}
+
 /// Runs [`intensity4`] over the pairs, four at a time (the last group padded with a pair
 /// above the horizon whose result is dropped); pairs below the horizon give 0.
 #[inline(always)]
 fn run(m: &AnalyticModel, exps: &[u32], pairs: &[(UnitVec3, UnitVec3)], out: &mut [Reflection]) {
-    let up = UnitVec3::Z;
-    for (p, o) in pairs.chunks(4).zip(out.chunks_mut(4)) {
-        let pair = |k: usize| {
-            p.get(k)
-                .filter(|(wi, wo)| wi.above_horizon() && wo.above_horizon())
-                .map_or((up, up), |&q| q)
-        };
-        let q = [pair(0), pair(1), pair(2), pair(3)].map(|(wi, wo)| (wi.get(), wo.get()));
-        let wi = [
-            F::from_array(q.map(|p| p.0.x)),
-            F::from_array(q.map(|p| p.0.y)),
-            F::from_array(q.map(|p| p.0.z)),
-        ];
-        let wo = [
-            F::from_array(q.map(|p| p.1.x)),
-            F::from_array(q.map(|p| p.1.y)),
-            F::from_array(q.map(|p| p.1.z)),
-        ];
+    for (q, o) in pairs.chunks(4).zip(out.chunks_mut(4)) {
+        let (wi, wo) = lanes_of(q);
         let r = intensity4(m, exps, wi, wo);
         for (k, slot) in o.iter_mut().enumerate() {
-            let (wi, wo) = p[k];
+            let (wi, wo) = q[k];
             *slot = if wi.above_horizon() && wo.above_horizon() {
                 r[k]
             } else {
@@ -701,4 +799,18 @@ pub(super) unsafe fn run_avx2(
     out: &mut [Reflection],
 ) {
     run(m, exps, pairs, out)
+}
+
+/// [`run_classes`] compiled for AVX2.
+///
+/// # Safety
+/// The processor must have AVX2.
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn run_classes_avx2(
+    m: &AnalyticModel,
+    exps: &[u32],
+    pairs: &[(UnitVec3, UnitVec3)],
+    out: &mut [ClassTerms],
+) {
+    run_classes(m, exps, pairs, out)
 }
