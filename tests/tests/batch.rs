@@ -168,3 +168,36 @@ fn the_class_batch_gives_the_bits_of_class_terms() {
     }
     assert!(compared > 10_000, "{compared}");
 }
+
+/// A baked table's `Bsdf::f_batch` (through `Brdf::eval_batch`) against its `f`: the same bits,
+/// averaged and spatial tables, f16 and f32.
+#[test]
+fn a_tables_batch_gives_the_bits_of_f() {
+    use clothbake_bake::{bake, BakeOptions};
+    use clothbake_loader::{Brdf, Options, Precision, StoredTable};
+    use std::sync::atomic::AtomicBool;
+    let twill = Fabric::from_path(&clothbake_tests::fixtures::tables().join("twill.json")).unwrap();
+    let p = pairs(21);
+    for spatial in [false, true] {
+        for precision in [Precision::F16, Precision::F32] {
+            let opts = BakeOptions {
+                grid: clothbake_tests::fixtures::grid(8, 16),
+                spatial,
+                ..BakeOptions::default()
+            };
+            let baked = bake(&twill, &opts, &|_| {}, &AtomicBool::new(false)).expect("bake");
+            let stored = StoredTable::from_table(baked.table, precision).expect("range");
+            let brdf = Brdf::from_stored(stored, Options::default()).expect("valid table");
+            let mut out = vec![[0.0; 3]; p.len()];
+            brdf.f_batch(&p, &mut out);
+            for (&(wi, wo), got) in p.iter().zip(&out) {
+                let want = Bsdf::f(&brdf, wi, wo);
+                assert_eq!(
+                    got.map(f64::to_bits),
+                    want.map(f64::to_bits),
+                    "{spatial} {precision:?}"
+                );
+            }
+        }
+    }
+}

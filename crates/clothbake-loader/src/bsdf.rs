@@ -14,6 +14,18 @@ impl Bsdf for Brdf {
         self.eval(f32s(wi), f32s(wo)).map(f64::from)
     }
 
+    /// Through [`Brdf::eval_batch`] (its misses overlapped; the same bits as `eval`).
+    fn f_batch(&self, pairs: &[(UnitVec3, UnitVec3)], out: &mut [Rgb]) {
+        assert_eq!(pairs.len(), out.len(), "one output per pair");
+        let (wi, wo): (Vec<_>, Vec<_>) = pairs.iter().map(|&(a, b)| (f32s(a), f32s(b))).unzip();
+        let mut f = vec![[0f32; 3]; pairs.len()];
+        self.eval_batch(&wi, &wo, &mut f)
+            .expect("slices of one length");
+        for (o, f) in out.iter_mut().zip(&f) {
+            *o = f.map(f64::from);
+        }
+    }
+
     fn f_at(&self, at: Footprint, wi: UnitVec3, wo: UnitVec3) -> Rgb {
         self.eval_at(f32s(wi), f32s(wo), at.u, at.v, at.width)
             .map(f64::from)
