@@ -111,7 +111,7 @@ impl Transport {
         self.bounces
     }
 
-    /// Orders 2 to N for the pair (orders[0], the direct term, is left zero); `multiple` is
+    /// Orders 2 to N for the pair (`orders[0]`, the direct term, is left zero); `multiple` is
     /// their sum with its standard error. Zero at or below the horizon.
     pub fn multiple(&self, wi: UnitVec3, wo: UnitVec3) -> PathEstimate {
         self.tracer.render_paths(

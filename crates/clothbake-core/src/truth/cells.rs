@@ -1,5 +1,5 @@
-//! Acceleration over the periodic tiling: [`CellIndex`] (a uniform grid over one period listing
-//! the segment copies, [`Prim`]s, whose bounding boxes overlap each cell) and [`CellWalk`] (the
+//! Acceleration over the periodic tiling: `CellIndex` (a uniform grid over one period listing
+//! the segment copies, `Prim`s, whose bounding boxes overlap each cell) and `CellWalk` (the
 //! 2-D DDA that visits, in order, every cell of the unbounded tiling a ray's xy path crosses).
 
 use super::intersect::{LocalRay, SegmentShape, Surface};

@@ -1,5 +1,5 @@
 //! The one door from the model's side: the only file of the truth that reads a
-//! [`Fabric`](crate::fabric::Fabric) or names the model's facet selector. It copies the fabric's
+//! [`Fabric`] or names the model's facet selector. It copies the fabric's
 //! description (weave pattern, per-thread radius, height, spacing, given segment length and facet
 //! material) into the truth's own plain [`Description`], from which [`super::yarns`] builds the
 //! micro-geometry by its own rules.
