@@ -30,6 +30,27 @@ pub fn direction_set(n: usize, max_theta_deg: f64) -> Vec<Pair> {
         .collect()
 }
 
+/// Pairs on which the model's special branches are taken: normal incidence, the symmetry
+/// planes (phi a multiple of 90 degrees: a projection's zero component), a diagonal and near
+/// grazing (89.99 degrees), for tests that compare two evaluations of the model.
+pub fn edge_pairs() -> Vec<Pair> {
+    [
+        (0.0, 0.0, 0.0, 0.0),
+        (30.0, 0.0, 45.0, 180.0),
+        (60.0, 90.0, 20.0, 270.0),
+        (89.99, 0.0, 89.99, 90.0),
+        (45.0, 45.0, 45.0, 225.0),
+        (0.0, 0.0, 70.0, 180.0),
+    ]
+    .map(|(ti, pi, to, po)| {
+        (
+            UnitVec3::from_degrees(ti, pi),
+            UnitVec3::from_degrees(to, po),
+        )
+    })
+    .to_vec()
+}
+
 /// The direction set of the secondary-reflection accuracy table and benchmarks
 /// (`cargo xtask ir-accuracy`, `cargo bench -p clothbake-core -- secondary`): 40 pairs of
 /// [`direction_set`] up to 85 degrees, and 4 grazing pairs whose light and eye run along the

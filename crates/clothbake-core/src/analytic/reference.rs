@@ -382,19 +382,7 @@ mod tests {
             UnitVec3::from_spherical(mu.acos(), std::f64::consts::TAU * rng.next_f64())
         };
         let mut out: Vec<_> = (0..n).map(|_| (dir(), dir())).collect();
-        for (ti, pi, to, po) in [
-            (0.0, 0.0, 0.0, 0.0),
-            (30.0, 0.0, 45.0, 180.0),
-            (60.0, 90.0, 20.0, 270.0),
-            (89.99, 0.0, 89.99, 90.0),
-            (45.0, 45.0, 45.0, 225.0),
-            (0.0, 0.0, 70.0, 180.0),
-        ] {
-            out.push((
-                UnitVec3::from_degrees(ti, pi),
-                UnitVec3::from_degrees(to, po),
-            ));
-        }
+        out.extend(crate::validate::edge_pairs());
         out
     }
 
