@@ -237,6 +237,7 @@ pub(crate) trait Lane:
     /// The magnitude of `self` with the sign of `sign`.
     fn copysign(self, sign: Self) -> Self;
     /// Whether bit `bit` (a mask of one bit) of each lane's representation is set.
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))] // read by the lanes' sin_cos only
     fn has_bit(self, bit: u64) -> Self::Mask;
 }
 
