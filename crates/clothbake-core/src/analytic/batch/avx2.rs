@@ -1,8 +1,7 @@
 //! The lanes of [`super`]: every function the lane form of the scalar one it names, inlined
 //! into [`run_avx2`], the one function compiled for AVX2.
 
-use crate::analytic::{AnalyticModel, ClassTerms, Unit, Variant, EPS};
-use crate::geometry::equal_area_height;
+use crate::analytic::{AnalyticModel, ClassTerms, SegmentData, Unit, Variant, EPS};
 use crate::lanes::{F64x4 as F, Mask4 as M};
 use crate::reflect::Reflection;
 use crate::shadowing::ActiveTable;
@@ -286,21 +285,24 @@ struct Cut {
     c: F,
 }
 
-/// `shadowing::mean_occluded_length` (eq. 3.6 averaged over the arc, the refined variant).
+/// `shadowing::mean_occluded_length` (eq. 3.6 averaged over the arc, the refined variant) for
+/// segment `seg` of length `max_len`. Its fallback's height is `seg.top`, the
+/// `equal_area_height(r, h)` the scalar function computes.
 #[inline(always)]
 fn mean_occluded_length(
-    r: f64,
-    h: f64,
+    seg: &SegmentData,
     o: &Occluder,
     psi: &Elevation,
     arc: &Arc,
     e: (F, F),
     max_len: f64,
 ) -> F {
+    let (r, h) = (seg.radius, seg.height);
     let zero = F::splat(0.0);
+    let inf = F::splat(f64::INFINITY);
     let (sp, cp) = (psi.sin, psi.cos);
     let fallback = arc.empty() | sp.le(zero);
-    let short = occluded_length(equal_area_height(r, h), o, psi).min(F::splat(max_len));
+    let short = occluded_length(seg.top, o, psi).min(F::splat(max_len));
     let num0 = o.support(sp, cp) - h * cp;
     let rc = r * cp;
     let inv_sp = 1.0 / sp;
@@ -328,13 +330,12 @@ fn mean_occluded_length(
             let (sf, cf) = from_lo(point);
             let v = ok & sf.gt(zero) & cf.gt(cos_len);
             cand[2 * j + i] = Cut {
-                key: v.select(-cf, F::splat(f64::INFINITY)),
+                key: v.select(-cf, inf),
                 s: point.0,
                 c: point.1,
             };
         }
     }
-    let inf = F::splat(f64::INFINITY);
     let any_cut =
         (cand[0].key.lt(inf) | cand[1].key.lt(inf)) | (cand[2].key.lt(inf) | cand[3].key.lt(inf));
     let mut sorted = [Cut {
@@ -493,6 +494,7 @@ fn end_interval(m: &AnalyticModel, u: &Unit, v: &View, arc: &Arc, e: (F, F)) -> 
     let Some((y0, y1)) = seg.extent else {
         return (F::splat(f64::NEG_INFINITY), F::splat(f64::INFINITY));
     };
+    let max_len = y1 - y0;
     let (y0, y1) = (F::splat(y0), F::splat(y1));
     let plus = v.va.gt(F::splat(0.0));
     let psi = &v.end_psi;
@@ -505,10 +507,9 @@ fn end_interval(m: &AnalyticModel, u: &Unit, v: &View, arc: &Arc, e: (F, F)) -> 
     if !some.any() {
         return (y0, y1);
     }
-    let max_len = seg.extent.map_or(0.0, |(a, b)| b - a);
     let hidden = match m.variant {
         Variant::Thesis => occluded_length(seg.top, &o, psi),
-        Variant::Refined => mean_occluded_length(seg.radius, seg.height, &o, psi, arc, e, max_len),
+        Variant::Refined => mean_occluded_length(seg, &o, psi, arc, e, max_len),
     };
     let hidden = some.select(hidden, F::splat(0.0));
     (plus.select(y0, y0 + hidden), plus.select(y1 - hidden, y1))
