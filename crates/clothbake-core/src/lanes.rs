@@ -229,11 +229,6 @@ pub(crate) trait Lane:
     fn lt(self, o: Self) -> Self::Mask;
     /// `a` where `m` holds, else `b`.
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
-    /// `a` where `m` holds, else `b`, for a pair.
-    #[inline(always)]
-    fn select_pair(m: Self::Mask, a: (Self, Self), b: (Self, Self)) -> (Self, Self) {
-        (Self::select(m, a.0, b.0), Self::select(m, a.1, b.1))
-    }
     /// The magnitude of `self` with the sign of `sign`.
     fn copysign(self, sign: Self) -> Self;
     /// Whether bit `bit` (a mask of one bit) of each lane's representation is set.
@@ -261,14 +256,6 @@ impl Lane for f64 {
     }
     #[inline(always)]
     fn select(m: bool, a: f64, b: f64) -> f64 {
-        if m {
-            a
-        } else {
-            b
-        }
-    }
-    #[inline(always)]
-    fn select_pair(m: bool, a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
         if m {
             a
         } else {

@@ -174,7 +174,7 @@ fn atan2_reduced<L: Lane>(y: L, x: L) -> L {
     // Written as selects, not branches (random directions mispredict them): one division.
     let (ax, ay) = (x.abs(), y.abs());
     let swap = ay.gt(ax);
-    let (num, den) = L::select_pair(swap, (ax, ay), (ay, ax));
+    let (num, den) = (L::select(swap, ax, ay), L::select(swap, ay, ax));
     // atan(num / den) in [0, pi/4]: above tan(pi/8), pi/4 + atan((num - den) / (num + den)).
     let big = num.gt(L::splat(0.414_213_562_373_095_03) * den);
     let (n2, d2) = (
