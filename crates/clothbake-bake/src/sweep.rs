@@ -627,28 +627,23 @@ impl Baker {
         let (ti, pi) = row_cell(&g, row);
         let wi = direction(ti, nti, pi, npi);
         let mut out = Vec::with_capacity(self.orbits.row_evaluations(row));
+        let mut canonical = (0..nto)
+            .flat_map(|to| (0..npo).map(move |po| (to, po)))
+            .filter(|&(_, po)| self.orbits.canonical(pi as usize, po as usize))
+            .map(|(to, po)| (g.index(ti, pi, to, po), direction(to, nto, po, npo)));
         let mut cells = Vec::with_capacity(CELLS_AT_ONCE);
-        for to in 0..nto {
-            for po in 0..npo {
-                if !self.orbits.canonical(pi as usize, po as usize) {
-                    continue;
-                }
-                cells.push((g.index(ti, pi, to, po), direction(to, nto, po, npo)));
-                if cells.len() == CELLS_AT_ONCE {
-                    // Checked between groups of cells: a row may hold millions of them.
-                    if cancel.load(Ordering::Relaxed) {
-                        return None;
-                    }
-                    (self.eval)(wi, &cells, &mut out);
-                    cells.clear();
-                }
+        loop {
+            cells.clear();
+            cells.extend(canonical.by_ref().take(CELLS_AT_ONCE));
+            if cells.is_empty() {
+                return Some(out);
             }
+            // Checked between groups of cells: a row may hold millions of them.
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            (self.eval)(wi, &cells, &mut out);
         }
-        if cancel.load(Ordering::Relaxed) {
-            return None;
-        }
-        (self.eval)(wi, &cells, &mut out);
-        Some(out)
     }
 
     /// Evaluates `rows` in parallel on the current rayon pool, handing each finished row to
