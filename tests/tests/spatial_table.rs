@@ -34,6 +34,15 @@ fn baked_with(f: &Fabric, spatial: bool, bounces: u32) -> Table {
         .table
 }
 
+/// The crossing cells alone: a spatial table of one bounce carries its yarns, whose point
+/// level would answer footprints under two cells.
+fn cells_only() -> Options {
+    Options {
+        point_level: false,
+        ..Options::default()
+    }
+}
+
 fn f32s(u: UnitVec3) -> [f32; 3] {
     [u.x as f32, u.y as f32, u.z as f32]
 }
@@ -160,7 +169,7 @@ fn cells_are_the_models(file: &str, bounces: u32, stored: usize) {
 fn cells_of(f: &Fabric, file: &str, bounces: u32, stored: usize) {
     {
         let model = AnalyticModel::new(f, FacetModel::Huo);
-        let brdf = Brdf::from_table(baked_with(f, true, bounces), Options::default()).unwrap();
+        let brdf = Brdf::from_table(baked_with(f, true, bounces), cells_only()).unwrap();
         let sp = brdf.spatial().unwrap();
         let held = sp.stored_classes();
         assert_eq!(
@@ -252,7 +261,7 @@ fn footprints_of(file: &str, bounces: u32) {
 /// As [`footprints_of`], of fabric `f` named `file`.
 fn footprints_of_fabric(f: &Fabric, file: &str, bounces: u32) {
     let model = AnalyticModel::new(f, FacetModel::Huo);
-    let brdf = Brdf::from_table(baked_with(f, true, bounces), Options::default()).unwrap();
+    let brdf = Brdf::from_table(baked_with(f, true, bounces), cells_only()).unwrap();
     let layout = brdf.spatial().unwrap().layout();
     let (u0, v0) = (layout.u_edges[0], layout.v_edges[0]);
     for (wi, wo) in node_pairs() {
@@ -430,10 +439,67 @@ fn mirror_images_are_shared_in_half_float_tables_too() {
 }
 
 #[test]
+fn a_spatial_table_of_one_bounce_carries_its_yarns_and_traces_them_up_close() {
+    // The yarns it carries are the fabric's (core::point), so up close the table answers the
+    // point level's own look; from two cells wide, its cells; from a period, its average.
+    let f = fabric("twill.json");
+    let t = baked(&f, true);
+    let period = clothbake_core::point::period(&f, FacetModel::Huo);
+    assert_eq!(t.meta.yarns.as_ref(), Some(&period));
+    assert!(baked_with(&f, true, 2).meta.yarns.is_none());
+    assert!(baked(&f, false).meta.yarns.is_none());
+    let yarns = clothbake_point::Yarns::new(period);
+    let brdf = Brdf::from_table(t.clone(), Options::default()).unwrap();
+    let cells = Brdf::from_table(t, cells_only()).unwrap();
+    assert!(brdf.has_point_level() && !cells.has_point_level());
+    let cell = 1.0 / 3.0;
+    let mut gaps = 0;
+    for (k, (wi, wo)) in node_pairs().into_iter().enumerate() {
+        let (i, o) = (f32s(wi), f32s(wo));
+        // The directions as the loader takes them (f32), as unit vectors.
+        let unit = |w: [f32; 3]| {
+            UnitVec3::new(clothbake_core::Vec3::new(
+                f64::from(w[0]),
+                f64::from(w[1]),
+                f64::from(w[2]),
+            ))
+            .unwrap()
+        };
+        for j in 0..20 {
+            let (u, v) = ((k * 7 + j * 13) as f64 * 0.0371 % 1.0, j as f64 * 0.0517);
+            let look = yarns.look(u, v, unit(i), unit(o));
+            assert_eq!(brdf.eval_at(i, o, u, v, 0.0), look.f.map(|x| x as f32));
+            assert_eq!(brdf.coverage_at(o, u, v, 0.0), look.coverage as f32);
+            gaps += usize::from(look.coverage == 0.0);
+            for w in [2.0 * cell, 0.8] {
+                assert_eq!(brdf.eval_at(i, o, u, v, w), cells.eval_at(i, o, u, v, w));
+            }
+            assert_eq!(brdf.eval_at(i, o, u, v, 1.0), cells.eval(i, o));
+        }
+    }
+    assert!(gaps > 0, "the twill shows its gaps between yarns somewhere");
+    // Through the Bsdf interface, f and coverage from one call.
+    use clothbake_core::Bsdf;
+    let (wi, wo) = node_pairs()[3];
+    let at = clothbake_core::Footprint {
+        u: 0.4,
+        v: 0.2,
+        width: 0.0,
+    };
+    let l = brdf.local(at, wi, wo);
+    assert_eq!(l.f, brdf.f_at(at, wi, wo));
+    assert_eq!(l.coverage, Bsdf::coverage_at(&brdf, at, wo));
+}
+
+#[test]
 fn spatial_tables_survive_both_file_formats() {
     let dir = std::env::temp_dir().join(format!("clothbake-spatial-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let t = baked(&fabric("gingham.wif"), true);
+    assert!(
+        t.meta.yarns.is_some(),
+        "the yarns travel in both formats too"
+    );
     let bin = dir.join("g.bin");
     clothbake_loader::write_binary(&bin, &t, false).unwrap();
     assert_eq!(clothbake_loader::read_binary(&bin).unwrap(), t);

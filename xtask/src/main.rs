@@ -14,6 +14,8 @@
 //! * `gallery [--quick] [--envmap FILE.exr]`: pictures of every shipped fabric rendered by
 //!   Mitsuba 3 (draped over a ball under a sky, path traced) into `docs/gallery/` (see
 //!   `gallery.rs`).
+//! * `lod`: the level-of-detail pictures (point, cells, period) against the ground-truth
+//!   pictures at six distances, into `docs/validation.md` (see `lod.rs`).
 //! * `validate-spatial`: the model per crossing cell against the truth sorted into the same
 //!   cells, written to `docs/validation-spatial.md`.
 //! * `validate`: holds the analytic model against the ray-traced ground truth for every shipped
@@ -36,6 +38,7 @@ mod figures;
 mod gallery;
 mod install_capi;
 mod ir_accuracy;
+mod lod;
 mod spatial;
 mod test;
 mod transport;
@@ -62,6 +65,7 @@ fn main() {
         "install-capi" => install_capi::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
         "validate" => validate(),
         "validate-spatial" => spatial::run(&root()),
+        "lod" => lod::run(&root()),
         "ch5" => ch5::run(&root()),
         "transport" => transport::run(&root(), std::env::args().nth(2).as_deref()),
         "figures" => figures::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
@@ -75,7 +79,7 @@ fn main() {
         "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots] | gallery [--quick] [--envmap FILE.exr] [--only NAME,...] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
+                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | lod | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots] | gallery [--quick] [--envmap FILE.exr] [--only NAME,...] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
             );
             std::process::exit(2);
         }
@@ -198,9 +202,14 @@ fn validate() {
         .unwrap();
     }
     let path = root().join("docs/validation.md");
-    // Keep the sections `cargo xtask transport` and `validate-spatial` write between markers.
+    // Keep the sections `cargo xtask transport`, `validate-spatial` and `lod` write between
+    // markers.
     let old = std::fs::read_to_string(&path).unwrap_or_default();
-    for marker in ["transport-validation", "spatial-validation"] {
+    for marker in [
+        "transport-validation",
+        "spatial-validation",
+        "lod-validation",
+    ] {
         let (begin, end) = (
             format!("<!-- {marker}:begin -->"),
             format!("<!-- {marker}:end -->"),

@@ -590,12 +590,20 @@ impl Baker {
             options_json: opts.to_json().to_string(),
             symmetry: symmetry_name(&syms),
             spatial: None,
+            yarns: None,
         };
         let orbits = match &spatial {
             Some(l) => Orbits::spatial(&g, l.classes as usize, l.lanes()),
             None => Orbits::new(&g, &syms),
         };
-        let meta = Metadata { spatial, ..meta };
+        // A spatial table of one bounce carries its period's yarns: its point level.
+        let yarns = (spatial.is_some() && opts.bounces == 1)
+            .then(|| clothbake_core::point::period(fabric, opts.facet));
+        let meta = Metadata {
+            spatial,
+            yarns,
+            ..meta
+        };
         Ok(Baker {
             orbits,
             syms,

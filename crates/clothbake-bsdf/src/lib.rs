@@ -48,9 +48,87 @@ pub struct Footprint {
     pub u: f64,
     /// Fraction of the period along the warp (+Y); any finite value, wrapped.
     pub v: f64,
-    /// Side of the square the pixel covers, in periods: 0 for a point, 1 or more for the whole
-    /// period (the averaged reflectance).
+    /// Side of the square the pixel covers, in periods: 0 (or NaN) for a point, 1 or more for
+    /// the whole period (the averaged reflectance).
     pub width: f64,
+}
+
+/// Footprint widths, in crossing cells, below which a footprint is answered by the point
+/// level alone (`POINT_UNTIL`) and from which by the cells alone (`CELLS_FROM`); between,
+/// the two blend smoothly (docs/spatial.md, "Levels of detail").
+pub const POINT_UNTIL: f64 = 1.0;
+/// See [`POINT_UNTIL`].
+pub const CELLS_FROM: f64 = 2.0;
+/// The most points across a footprint that the point level integrates ([`Level::Local`]).
+pub const MAX_POINTS_ACROSS: usize = 8;
+
+/// The level of detail a footprint asks for: the one rule every spatially varying
+/// reflectance follows ([`Footprint::level`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Level {
+    /// Inside the period: the point level with weight `point` in [0, 1], blended with the box
+    /// filter of side `width` periods (in [0, 1)) over the crossing cells with weight
+    /// `1 - point`. The point level integrates the footprint's square with `points` x
+    /// `points` stratified points (1: the point itself), about eight to a cell across, so that
+    /// a footprint of a cell or two converges instead of aliasing. A reflectance without a
+    /// point level uses the cells alone.
+    Local {
+        /// Weight of the point level.
+        point: f64,
+        /// Side of the footprint's square, in periods (0: the point; the cell at the point).
+        width: f64,
+        /// Points across the square that the point level integrates, 1 to
+        /// [`MAX_POINTS_ACROSS`].
+        points: usize,
+    },
+    /// The whole period: the averaged reflectance.
+    Period,
+}
+
+impl Footprint {
+    /// The level of detail of this footprint on a weave whose crossing cells are `cell`
+    /// periods wide: [`Level::Period`] for a width of 1 or more or a point not finite; else
+    /// the point level alone up to [`POINT_UNTIL`] cells, the cells alone from [`CELLS_FROM`],
+    /// and a smoothstep between; the point level's points across are ceil(8 width / cell),
+    /// from 1 to [`MAX_POINTS_ACROSS`]. A NaN width is a point.
+    #[inline]
+    pub fn level(&self, cell: f64) -> Level {
+        if !(self.u.is_finite() && self.v.is_finite()) || self.width >= 1.0 {
+            return Level::Period;
+        }
+        let width = if self.width.is_nan() {
+            0.0
+        } else {
+            self.width.max(0.0)
+        };
+        let x = ((width / cell - POINT_UNTIL) / (CELLS_FROM - POINT_UNTIL)).clamp(0.0, 1.0);
+        let point = if x.is_nan() {
+            1.0
+        } else {
+            1.0 - x * x * (3.0 - 2.0 * x)
+        };
+        let across = (8.0 * width / cell).ceil();
+        let points = if across.is_nan() {
+            1
+        } else {
+            across.clamp(1.0, MAX_POINTS_ACROSS as f64) as usize
+        };
+        Level::Local {
+            point,
+            width,
+            points,
+        }
+    }
+}
+
+/// What a footprint of the cloth shows: f_r and the share of it that is yarn, from one call
+/// ([`Bsdf::local`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Local {
+    /// f_r in 1/sr, RGB, the coverage-weighted mean over the footprint.
+    pub f: Rgb,
+    /// The share of the footprint's projected area seen from `wo` where the eye meets yarn.
+    pub coverage: f64,
 }
 
 /// A bidirectional reflectance distribution: f_r, a sampler of incident directions and its
@@ -74,8 +152,8 @@ pub trait Bsdf: Sync {
     }
 
     /// f_r seen through a footprint of the weave period: the coverage-weighted mean of the
-    /// local f_r over the footprint, which is [`Bsdf::f`] once the footprint spans the period.
-    /// The default is spatially uniform.
+    /// local f_r over the footprint, which is [`Bsdf::f`] once the footprint spans the period
+    /// ([`Footprint::level`]). The default is spatially uniform.
     fn f_at(&self, at: Footprint, wi: UnitVec3, wo: UnitVec3) -> Rgb {
         let _ = at;
         self.f(wi, wo)
@@ -86,6 +164,15 @@ pub trait Bsdf: Sync {
     fn coverage_at(&self, at: Footprint, wo: UnitVec3) -> f64 {
         let _ = (at, wo);
         1.0
+    }
+
+    /// [`Bsdf::f_at`] and [`Bsdf::coverage_at`] in one call, which a reflectance that traces
+    /// its yarns answers with one eye ray. The default calls the two.
+    fn local(&self, at: Footprint, wi: UnitVec3, wo: UnitVec3) -> Local {
+        Local {
+            f: self.f_at(at, wi, wo),
+            coverage: self.coverage_at(at, wo),
+        }
     }
 
     /// Draws an incident direction for the outgoing `wo` from `u` in [0, 1)^2; `None` when
@@ -176,6 +263,42 @@ mod tests {
         assert!(b
             .sample(UnitVec3::from_degrees(90.0, 0.0), [0.5; 2])
             .is_none());
+    }
+
+    #[test]
+    fn the_level_rule_hands_over_smoothly_and_monotonically() {
+        let at = |u, v, width| Footprint { u, v, width };
+        let cell = 1.0 / 3.0;
+        assert_eq!(at(0.2, 0.3, 1.0).level(cell), Level::Period);
+        assert_eq!(at(f64::NAN, 0.3, 0.1).level(cell), Level::Period);
+        assert_eq!(at(0.2, f64::INFINITY, 0.0).level(cell), Level::Period);
+        let point = |w: f64| match at(0.2, 0.3, w).level(cell) {
+            Level::Local {
+                point,
+                width,
+                points,
+            } => {
+                assert!(width == w.max(0.0) || (w.is_nan() && width == 0.0));
+                assert!((1..=MAX_POINTS_ACROSS).contains(&points));
+                assert_eq!(points == 1, width <= 0.125 * cell, "{w}");
+                point
+            }
+            Level::Period => panic!("{w}"),
+        };
+        assert_eq!(point(f64::NAN), 1.0);
+        assert_eq!(point(-1.0), 1.0);
+        assert_eq!(point(POINT_UNTIL * cell), 1.0);
+        assert_eq!(point(CELLS_FROM * cell), 0.0);
+        assert_eq!(point(0.9), 0.0);
+        // Halfway between the two widths, halfway between the levels (smoothstep's middle).
+        assert!((point(0.5 * (POINT_UNTIL + CELLS_FROM) * cell) - 0.5).abs() < 1e-12);
+        // Continuous and monotone: no step larger than the slope allows.
+        let mut last = 1.0;
+        for k in 0..=1000 {
+            let p = point(k as f64 / 1000.0 * 0.9);
+            assert!(p <= last && last - p < 0.01, "{k}: {p} after {last}");
+            last = p;
+        }
     }
 
     #[test]

@@ -26,6 +26,7 @@ extern "C" {
 #define CLOTHBAKE_F32 1u         /* hold values as f32 even if the file stores half floats */
 #define CLOTHBAKE_RECIPROCAL 2u  /* symmetrise: 0.5 (f(wi, wo) + f(wo, wi)) */
 #define CLOTHBAKE_NO_SAMPLING 4u /* skip the sampling CDFs (4 bytes a cell) */
+#define CLOTHBAKE_NO_POINT_LEVEL 8u /* no point level: the crossing cells answer every footprint under a period */
 
 /* An open table (opaque). */
 typedef struct ClothbakeBrdf clothbake_brdf;
@@ -43,9 +44,12 @@ int clothbake_grid(const clothbake_brdf *brdf, uint32_t *out);
 int clothbake_eval(const clothbake_brdf *brdf, const float *wi, const float *wo, float *out);
 
 /* f_r at point (u, v) of the weave period (fractions, wrapped) through a footprint of side
- * `width` periods (0: the crossing cell; >= 1: clothbake_eval) into out[3], and the share of
- * the footprint in which the eye meets yarn into *coverage (unless NULL). A table baked with
- * --spatial shows the weave; another answers clothbake_eval and coverage 1. 0, or -1 on error. */
+ * `width` periods (0: the point; >= 1: clothbake_eval) into out[3], and the share of the
+ * footprint in which the eye meets yarn into *coverage (unless NULL), at the footprint's level
+ * of detail (docs/spatial.md): a table baked with --spatial (one bounce) carries its yarns and
+ * traces them under a crossing cell (unless opened with CLOTHBAKE_NO_POINT_LEVEL), shows its
+ * crossing cells from two cells wide, and the average from a period; another answers
+ * clothbake_eval and coverage 1. 0, or -1 on error. */
 int clothbake_eval_at(const clothbake_brdf *brdf, const float *wi, const float *wo, double u,
                       double v, double width, float *out, float *coverage);
 

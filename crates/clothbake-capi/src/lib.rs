@@ -18,7 +18,11 @@ pub const CLOTHBAKE_F32: u32 = 1;
 pub const CLOTHBAKE_RECIPROCAL: u32 = 2;
 /// `clothbake_open` flag: do not build the sampling CDFs (saves 4 bytes a cell).
 pub const CLOTHBAKE_NO_SAMPLING: u32 = 4;
-const ALL_FLAGS: u32 = CLOTHBAKE_F32 | CLOTHBAKE_RECIPROCAL | CLOTHBAKE_NO_SAMPLING;
+/// `clothbake_open` flag: no point level (a spatial table that carries its yarns then answers
+/// every footprint under a period with its crossing cells, docs/spatial.md).
+pub const CLOTHBAKE_NO_POINT_LEVEL: u32 = 8;
+const ALL_FLAGS: u32 =
+    CLOTHBAKE_F32 | CLOTHBAKE_RECIPROCAL | CLOTHBAKE_NO_SAMPLING | CLOTHBAKE_NO_POINT_LEVEL;
 
 /// The opaque handle of an open table.
 pub struct ClothbakeBrdf(Brdf);
@@ -85,7 +89,7 @@ pub unsafe extern "C" fn clothbake_open(path: *const c_char, flags: u32) -> *mut
         }
         if flags & !ALL_FLAGS != 0 {
             return Err(format!(
-                "clothbake_open: unknown flags {:#x}; use CLOTHBAKE_F32, CLOTHBAKE_RECIPROCAL, CLOTHBAKE_NO_SAMPLING",
+                "clothbake_open: unknown flags {:#x}; use CLOTHBAKE_F32, CLOTHBAKE_RECIPROCAL, CLOTHBAKE_NO_SAMPLING, CLOTHBAKE_NO_POINT_LEVEL",
                 flags & !ALL_FLAGS
             ));
         }
@@ -100,6 +104,7 @@ pub unsafe extern "C" fn clothbake_open(path: *const c_char, flags: u32) -> *mut
             },
             reciprocal: flags & CLOTHBAKE_RECIPROCAL != 0,
             sampling: flags & CLOTHBAKE_NO_SAMPLING == 0,
+            point_level: flags & CLOTHBAKE_NO_POINT_LEVEL == 0,
         };
         let b = Brdf::open(Path::new(path), options).map_err(|e| e.to_string())?;
         Ok(Box::into_raw(Box::new(ClothbakeBrdf(b))))
@@ -162,7 +167,8 @@ pub unsafe extern "C" fn clothbake_eval(
 }
 
 /// `f_r` at point (`u`, `v`) of the weave period (fractions, wrapped) through a footprint of
-/// side `width` periods (0: the crossing cell; 1 or more: [`clothbake_eval`]), into `out`
+/// side `width` periods (0: the point; 1 or more: [`clothbake_eval`]), at its level of detail
+/// (the yarns traced where the table carries them, its crossing cells, its average), into `out`
 /// (RGB, 1/sr); the share of the footprint in which the eye meets yarn into `coverage` when it
 /// is not NULL. A table baked with `--spatial` shows the weave; another answers
 /// [`clothbake_eval`] and coverage 1. 0, or -1 on error (a NaN or infinite `u`, `v` or `width`,
@@ -196,9 +202,10 @@ pub unsafe extern "C" fn clothbake_eval_at(
             ));
         }
         let (wi, wo) = (vec3(wi, F, "wi")?, vec3(wo, F, "wo")?);
-        put3(out, b.eval_at(wi, wo, u, v, width), F, "out")?;
+        let (f, c) = b.local_at(wi, wo, u, v, width);
+        put3(out, f, F, "out")?;
         if !coverage.is_null() {
-            *coverage = b.coverage_at(wo, u, v, width);
+            *coverage = c;
         }
         Ok(0)
     })

@@ -3,7 +3,8 @@
 //! pairs cycled (`coherent`, as neighbouring rays of a renderer). The ray tracer's cost at 1%
 //! error is reported beside it by the `raytrace_1pct` group; the secondary reflection per pair
 //! (random pairs), and against the two-level sampling (the fixed direction set whose errors
-//! `cargo xtask ir-accuracy` tabulates), by `secondary` and `secondary_vs_sampling`.
+//! `cargo xtask ir-accuracy` tabulates), by `secondary` and `secondary_vs_sampling`. The point
+//! level's look at a random point of the period for each random pair: `point_look`.
 
 use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
 use clothbake_core::rng::Rng;
@@ -204,9 +205,33 @@ fn secondary_vs_sampling(c: &mut Criterion) {
     }
 }
 
+/// The point level (clothbake-point): one eye ray and one shadow ray through the twill's
+/// yarns, at a random point of the period for each random pair of the pool.
+fn point(c: &mut Criterion) {
+    let fabric = twill();
+    let dirs = directions(1 << 16);
+    let mut rng = Rng::new(35);
+    let points: Vec<(f64, f64)> = (0..dirs.len())
+        .map(|_| (rng.next_f64(), rng.next_f64()))
+        .collect();
+    let yarns = clothbake_core::point::yarns(&fabric, FacetModel::Huo);
+    for (name, mask) in [("random", dirs.len() - 1), ("coherent", 63)] {
+        c.bench_function(&format!("point_look/twill/huo/{name}"), |b| {
+            let mut k = 0;
+            b.iter(|| {
+                k = (k + 1) & mask;
+                let (wi, wo) = dirs[k];
+                let (u, v) = points[k];
+                black_box(yarns.look(black_box(u), black_box(v), wi, wo))
+            })
+        });
+    }
+}
+
 criterion_group!(
     benches,
     analytic,
+    point,
     raytrace_1pct,
     secondary,
     secondary_vs_sampling

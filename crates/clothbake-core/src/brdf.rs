@@ -4,9 +4,10 @@
 //! export, pictures and Python all evaluate the model through it.
 
 use crate::analytic::{AnalyticModel, SecondaryOptions};
-use crate::cells::{Cell, PeriodPoint};
+use crate::cells::PeriodPoint;
 use crate::reflect::{intensity_to_brdf, Reflection};
-use clothbake_bsdf::{Bsdf, Footprint, Rgb, UnitVec3};
+use clothbake_bsdf::{Bsdf, Footprint, Level, Local, Rgb, UnitVec3};
+use clothbake_point::Yarns;
 
 /// Which part of the model's reflection an [`AnalyticBsdf`] returns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -37,10 +38,13 @@ impl Component {
 
 /// The analytic model of a fabric (any facet and variant) with a bounce setting, as a BSDF.
 /// Sampling is the trait's cos(theta_i)-weighted default: the model has no closed-form inverse.
+/// With the fabric's yarns ([`AnalyticBsdf::with_yarns`]) footprints smaller than a crossing
+/// cell are answered by the point level (docs/spatial.md, "Levels of detail").
 pub struct AnalyticBsdf {
     model: AnalyticModel,
     secondary: Option<SecondaryOptions>,
     component: Component,
+    yarns: Option<Yarns>,
 }
 
 impl AnalyticBsdf {
@@ -50,7 +54,22 @@ impl AnalyticBsdf {
             model,
             secondary,
             component: Component::Total,
+            yarns: None,
         }
+    }
+
+    /// The same BSDF with the point level: the fabric's yarns (`crate::point::yarns` of the
+    /// fabric the model was built from), traced for footprints under a crossing cell. The
+    /// point level is one bounce; with two, the cells carry the second bounce's share as the
+    /// footprint grows, and [`Component::Secondary`] has no point level.
+    pub fn with_yarns(mut self, yarns: Yarns) -> AnalyticBsdf {
+        self.yarns = Some(yarns);
+        self
+    }
+
+    /// The yarns of the point level, when given.
+    pub fn yarns(&self) -> Option<&Yarns> {
+        self.yarns.as_ref()
     }
 
     /// The same BSDF returning only `component`; `None` where the component needs the second
@@ -84,18 +103,95 @@ impl AnalyticBsdf {
 }
 
 impl AnalyticBsdf {
-    /// The cells a footprint covers with their shares of the period's area; `None` once it
-    /// spans the whole period (or is not finite).
-    fn cells_under(&self, at: Footprint) -> Option<Vec<(Cell, f64)>> {
-        let p = PeriodPoint::new(at.u, at.v)?;
+    /// The side of a crossing cell, in periods, that the level rule ([`Footprint::level`])
+    /// measures footprints in: one over the larger thread count of the period.
+    pub fn cell_width(&self) -> f64 {
+        let (nx, ny) = self.model.cells().dims();
+        1.0 / nx.max(ny).max(1) as f64
+    }
+
+    /// The point level, where this BSDF has it and the component is one it holds.
+    fn point_level(&self) -> Option<&Yarns> {
+        match self.component {
+            Component::Total | Component::Direct => self.yarns.as_ref(),
+            _ => None,
+        }
+    }
+
+    /// The box filter of side `width` periods at (u, v) over the crossing cells: the cells'
+    /// f_r weighted by their covered share times their coverage, and the mean coverage
+    /// (thesis units, docs/spatial.md).
+    fn cells(&self, u: f64, v: f64, width: f64, wi: UnitVec3, wo: UnitVec3) -> Local {
+        let Some(p) = PeriodPoint::new(u, v) else {
+            return self.period(wi, wo);
+        };
         let grid = self.model.cells();
-        if at.width >= 1.0 || at.width.is_nan() {
-            return None;
+        let cells = if width <= 0.0 {
+            vec![(grid.cell_at(p), 1.0)]
+        } else {
+            grid.overlaps(p, width)
+        };
+        let (mut num, mut den, mut area) = ([0.0; 3], 0.0, 0.0);
+        for (cell, share) in cells {
+            let l = self
+                .model
+                .intensity_in(wi, wo, cell, self.secondary.as_ref());
+            let i = self.component.of(&l.reflection);
+            let w = share * l.coverage;
+            for k in 0..3 {
+                num[k] += w * i[k];
+            }
+            den += w;
+            area += share;
         }
-        if at.width <= 0.0 {
-            return Some(vec![(grid.cell_at(p), 1.0)]);
+        Local {
+            f: if den > 0.0 {
+                intensity_to_brdf(num.map(|x| x / den), wi)
+            } else {
+                [0.0; 3]
+            },
+            coverage: if area > 0.0 { den / area } else { 0.0 },
         }
-        Some(grid.overlaps(p, at.width))
+    }
+
+    /// The mean coverage of the box filter of side `width` periods at the footprint's point.
+    fn cells_coverage(&self, at: Footprint, width: f64, wo: UnitVec3) -> f64 {
+        let Some(p) = PeriodPoint::new(at.u, at.v) else {
+            return self.model.coverage(wo);
+        };
+        let grid = self.model.cells();
+        if width <= 0.0 {
+            return self.model.coverage_in(grid.cell_at(p), wo);
+        }
+        let cells = grid.overlaps(p, width);
+        let total: f64 = cells.iter().map(|c| c.1).sum();
+        cells
+            .iter()
+            .map(|&(cell, share)| share * self.model.coverage_in(cell, wo))
+            .sum::<f64>()
+            / total
+    }
+
+    /// The whole period: f_r and the directional coverage C(wo).
+    fn period(&self, wi: UnitVec3, wo: UnitVec3) -> Local {
+        Local {
+            f: self.f(wi, wo),
+            coverage: self.model.coverage(wo),
+        }
+    }
+}
+
+/// `a` and `b` blended with weights `wa` and 1 - `wa`, each f_r weighted by its coverage.
+fn blend(wa: f64, a: Local, b: Local) -> Local {
+    let (ca, cb) = (wa * a.coverage, (1.0 - wa) * b.coverage);
+    let c = ca + cb;
+    Local {
+        f: if c > 0.0 {
+            [0, 1, 2].map(|k| (ca * a.f[k] + cb * b.f[k]) / c)
+        } else {
+            [0.0; 3]
+        },
+        coverage: c,
     }
 }
 
@@ -132,49 +228,79 @@ impl Bsdf for AnalyticBsdf {
         }
     }
 
-    /// The box filter over the footprint of the cells' f_r (thesis units, docs/spatial.md),
-    /// weighted by area times coverage; [`Bsdf::f`] at a footprint of a period or more.
+    /// The footprint's level of detail ([`Footprint::level`]): the point level's look (with
+    /// the yarns), the box filter of the crossing cells' f_r weighted by area times coverage,
+    /// a coverage-weighted blend of the two, or [`Bsdf::f`] at a footprint of a period or more.
     fn f_at(&self, at: Footprint, wi: UnitVec3, wo: UnitVec3) -> Rgb {
-        if !(wi.above_horizon() && wo.above_horizon()) {
-            return [0.0; 3];
-        }
-        let Some(cells) = self.cells_under(at) else {
-            return self.f(wi, wo);
-        };
-        let (mut num, mut den) = ([0.0; 3], 0.0);
-        for (cell, share) in cells {
-            let l = self
-                .model
-                .intensity_in(wi, wo, cell, self.secondary.as_ref());
-            let i = self.component.of(&l.reflection);
-            let w = share * l.coverage;
-            for k in 0..3 {
-                num[k] += w * i[k];
-            }
-            den += w;
-        }
-        if den <= 0.0 {
-            return [0.0; 3];
-        }
-        intensity_to_brdf(num.map(|x| x / den), wi)
+        self.local(at, wi, wo).f
     }
 
     fn coverage_at(&self, at: Footprint, wo: UnitVec3) -> f64 {
-        let Some(cells) = self.cells_under(at) else {
-            return self.model.coverage(wo);
+        if !wo.above_horizon() {
+            return 0.0;
+        }
+        let (point, width, points) = match at.level(self.cell_width()) {
+            Level::Period => return self.model.coverage(wo),
+            Level::Local {
+                point,
+                width,
+                points,
+            } => (point, width, points),
         };
-        let total: f64 = cells.iter().map(|c| c.1).sum();
-        cells
-            .iter()
-            .map(|&(cell, share)| share * self.model.coverage_in(cell, wo))
-            .sum::<f64>()
-            / total
+        // The coverage does not depend on the light: the look under an overhead one.
+        let seen = |y: &Yarns| {
+            y.look_within(at.u, at.v, width, points, UnitVec3::Z, wo)
+                .coverage
+        };
+        match self.point_level().filter(|_| point > 0.0) {
+            Some(y) if point >= 1.0 => seen(y),
+            Some(y) => point * seen(y) + (1.0 - point) * self.cells_coverage(at, width, wo),
+            None => self.cells_coverage(at, width, wo),
+        }
+    }
+
+    fn local(&self, at: Footprint, wi: UnitVec3, wo: UnitVec3) -> Local {
+        if !wo.above_horizon() {
+            return Local {
+                f: [0.0; 3],
+                coverage: 0.0,
+            };
+        }
+        if !wi.above_horizon() {
+            // Nothing reflected, but the eye still sees what it sees.
+            return Local {
+                f: [0.0; 3],
+                coverage: self.coverage_at(at, wo),
+            };
+        }
+        let (point, width, points) = match at.level(self.cell_width()) {
+            Level::Period => return self.period(wi, wo),
+            Level::Local {
+                point,
+                width,
+                points,
+            } => (point, width, points),
+        };
+        let yarns = self.point_level().filter(|_| point > 0.0);
+        let Some(yarns) = yarns else {
+            return self.cells(at.u, at.v, width, wi, wo);
+        };
+        let look = yarns.look_within(at.u, at.v, width, points, wi, wo);
+        let seen = Local {
+            f: look.f,
+            coverage: look.coverage,
+        };
+        if point >= 1.0 {
+            return seen;
+        }
+        blend(point, seen, self.cells(at.u, at.v, width, wi, wo))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cells::Cell;
     use crate::{Fabric, FacetModel};
 
     fn shipped(name: &str) -> AnalyticModel {
@@ -244,6 +370,79 @@ mod tests {
         let lo = cells.iter().cloned().fold(f64::INFINITY, f64::min);
         let hi = cells.iter().cloned().fold(0.0, f64::max);
         assert!(lo <= mid && mid <= hi && lo < hi);
+    }
+
+    #[test]
+    fn with_yarns_a_point_is_the_point_level_and_the_levels_blend_without_a_step() {
+        let f = Fabric::from_path(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/twill.json"),
+        )
+        .unwrap();
+        let y = crate::point::yarns(&f, FacetModel::Huo);
+        let cells = AnalyticBsdf::new(AnalyticModel::new(&f, FacetModel::Huo), None);
+        let b = AnalyticBsdf::new(AnalyticModel::new(&f, FacetModel::Huo), None).with_yarns(y);
+        let (wi, wo) = (
+            UnitVec3::from_degrees(50.0, 20.0),
+            UnitVec3::from_degrees(30.0, 200.0),
+        );
+        let at = |u, v, width| Footprint { u, v, width };
+        let cell = 1.0 / 3.0;
+        let (mut gaps, mut apart) = (0, 0.0);
+        let mut moved = [0.0; 100];
+        for k in 0..200 {
+            let (u, v) = (k as f64 * 0.137 % 1.0, k as f64 * 0.291 % 1.0);
+            // A point (and anything under an eighth of a cell) is the yarns' look.
+            let look = b.yarns().unwrap().look(u, v, wi, wo);
+            for w in [0.0, f64::NAN, 0.1 * cell] {
+                let l = b.local(at(u, v, w), wi, wo);
+                assert_eq!((l.f, l.coverage), (look.f, look.coverage));
+                assert_eq!(b.f_at(at(u, v, w), wi, wo), look.f);
+                assert_eq!(b.coverage_at(at(u, v, w), wo), look.coverage);
+            }
+            // Up to a cell, the yarns' looks integrated over the footprint.
+            let w = 0.9 * cell;
+            let within = b.yarns().unwrap().look_within(u, v, w, 8, wi, wo);
+            let l = b.local(at(u, v, w), wi, wo);
+            assert_eq!((l.f, l.coverage), (within.f, within.coverage));
+            gaps += usize::from(look.coverage == 0.0);
+            // From two cells on, the cells' box filter, as without the yarns.
+            for w in [2.0 * cell, 0.7, 0.99] {
+                assert_eq!(b.f_at(at(u, v, w), wi, wo), cells.f_at(at(u, v, w), wi, wo));
+                let (c0, c1) = (
+                    b.coverage_at(at(u, v, w), wo),
+                    cells.coverage_at(at(u, v, w), wo),
+                );
+                assert!((c0 - c1).abs() < 1e-12, "{c0} {c1}");
+            }
+            // Between, a coverage-weighted blend whose weight moves smoothly with the width.
+            let w = 1.5 * cell;
+            let mid = b.local(at(u, v, w), wi, wo);
+            let c = cells.local(at(u, v, w), wi, wo);
+            let p = b.yarns().unwrap().look_within(u, v, w, 8, wi, wo);
+            let want_cov = 0.5 * p.coverage + 0.5 * c.coverage;
+            assert!((mid.coverage - want_cov).abs() < 1e-12);
+            let step = |w: f64| b.local(at(u, v, w), wi, wo).f[0] * b.coverage_at(at(u, v, w), wo);
+            // The change of f c over each step of a hundredth of a cell from one cell to two,
+            // in absolute value, summed over the points: the point level's sampling noise (a
+            // point of the 64 crossing an edge) stays small in it, a pop between the levels
+            // would add the levels' whole difference at one step.
+            let mut last = step(cell);
+            for (i, acc) in moved.iter_mut().enumerate() {
+                let s = step((1.0 + 0.01 * (i + 1) as f64) * cell);
+                *acc += (s - last).abs();
+                last = s;
+            }
+            apart += (p.f[0] * p.coverage - c.f[0] * c.coverage).abs();
+        }
+        let worst = moved.iter().cloned().fold(0.0, f64::max);
+        assert!(
+            worst < 0.1 * apart,
+            "a step moves {worst}, the levels differ by {apart}"
+        );
+        assert!(gaps < 100, "{gaps} gaps of 200");
+        // The period is the average, with or without the yarns.
+        assert_eq!(b.f_at(at(0.3, 0.4, 1.0), wi, wo), b.f(wi, wo));
+        assert_eq!(b.coverage_at(at(0.3, 0.4, 1.0), wo), b.model().coverage(wo));
     }
 
     #[test]

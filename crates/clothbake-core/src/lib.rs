@@ -16,6 +16,7 @@ pub mod facet;
 pub mod geometry;
 pub mod interreflection;
 pub mod lanes;
+pub mod point;
 pub mod quad;
 pub mod reflect;
 pub mod rng;
@@ -37,7 +38,7 @@ pub use analytic::{
 };
 pub use brdf::{AnalyticBsdf, Component};
 pub use cells::{Cell, CellGrid, PeriodPoint};
-pub use clothbake_bsdf::{vec3, Bsdf, BsdfSample, Footprint, FromFn, Rgb};
+pub use clothbake_bsdf::{vec3, Bsdf, BsdfSample, Footprint, FromFn, Level, Local, Rgb};
 pub use fabric::{Fabric, FabricError, Field, Naming, PlainNaming};
 pub use facet::{Facet, FacetIntensity, FacetModel};
 pub use geometry::Geometry;

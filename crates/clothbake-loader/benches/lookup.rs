@@ -30,6 +30,7 @@ fn brdf(memory: Memory, reciprocal: bool) -> Brdf {
         memory,
         reciprocal,
         sampling: true,
+        point_level: false,
     };
     Brdf::from_stored(stored, opts).unwrap()
 }

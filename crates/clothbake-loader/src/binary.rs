@@ -184,6 +184,7 @@ mod legacy {
                 options_json: self.options_json,
                 symmetry: self.symmetry,
                 spatial: None,
+                yarns: None,
             }
         }
     }

@@ -3,7 +3,7 @@
 //! table was opened without sampling). Directions are rounded to f32 as the lookup takes them.
 
 use crate::lookup::Brdf;
-use clothbake_bsdf::{Bsdf, BsdfSample, Footprint, Rgb, UnitVec3, Vec3};
+use clothbake_bsdf::{Bsdf, BsdfSample, Footprint, Local, Rgb, UnitVec3, Vec3};
 
 fn f32s(u: UnitVec3) -> [f32; 3] {
     [u.x as f32, u.y as f32, u.z as f32]
@@ -33,6 +33,15 @@ impl Bsdf for Brdf {
 
     fn coverage_at(&self, at: Footprint, wo: UnitVec3) -> f64 {
         f64::from(Brdf::coverage_at(self, f32s(wo), at.u, at.v, at.width))
+    }
+
+    /// Through [`Brdf::local_at`]: the point level traces once for both.
+    fn local(&self, at: Footprint, wi: UnitVec3, wo: UnitVec3) -> Local {
+        let (f, c) = self.local_at(f32s(wi), f32s(wo), at.u, at.v, at.width);
+        Local {
+            f: f.map(f64::from),
+            coverage: f64::from(c),
+        }
     }
 
     fn sample(&self, wo: UnitVec3, u: [f64; 2]) -> Option<BsdfSample> {

@@ -37,6 +37,7 @@ use crate::sampling::Sampler;
 use crate::spatial::SpatialLookup;
 use crate::stored::{Samples, StoredTable};
 use crate::table::{Grid, Metadata, Precision, Table};
+use clothbake_bsdf::{Footprint, Level};
 
 /// True when a pair has a value: both directions above the horizon, no component NaN.
 #[inline(always)]
@@ -66,15 +67,20 @@ pub struct Options {
     /// Build the importance-sampling CDFs at load time ([`Brdf::sample`], [`Brdf::pdf`]);
     /// 4 bytes per table cell. Without them `sample` and `pdf` give a zero pdf.
     pub sampling: bool,
+    /// Answer footprints under two crossing cells at the point level where the table carries
+    /// its period's yarns (a spatial table of one bounce; docs/spatial.md). Off: the crossing
+    /// cells answer every footprint under a period, as in a table without yarns.
+    pub point_level: bool,
 }
 
 impl Default for Options {
-    /// Values as stored, no symmetrisation, sampling on.
+    /// Values as stored, no symmetrisation, sampling on, the point level where the table has it.
     fn default() -> Self {
         Options {
             memory: Memory::AsStored,
             reciprocal: false,
             sampling: true,
+            point_level: true,
         }
     }
 }
@@ -159,6 +165,25 @@ pub struct Brdf {
     sampler: Option<Sampler>,
     /// The classes of a spatially varying table (`crate::spatial`).
     spatial: Option<SpatialLookup>,
+    /// The point level, where the table carries its yarns and the options ask for it.
+    point: Option<PointLevel>,
+}
+
+/// The point level of a table: its period's yarns sorted for tracing, and the crossing cell's
+/// side in periods that the level rule measures footprints in.
+#[derive(Clone, Debug)]
+struct PointLevel {
+    yarns: clothbake_point::Yarns,
+    cell: f64,
+}
+
+/// An f32 direction as a unit vector (the horizon tests are the point level's own).
+fn unit(w: [f32; 3]) -> Option<clothbake_bsdf::UnitVec3> {
+    clothbake_bsdf::UnitVec3::new(clothbake_bsdf::Vec3::new(
+        f64::from(w[0]),
+        f64::from(w[1]),
+        f64::from(w[2]),
+    ))
 }
 
 impl Brdf {
@@ -203,6 +228,13 @@ impl Brdf {
         } else {
             SimdPath::Portable
         };
+        let point = match (&meta.yarns, &spatial) {
+            (Some(p), Some(s)) if options.point_level => Some(PointLevel {
+                yarns: clothbake_point::Yarns::new(p.clone()),
+                cell: s.cell_width(),
+            }),
+            _ => None,
+        };
         Ok(Brdf {
             meta,
             nodes,
@@ -210,6 +242,7 @@ impl Brdf {
             reciprocal: options.reciprocal,
             sampler,
             spatial,
+            point,
         })
     }
 
@@ -218,13 +251,82 @@ impl Brdf {
         self.spatial.as_ref()
     }
 
+    /// Whether this table answers footprints under two crossing cells at the point level (it
+    /// carries its yarns and was opened with [`Options::point_level`]).
+    pub fn has_point_level(&self) -> bool {
+        self.point.is_some()
+    }
+
+    /// f_r and coverage at the point level where the level rule ([`Footprint::level`]) gives
+    /// it a share: the yarns' look over the footprint, blended with the cells' box filter
+    /// between one and two cells wide. `None` where the cells or the period answer alone.
+    fn point_local(
+        &self,
+        wi: [f32; 3],
+        wo: [f32; 3],
+        u: f64,
+        v: f64,
+        width: f64,
+    ) -> Option<([f32; 3], f32)> {
+        let p = self.point.as_ref()?;
+        let Level::Local {
+            point,
+            width,
+            points,
+        } = (Footprint { u, v, width }).level(p.cell)
+        else {
+            return None;
+        };
+        if point <= 0.0 {
+            return None;
+        }
+        let (Some(i), Some(o)) = (unit(wi), unit(wo)) else {
+            return Some(([0.0; 3], 0.0));
+        };
+        // The coverage does not depend on the light: where it is below the horizon, the look
+        // under an overhead one gives it.
+        let look = p.yarns.look_within(u, v, width, points, i, o);
+        let (f, c) = if i.above_horizon() {
+            (look.f, look.coverage)
+        } else {
+            let z = clothbake_bsdf::UnitVec3::Z;
+            (
+                [0.0; 3],
+                p.yarns.look_within(u, v, width, points, z, o).coverage,
+            )
+        };
+        if point >= 1.0 {
+            return Some((f.map(|x| x as f32), c as f32));
+        }
+        let s = self.spatial.as_ref()?;
+        let fc = s.eval_within(self.simd, wi, wo, u, v, width);
+        let cc = f64::from(s.coverage_at(wo, u, v, width).unwrap_or(1.0));
+        let (a, b) = (point * c, (1.0 - point) * cc);
+        let sum = a + b;
+        let blend = |k: usize| {
+            if sum > 0.0 {
+                ((a * f[k] + b * f64::from(fc[k])) / sum) as f32
+            } else {
+                0.0
+            }
+        };
+        Some(([blend(0), blend(1), blend(2)], sum as f32))
+    }
+
     /// f_r through a footprint of the weave period (docs/spatial.md): at (u, v) in period
-    /// fractions (wrapped), over a square of side `width` periods. A spatial table answers the
-    /// coverage-weighted mean of its cells' f_r over the square, and its averaged f_r
-    /// ([`Brdf::eval`]) once `width` reaches 1; an averaged table always answers
-    /// [`Brdf::eval`].
+    /// fractions (wrapped), over a square of side `width` periods, at the level of detail
+    /// [`Footprint::level`] gives it. A spatial table that carries its yarns answers
+    /// footprints under a crossing cell at the point level (the yarns traced), blends it with
+    /// its cells up to two cells wide, and answers the coverage-weighted mean of its cells'
+    /// f_r over the square beyond; its averaged f_r ([`Brdf::eval`]) once `width` reaches 1;
+    /// an averaged table always answers [`Brdf::eval`].
     #[inline]
     pub fn eval_at(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64, width: f64) -> [f32; 3] {
+        if self.point.is_some() {
+            if let Some((f, _)) = self.point_local(wi, wo, u, v, width) {
+                return f;
+            }
+        }
         // One call takes the directions on each path (no copies kept for another).
         match &self.spatial {
             Some(s) if SpatialLookup::answers(u, v, width) => {
@@ -234,11 +336,37 @@ impl Brdf {
         }
     }
 
+    /// [`Brdf::eval_at`] and [`Brdf::coverage_at`] from one call: at the point level the
+    /// yarns are traced once for both.
+    pub fn local_at(
+        &self,
+        wi: [f32; 3],
+        wo: [f32; 3],
+        u: f64,
+        v: f64,
+        width: f64,
+    ) -> ([f32; 3], f32) {
+        if self.point.is_some() {
+            if let Some(l) = self.point_local(wi, wo, u, v, width) {
+                return l;
+            }
+        }
+        (
+            self.eval_at(wi, wo, u, v, width),
+            self.coverage_at(wo, u, v, width),
+        )
+    }
+
     /// The share of a footprint's projected area in which the eye meets yarn, seen from `wo`
     /// (see [`Brdf::eval_at`]); for a footprint of a whole period or more, or a point not
     /// finite (where `eval_at` answers the average), the directional coverage C(wo). An
     /// averaged table carries no coverage and answers 1 (opaque).
     pub fn coverage_at(&self, wo: [f32; 3], u: f64, v: f64, width: f64) -> f32 {
+        if self.point.is_some() {
+            if let Some((_, c)) = self.point_local([0.0, 0.0, 1.0], wo, u, v, width) {
+                return c;
+            }
+        }
         // Where `eval_at` answers the average, the whole period (just under, which the
         // spatial table still answers).
         let (u, v, width) = if SpatialLookup::answers(u, v, width) {

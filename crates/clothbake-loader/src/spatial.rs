@@ -22,7 +22,7 @@ use crate::lookup::{has_value, pad4, SimdPath};
 use crate::nodes::{Lane, MirrorLanes, Nodes, Values};
 use crate::stored::Samples;
 use crate::table::Grid;
-use clothbake_bsdf::Footprint;
+use clothbake_bsdf::{Footprint, Level};
 
 /// Most crossing cells a spatial table's period may have (2^16): the layout is stored as JSON
 /// in the header.
@@ -596,14 +596,6 @@ fn with_sides(p: &PointCell, d: f32, s: f32, g: [f32; 4]) -> [f32; 3] {
     })
 }
 
-/// Whether `u` and `v` are both finite, in one test: x - x is 0 for a finite x and NaN for
-/// an infinite one or NaN.
-#[inline(always)]
-#[allow(clippy::eq_op)]
-pub(crate) fn both_finite(u: f64, v: f64) -> bool {
-    (u - u) + (v - v) == 0.0
-}
-
 /// `x`, or 0 where it is below 0 or NaN (as `x.max(0.0)`, in one instruction on x86-64).
 #[inline(always)]
 fn non_negative(x: f32) -> f32 {
@@ -960,12 +952,21 @@ impl SpatialLookup {
         seen
     }
 
+    /// The side of a crossing cell that the level rule measures footprints in: one over the
+    /// larger count of cells along u and along v (as the model's `AnalyticBsdf::cell_width`).
+    pub(crate) fn cell_width(&self) -> f64 {
+        let (nx, ny) = self.layout.dims();
+        1.0 / nx.max(ny).max(1) as f64
+    }
+
     /// Whether this table answers f_r and coverage at (u, v) through a footprint of side
-    /// `width` ([`crate::Brdf::eval_at`]): below a period (NaN a point) at a finite point;
-    /// elsewhere the averaged table answers.
+    /// `width` ([`crate::Brdf::eval_at`]): where the level rule ([`Footprint::level`]) asks
+    /// for less than the period (below a period, NaN a point, at a finite point); elsewhere
+    /// the averaged table answers. A table has no point level: inside the period its cells
+    /// answer.
     #[inline(always)]
     pub(crate) fn answers(u: f64, v: f64, width: f64) -> bool {
-        (width < 1.0 || width.is_nan()) && both_finite(u, v)
+        matches!(Footprint { u, v, width }.level(1.0), Level::Local { .. })
     }
 
     /// f_r through the footprint, where the table [`answers`](SpatialLookup::answers): the
@@ -1314,25 +1315,6 @@ mod tests {
         assert!(compared <= budget, "{compared} values compared");
         assert_eq!(stored.len(), k as usize);
         assert!(held.iter().enumerate().all(|(c, h)| *h == (c, 0, false)));
-    }
-
-    #[test]
-    fn both_finite_is_both_is_finite() {
-        let xs = [
-            0.0,
-            -0.0,
-            1.5,
-            -1e308,
-            f64::MAX,
-            f64::MIN_POSITIVE,
-            f64::INFINITY,
-        ];
-        let xs: Vec<f64> = xs.iter().flat_map(|&x| [x, -x]).chain([f64::NAN]).collect();
-        for &u in &xs {
-            for &v in &xs {
-                assert_eq!(both_finite(u, v), u.is_finite() && v.is_finite(), "{u} {v}");
-            }
-        }
     }
 
     #[test]

@@ -209,6 +209,11 @@ pub struct Metadata {
     /// absent from averaged tables, whose headers are as before.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spatial: Option<Spatial>,
+    /// For a spatial table of one bounce, the period's yarns (`clothbake_point::Period`,
+    /// checked on reading by its one constructor): with them the loader answers footprints
+    /// under two crossing cells at the point level (docs/spatial.md). Absent elsewhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yarns: Option<clothbake_point::Period>,
 }
 
 impl Metadata {
@@ -246,6 +251,7 @@ impl Metadata {
             options_json: options_json.into(),
             symmetry: symmetry.into(),
             spatial: None,
+            yarns: None,
         }
     }
 

@@ -35,6 +35,7 @@ fn brdfs(kernel: SimdPath, reciprocal: bool) -> Vec<(Memory, Brdf)> {
             memory,
             reciprocal,
             sampling: false,
+            point_level: false,
         };
         let stored =
             clothbake_loader::StoredTable::from_table(table(), clothbake_loader::Precision::F16)

@@ -61,6 +61,7 @@ fn parse_v1(b: &[u8]) -> Table {
         options_json: c.text(),
         symmetry: c.text(),
         spatial: None,
+        yarns: None,
     };
     assert_eq!(c.1, 20 + h, "the header is exactly H bytes");
     let n = c.u64() as usize;

@@ -320,7 +320,7 @@ pub fn bake(
     })?;
     match done.table {
         None => Ok(None),
-        Some(t) => PyTable::from_stored(StoredTable::from(t), false)
+        Some(t) => PyTable::from_stored(StoredTable::from(t), false, true)
             .map(Some)
             .map_err(table_err),
     }

@@ -1,10 +1,11 @@
 //! `clothbake.Fabric`: a validated fabric description and its BRDF from the analytic model
 //! (thesis ch. 3-4, ch. 5 with two bounces) or the ray-traced ground truth.
 
-use crate::vectors::{check_unit, period_rows, same_len, to_array, to_array1, unit_rows};
+use crate::vectors::{check_unit, period_rows, same_len, to_array, to_array1, unit_rows, widths};
 use clothbake_core::{
-    intensity_to_brdf, AnalyticModel, Fabric, FacetModel, LocalReflection, PeriodPoint, RayTracer,
-    Reflection, SecondaryOptions, Transport, UnitVec3, Vec3, ALL_BOUNCES,
+    intensity_to_brdf, AnalyticBsdf, AnalyticModel, Bsdf, Component, Fabric, FacetModel, Footprint,
+    Local, PeriodPoint, RayTracer, Reflection, SecondaryOptions, Transport, UnitVec3, Vec3,
+    ALL_BOUNCES,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -49,6 +50,9 @@ pub struct PyFabric {
     pub(crate) path: Option<std::path::PathBuf>,
     /// Analytic models, built on first use: Huo's facets, Lewis's.
     models: [OnceLock<AnalyticModel>; 2],
+    /// The one-bounce model with the fabric's yarns (every level of detail), built on first
+    /// use: Huo's facets, Lewis's.
+    levels: [OnceLock<AnalyticBsdf>; 2],
 }
 
 impl PyFabric {
@@ -59,6 +63,18 @@ impl PyFabric {
             FacetModel::Lewis => 1,
         };
         self.models[k].get_or_init(|| AnalyticModel::new(&self.fabric, facet))
+    }
+
+    /// The one-bounce model with the fabric's yarns: every level of detail (built once).
+    pub fn levels(&self, facet: FacetModel) -> &AnalyticBsdf {
+        let k = match facet {
+            FacetModel::Huo => 0,
+            FacetModel::Lewis => 1,
+        };
+        self.levels[k].get_or_init(|| {
+            AnalyticBsdf::new(self.model(facet).clone(), None)
+                .with_yarns(clothbake_core::point::yarns(&self.fabric, facet))
+        })
     }
 }
 
@@ -107,6 +123,7 @@ impl PyFabric {
             fabric,
             path,
             models: [OnceLock::new(), OnceLock::new()],
+            levels: [OnceLock::new(), OnceLock::new()],
         })
     }
 
@@ -139,11 +156,17 @@ impl PyFabric {
     /// facet: "huo" (default, eqs 4.6 and 4.8) or "lewis" (energy conserving).
     /// split: also return the diffuse, specular and secondary parts, each as f_r in 1/sr.
     /// uv: points of the weave period, (N, 2) or (2,), in period fractions (u along the weft
-    /// +X, v along the warp +Y, any finite numbers, wrapped; analytic only): f_r of the yarn
-    /// over that crossing instead of the period's average (docs/spatial.md); with `split=True`
-    /// the dict also holds "coverage", c(x; wo) per row.
+    /// +X, v along the warp +Y, any finite numbers, wrapped; analytic only): f_r seen through
+    /// a footprint there instead of the period's average, through the model's BSDF
+    /// (`Bsdf::local`, docs/spatial.md). width: the footprint's side in periods, one number
+    /// or one a row (default 0, the point itself; 1 or more, the period). level: "auto" (default), the footprint's level of
+    /// detail: with one bounce the yarns traced up close (the point level), the crossing cells
+    /// from two cells wide, the period from a period; or "cells", the crossing cells as a
+    /// spatial table holds them. With `split=True` the dict holds "brdf", "coverage" (the
+    /// footprint's c per row) and, with bounces=2, "secondary"; a footprint's reflection is not
+    /// split into diffuse and specular parts.
     /// Returns an (N, 3) float64 array, or a dict of them with `split=True`.
-    #[pyo3(signature = (wi, wo, method="analytic", bounces=None, facet="huo", split=false, samples=100_000, seed=1, uv=None))]
+    #[pyo3(signature = (wi, wo, method="analytic", bounces=None, facet="huo", split=false, samples=100_000, seed=1, uv=None, width=None, level="auto"))]
     #[allow(clippy::too_many_arguments)]
     fn eval<'py>(
         &self,
@@ -157,8 +180,19 @@ impl PyFabric {
         samples: usize,
         seed: u64,
         uv: Option<&Bound<'py, PyAny>>,
+        width: Option<&Bound<'py, PyAny>>,
+        level: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let facet = facet_model(facet)?;
+        let point_level = match level {
+            "auto" => true,
+            "cells" => false,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "level: {other:?}; use \"auto\" (the footprint's level of detail) or \"cells\" (the crossing cells)"
+                )))
+            }
+        };
         let bounces = bounces_arg(bounces)?;
         if bounces > 2 && (method != "analytic" || uv.is_some()) {
             return Err(PyValueError::new_err(
@@ -195,19 +229,41 @@ impl PyFabric {
         let mut coverage = Vec::new();
         let out: Vec<[[f64; 3]; 4]> = match (method, &at) {
             ("analytic", Some(at)) => {
+                let w = match width {
+                    Some(w) => widths(w, pairs.len())?,
+                    None => vec![0.0; pairs.len()],
+                };
                 let m = self.model(facet);
-                let local: Vec<LocalReflection> = py.detach(|| {
+                let cells;
+                let bsdf = if point_level && secondary.is_none() {
+                    self.levels(facet)
+                } else {
+                    cells = AnalyticBsdf::new(m.clone(), secondary);
+                    &cells
+                };
+                let i2 = secondary.and_then(|_| {
+                    AnalyticBsdf::new(m.clone(), secondary).with_component(Component::Secondary)
+                });
+                let local: Vec<(Local, [f64; 3])> = py.detach(|| {
                     pairs
                         .par_iter()
                         .zip(at)
-                        .map(|(&(a, b), &p)| m.intensity_at(a, b, p, secondary.as_ref()))
+                        .zip(&w)
+                        .map(|((&(a, b), p), &width)| {
+                            let fp = Footprint {
+                                u: p.u(),
+                                v: p.v(),
+                                width,
+                            };
+                            let s = i2.as_ref().map_or([0.0; 3], |s| s.f_at(fp, a, b));
+                            (bsdf.local(fp, a, b), s)
+                        })
                         .collect()
                 });
-                coverage = local.iter().map(|l| l.coverage).collect();
+                coverage = local.iter().map(|l| l.0.coverage).collect();
                 local
                     .iter()
-                    .zip(&pairs)
-                    .map(|(l, &(a, _))| parts(&l.reflection, a))
+                    .map(|(l, s)| [l.f, [f64::NAN; 3], [f64::NAN; 3], *s])
                     .collect()
             }
             ("analytic", None) if bounces > 2 => {
@@ -286,7 +342,11 @@ impl PyFabric {
             .iter()
             .enumerate()
         {
-            d.set_item(PyString::new(py, name), to_array(py, &part(k), single)?)?;
+            // A footprint's reflection comes whole (and its I_2 only with two bounces).
+            let unsplit = at.is_some() && (k == 1 || k == 2 || (k == 3 && bounces != 2));
+            if !unsplit {
+                d.set_item(PyString::new(py, name), to_array(py, &part(k), single)?)?;
+            }
         }
         if at.is_some() {
             d.set_item(
@@ -295,6 +355,38 @@ impl PyFabric {
             )?;
         }
         Ok(d.into_any())
+    }
+
+    /// f_r and coverage at point (u, v) of the weave period through a footprint of side
+    /// `width` periods, for one pair of unit vectors given as 3 floats each (fabric frame,
+    /// analytic model, direct reflection, every level of detail: the yarns traced up close):
+    /// the scalar path of the Mitsuba plugin. Returns ((r, g, b), coverage).
+    #[pyo3(signature = (wi, wo, u, v, width=0.0, facet="huo"))]
+    fn eval1_at(
+        &self,
+        wi: [f64; 3],
+        wo: [f64; 3],
+        u: f64,
+        v: f64,
+        width: f64,
+        facet: &str,
+    ) -> PyResult<((f64, f64, f64), f64)> {
+        check_unit("wi", 0, wi)?;
+        check_unit("wo", 0, wo)?;
+        if !(u.is_finite() && v.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "u, v: ({u}, {v}); give finite period fractions"
+            )));
+        }
+        if !(width.is_finite() && width >= 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "width: {width} is not a footprint; give the square's side in periods, >= 0"
+            )));
+        }
+        let l =
+            self.levels(facet_model(facet)?)
+                .local(Footprint { u, v, width }, unit(wi), unit(wo));
+        Ok(((l.f[0], l.f[1], l.f[2]), l.coverage))
     }
 
     /// f_r(wi, wo) in 1/sr for one pair of unit vectors given as 3 floats each (fabric frame,

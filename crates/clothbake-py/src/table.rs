@@ -2,7 +2,7 @@
 //! (`clothbake_loader::Brdf`) and importance sampling.
 
 use crate::vectors::{
-    check_unit, period_rows, rows, same_len, to_array, to_array1, unit_rows, unit_rows_f32,
+    check_unit, period_rows, rows, same_len, to_array, to_array1, unit_rows, unit_rows_f32, widths,
 };
 use clothbake_loader::{
     write_binary, write_exr, Brdf, Memory, Options, Precision, StoredTable, TableError,
@@ -36,18 +36,29 @@ pub fn table_err(e: TableError) -> PyErr {
 pub struct PyTable {
     stored: StoredTable,
     brdf: Brdf,
+    reciprocal: bool,
 }
 
 impl PyTable {
-    /// A table in memory, ready for lookups and sampling.
-    pub fn from_stored(stored: StoredTable, reciprocal: bool) -> Result<PyTable, TableError> {
+    /// A table in memory, ready for lookups and sampling; `point_level` as
+    /// [`Options::point_level`].
+    pub fn from_stored(
+        stored: StoredTable,
+        reciprocal: bool,
+        point_level: bool,
+    ) -> Result<PyTable, TableError> {
         let options = Options {
             memory: Memory::AsStored,
             reciprocal,
             sampling: true,
+            point_level,
         };
         let brdf = Brdf::from_stored(stored.clone(), options)?;
-        Ok(PyTable { stored, brdf })
+        Ok(PyTable {
+            stored,
+            brdf,
+            reciprocal,
+        })
     }
 }
 
@@ -62,14 +73,21 @@ fn narrow(r: &[[f64; 3]]) -> Vec<[f32; 3]> {
 #[pymethods]
 impl PyTable {
     /// Opens a table file (OpenEXR or binary, docs/table-format.md). `reciprocal=True`
-    /// symmetrises every lookup, 0.5 (f(wi, wo) + f(wo, wi)). Raises FileNotFoundError for a
-    /// missing file and ValueError for a file that is not a valid table.
+    /// symmetrises every lookup, 0.5 (f(wi, wo) + f(wo, wi)). `point_level=False` makes a
+    /// spatial table that carries its yarns answer every footprint under a period with its
+    /// crossing cells (docs/spatial.md). Raises FileNotFoundError for a missing file and
+    /// ValueError for a file that is not a valid table.
     #[staticmethod]
-    #[pyo3(signature = (path, reciprocal=false))]
-    fn open(py: Python<'_>, path: PathBuf, reciprocal: bool) -> PyResult<PyTable> {
+    #[pyo3(signature = (path, reciprocal=false, point_level=true))]
+    fn open(
+        py: Python<'_>,
+        path: PathBuf,
+        reciprocal: bool,
+        point_level: bool,
+    ) -> PyResult<PyTable> {
         py.detach(|| {
             let stored = clothbake_loader::read_table_stored(&path)?;
-            PyTable::from_stored(stored, reciprocal).map_err(|e| match e {
+            PyTable::from_stored(stored, reciprocal, point_level).map_err(|e| match e {
                 TableError::InvalidTable { reason } => TableError::Corrupted {
                     path: path.clone(),
                     reason,
@@ -163,38 +181,34 @@ impl PyTable {
 
     /// f_r at points of the weave period through a footprint (docs/spatial.md): `uv` (N, 2)
     /// or (2,) in period fractions (u along the weft, v along the warp, wrapped), `width` the
-    /// side of the square each lookup covers, in periods (0: the crossing cell at uv; 1 or
-    /// more: the averaged table). A table baked with `spatial=True` shows the weave; an
-    /// averaged table answers `eval`. Returns (f_r (N, 3), coverage (N,)), float32.
-    #[pyo3(signature = (wi, wo, uv, width=0.0))]
+    /// side of the square each lookup covers, in periods (0: the point at uv; 1 or more: the
+    /// averaged table), answered at its level of detail: a table baked with `spatial=True`
+    /// (one bounce) traces its yarns under a crossing cell and shows its cells from two cells
+    /// wide; an averaged table answers `eval`. `width` is one number or one a row (N,).
+    /// Returns (f_r (N, 3), coverage (N,)), float32.
+    #[pyo3(signature = (wi, wo, uv, width=None))]
     fn eval_at<'py>(
         &self,
         py: Python<'py>,
         wi: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
         uv: &Bound<'py, PyAny>,
-        width: f64,
+        width: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let a = unit_rows("wi", wi)?;
         let b = unit_rows("wo", wo)?;
         same_len(("wi", a.rows.len()), ("wo", b.rows.len()))?;
         let p = period_rows(uv, a.rows.len())?;
-        if !(width.is_finite() && width >= 0.0) {
-            return Err(PyValueError::new_err(format!(
-                "width: {width} is not a footprint; give the square's side in periods, >= 0"
-            )));
-        }
+        let w = match width {
+            Some(w) => widths(w, a.rows.len())?,
+            None => vec![0.0; a.rows.len()],
+        };
         let (wi32, wo32) = (narrow(&a.rows), narrow(&b.rows));
         let (f, c): (Vec<[f32; 3]>, Vec<f32>) = py.detach(|| {
             wi32.iter()
                 .zip(&wo32)
-                .zip(&p.rows)
-                .map(|((&i, &o), &[u, v])| {
-                    (
-                        self.brdf.eval_at(i, o, u, v, width),
-                        self.brdf.coverage_at(o, u, v, width),
-                    )
-                })
+                .zip(p.rows.iter().zip(&w))
+                .map(|((&i, &o), (&[u, v], &width))| self.brdf.local_at(i, o, u, v, width))
                 .unzip()
         });
         let single = a.single && b.single && p.single;
@@ -263,6 +277,20 @@ impl PyTable {
         to_array1(py, p, a.single && b.single)
     }
 
+    /// Whether `eval_at` answers footprints under two crossing cells at the point level (the
+    /// table carries its yarns and was opened with `point_level=True`).
+    #[getter]
+    fn has_point_level(&self) -> bool {
+        self.brdf.has_point_level()
+    }
+
+    /// The same table without its point level: its crossing cells answer every footprint
+    /// under a period (what a spatial table held before it carried its yarns).
+    fn without_point_level(&self, py: Python<'_>) -> PyResult<PyTable> {
+        py.detach(|| PyTable::from_stored(self.stored.clone(), self.reciprocal, false))
+            .map_err(table_err)
+    }
+
     /// f_r(wi, wo) in 1/sr for one pair of unit vectors given as 3 floats each: the scalar
     /// path renderers call per sample.
     fn eval1(&self, wi: [f64; 3], wo: [f64; 3]) -> PyResult<Triple> {
@@ -286,6 +314,29 @@ impl PyTable {
             .brdf
             .eval_at(wi.map(|x| x as f32), wo.map(|x| x as f32), u, v, width);
         Ok((f[0], f[1], f[2]))
+    }
+
+    /// As `eval1_at`, with the footprint's coverage from the same lookup: ((r, g, b),
+    /// coverage).
+    fn eval1_local(
+        &self,
+        wi: [f64; 3],
+        wo: [f64; 3],
+        u: f64,
+        v: f64,
+        width: f64,
+    ) -> PyResult<(Triple, f32)> {
+        check_unit("wi", 0, wi)?;
+        check_unit("wo", 0, wo)?;
+        if !(u.is_finite() && v.is_finite() && width.is_finite() && width >= 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "({u}, {v}) with width {width}: give finite period fractions and a width >= 0"
+            )));
+        }
+        let (f, c) = self
+            .brdf
+            .local_at(wi.map(|x| x as f32), wo.map(|x| x as f32), u, v, width);
+        Ok(((f[0], f[1], f[2]), c))
     }
 
     /// One importance sample for `wo` (3 floats, unit) and `u1, u2` in [0, 1):

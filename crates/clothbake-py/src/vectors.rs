@@ -127,6 +127,38 @@ pub fn unit_rows_f32(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<(Vec<[f32; 
 
 /// Reads `uv`, points of the weave period as `(N, 2)` (or `(2,)`) period fractions, one per row
 /// of `wi` (`n` rows); a row that is not finite is an error naming it.
+/// Reads a footprint width: one number for every row, or an array of `n` (one a row), each
+/// finite and >= 0 (the side of a square in periods).
+pub fn widths(obj: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<f64>> {
+    let out = if let Ok(w) = obj.extract::<f64>() {
+        vec![w; n]
+    } else {
+        let np = obj.py().import("numpy")?;
+        let flat = np
+            .call_method1("asarray", (obj, "float64"))
+            .and_then(|a| a.call_method0("ravel"))
+            .and_then(|a| a.call_method0("tolist"))
+            .and_then(|l| l.extract::<Vec<f64>>())
+            .map_err(|e| {
+                PyValueError::new_err(format!(
+                    "width: cannot be read as numbers ({e}); give one number or an array (N,)"
+                ))
+            })?;
+        same_len(("wi", n), ("width", flat.len()))?;
+        flat
+    };
+    if let Some((i, w)) = out
+        .iter()
+        .enumerate()
+        .find(|(_, w)| !(w.is_finite() && **w >= 0.0))
+    {
+        return Err(PyValueError::new_err(format!(
+            "width: row {i} is {w}, not a footprint; give the square's side in periods, >= 0"
+        )));
+    }
+    Ok(out)
+}
+
 pub fn period_rows(obj: &Bound<'_, PyAny>, n: usize) -> PyResult<Rows<2>> {
     let r = rows::<2>("uv", obj)?;
     same_len(("wi", n), ("uv", r.rows.len()))?;

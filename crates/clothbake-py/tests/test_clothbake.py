@@ -69,14 +69,16 @@ def test_every_bounce_adds_to_the_analytic_second_bounce(twill_path):
 
 
 def test_points_of_the_period_average_to_the_period(twill_path):
-    """docs/spatial.md: the coverage-weighted mean of f_r over the period is the average."""
+    """docs/spatial.md: the coverage-weighted mean of the crossing cells' f_r over the period
+    is the average."""
     fab = clothbake.Fabric(twill_path)
     n = 30  # 10 x 10 points in each of the twill's 3 x 3 equal cells
     u, v = np.meshgrid((np.arange(n) + 0.5) / n, (np.arange(n) + 0.5) / n)
     uv = np.stack([u.ravel(), v.ravel()], axis=-1)
     wi = np.repeat(dirs([60], [0]), len(uv), axis=0)
     wo = np.repeat(dirs([20], [180]), len(uv), axis=0)
-    s = fab.eval(wi, wo, uv=uv, split=True)
+    s = fab.eval(wi, wo, uv=uv, split=True, level="cells")
+    assert "diffuse" not in s
     c = s["coverage"]
     # Light is attributed where the yarn lies, so a yarn seen over a neighbour's cell can
     # exceed 1 slightly (docs/spatial.md); the period mean cannot exceed 1 here.
@@ -84,13 +86,43 @@ def test_points_of_the_period_average_to_the_period(twill_path):
     mean = (c[:, None] * s["brdf"]).sum(axis=0) / c.sum()
     np.testing.assert_allclose(mean, fab.eval(wi[:1], wo[:1])[0], rtol=1e-9)
     # Warp floats and weft floats differ; a whole period away is the same point.
-    f = fab.eval(wi[:2], wo[:2], uv=np.array([[0.0, 0.0], [0.7, 0.05]]))
+    f = fab.eval(wi[:2], wo[:2], uv=np.array([[0.0, 0.0], [0.7, 0.05]]), level="cells")
     assert abs(f[0, 0] - f[1, 0]) > 0.1 * f[0, 0]
-    np.testing.assert_array_equal(fab.eval(wi[0], wo[0], uv=np.array([-3.0, 2.0])), f[0])
+    np.testing.assert_array_equal(
+        fab.eval(wi[0], wo[0], uv=np.array([-3.0, 2.0]), level="cells"), f[0]
+    )
     with pytest.raises(ValueError, match="uv"):
         fab.eval(wi[:1], wo[:1], uv=np.array([[np.nan, 0.0]]))
     with pytest.raises(ValueError, match="uv"):
         fab.eval(wi[:1], wo[:1], uv=np.array([[0.0, 0.0]]), method="raytrace")
+    with pytest.raises(ValueError, match="width"):
+        fab.eval(wi[:1], wo[:1], uv=np.array([[0.0, 0.0]]), width=-1.0)
+    with pytest.raises(ValueError, match="level"):
+        fab.eval(wi[:1], wo[:1], uv=np.array([[0.0, 0.0]]), level="yarn")
+
+
+def test_the_yarns_up_close_average_to_the_ray_tracer(twill_path):
+    """docs/spatial.md, the point level: at a point the yarns are traced (coverage 0 in a gap,
+    1 on yarn), and the coverage-weighted mean over the period is the ground truth's average
+    (the ray tracer, an independent code), within its noise and the grid's."""
+    fab = clothbake.Fabric(twill_path)
+    n = 150
+    u, v = np.meshgrid((np.arange(n) + 0.5) / n, (np.arange(n) + 0.5) / n)
+    uv = np.stack([u.ravel(), v.ravel()], axis=-1)
+    wi = np.repeat(dirs([50], [20]), len(uv), axis=0)
+    wo = np.repeat(dirs([35], [200]), len(uv), axis=0)
+    s = fab.eval(wi, wo, uv=uv, split=True)
+    c = s["coverage"]
+    assert set(np.unique(c)) <= {0.0, 1.0} and 0.5 < c.mean() < 1.0
+    assert (s["brdf"][c == 0] == 0).all()
+    mean = (c[:, None] * s["brdf"]).sum(axis=0) / c.sum()
+    truth = fab.eval(wi[:1], wo[:1], method="raytrace", samples=400_000)[0]
+    np.testing.assert_allclose(mean, truth, rtol=0.01)
+    # A footprint of a period is the average; two cells and more, the crossing cells.
+    whole = fab.eval(wi[:1], wo[:1], uv=uv[:1], width=1.0)[0]
+    np.testing.assert_array_equal(whole, fab.eval(wi[:1], wo[:1])[0])
+    wide = fab.eval(wi[:3], wo[:3], uv=uv[:3], width=0.7)
+    np.testing.assert_array_equal(wide, fab.eval(wi[:3], wo[:3], uv=uv[:3], width=0.7, level="cells"))
 
 
 def test_a_spatial_table_shows_the_model_per_cell(twill_path):
@@ -103,11 +135,25 @@ def test_a_spatial_table_shows_the_model_per_cell(twill_path):
     wi = np.repeat(dirs([52.5], [15.0]), 9, axis=0)
     wo = np.repeat(dirs([22.5], [195.0]), 9, axis=0)
     uv = np.array([[(i + 0.5) / 3, (j + 0.5) / 3] for j in range(3) for i in range(3)])
-    f, c = t.eval_at(wi, wo, uv)
-    s = fab.eval(wi, wo, uv=uv, split=True)
+    # The table carries the twill's yarns: up close it traces them, as the model does.
+    assert t.has_point_level
+    f_pt, c_pt = t.eval_at(wi, wo, uv)
+    s_pt = fab.eval(wi, wo, uv=uv, split=True)
+    np.testing.assert_allclose(f_pt, s_pt["brdf"], rtol=1e-4, atol=1e-6)
+    np.testing.assert_array_equal(c_pt, s_pt["coverage"])
+    # Its crossing cells alone are the model's cells.
+    cells = t.without_point_level()
+    assert not cells.has_point_level
+    f, c = cells.eval_at(wi, wo, uv)
+    s = fab.eval(wi, wo, uv=uv, split=True, level="cells")
     np.testing.assert_allclose(f, s["brdf"], rtol=1e-5)
     np.testing.assert_allclose(c, s["coverage"], rtol=1e-5)
     assert f[:, 0].max() > 1.1 * f[:, 0].min()
+    # Widths one a row: from two cells wide the cells answer, at a period the average.
+    w = np.array([0.7] * 8 + [1.0])
+    fw, _ = t.eval_at(wi, wo, uv, width=w)
+    np.testing.assert_array_equal(fw[:8], cells.eval_at(wi[:8], wo[:8], uv[:8], width=0.7)[0])
+    np.testing.assert_array_equal(fw[8], t.eval(wi[8:], wo[8:])[0])
     whole, _ = t.eval_at(wi, wo, uv, width=1.0)
     np.testing.assert_array_equal(whole, t.eval(wi, wo))
     with pytest.raises(ValueError, match="uv"):
@@ -131,7 +177,7 @@ def test_a_spatial_table_with_the_second_bounce_shows_the_model_per_cell(twill_p
     f, _ = t.eval_at(wi, wo, uv)
     np.testing.assert_allclose(f, fab.eval(wi, wo, uv=uv, bounces=2), rtol=1e-5)
     # The second bounce is in it: the direct reflection alone is lower.
-    assert (fab.eval(wi, wo, uv=uv) < f - 1e-4).any()
+    assert (fab.eval(wi, wo, uv=uv, level="cells") < f - 1e-4).any()
 
 
 def test_brdf_is_linear_in_the_albedo(twill_path):

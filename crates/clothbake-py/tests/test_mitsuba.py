@@ -143,11 +143,13 @@ def test_white_furnace_lewis(twill_path, tmp_path, figures_dir):
     assert lum[seen].mean() > 0.3
 
 
-def swatch_pair(table, tmp_path, periods=None):
+def swatch_pair(table, tmp_path, periods=None, weave=None, spp=None, aa=4):
     """The swatch scene of `test_plugin_matches_clothbake_render` through the project's own
-    renderer and through the plugin, on the same table file: (ours, plugin) linear images.
-    With `periods`, both look f_r up at points of the weave period (`render --periods N`
-    across the side 60; the plugin's `periods` per UV unit, the rectangle's UV spanning it)."""
+    renderer and through the plugin, on the same table file (or, with `weave`, the same
+    fabric file): (ours, plugin) linear images. With `periods`, both look f_r up at points of
+    the weave period through their footprints and draw the cloth over black (`render
+    --periods N --gaps` across the side 60; the plugin's `periods` per UV unit, the
+    rectangle's UV spanning it)."""
     import os
     import subprocess
 
@@ -158,12 +160,13 @@ def swatch_pair(table, tmp_path, periods=None):
 
     res, fov, eye, light = 40, 30.0, [0.0, -40.0, 40.0], [0.3, 0.6, 0.74]
     ours = tmp_path / "ours.exr"
-    weave = ["--periods", str(periods)] if periods else []
+    close = ["--periods", str(periods), "--gaps"] if periods else []
+    source = ["--weave", str(weave)] if weave else ["--table", str(table)]
     subprocess.run(
-        [exe, "render", "--table", str(table), "--scene", "swatch", "--eye", ",".join(map(str, eye)),
+        [exe, "render", *source, "--scene", "swatch", "--eye", ",".join(map(str, eye)),
          "--look-at", "0,0,0", "--light", ",".join(map(str, light)), "--fov", str(fov),
-         "--res", str(res), "--aa", "4", "--ambient", "0", "--irradiance", str(E),
-         "-o", str(tmp_path / "ours.png"), "--exr", str(ours), "-q", "--force", *weave],
+         "--res", str(res), "--aa", str(aa), "--ambient", "0", "--irradiance", str(E),
+         "-o", str(tmp_path / "ours.png"), "--exr", str(ours), "-q", "--force", *close],
         check=True,
     )
     with OpenEXR.File(str(ours)) as f:
@@ -173,9 +176,10 @@ def swatch_pair(table, tmp_path, periods=None):
         else:
             img_ours = np.stack([np.asarray(ch[c].pixels, dtype=np.float64) for c in "RGB"], axis=-1)
     to = np.array(light) / np.linalg.norm(light)
-    bsdf = {"type": "clothbake", "table": str(table)}
+    bsdf = {"type": "clothbake", "weave": str(weave)} if weave else {"type": "clothbake", "table": str(table)}
     if periods:
         bsdf["periods"] = float(periods)
+    spp = spp or (64 if periods else 16)
     sc = mi.load_dict({
         "type": "scene",
         "integrator": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 0},
@@ -184,14 +188,14 @@ def swatch_pair(table, tmp_path, periods=None):
             "to_world": mi.ScalarTransform4f().look_at(origin=eye, target=[0, 0, 0], up=[0, 0, 1]),
             "film": {"type": "hdrfilm", "width": res, "height": res, "rfilter": {"type": "box"},
                      "pixel_format": "rgb"},
-            "sampler": {"type": "independent", "sample_count": 64 if periods else 16},
+            "sampler": {"type": "independent", "sample_count": spp},
         },
         "shape": {"type": "rectangle", "to_world": mi.ScalarTransform4f().scale([30, 30, 1]),
                   "bsdf": bsdf},
         "light": {"type": "directional", "direction": (-to).tolist(),
                   "irradiance": {"type": "rgb", "value": [E, E, E]}},
     })
-    img_mi = render(sc, 64 if periods else 16)
+    img_mi = render(sc, spp)
     assert img_ours.shape == img_mi.shape
     return img_ours, img_mi
 
@@ -223,7 +227,7 @@ def test_plugin_shows_the_weave_of_a_spatial_table(twill_path, tmp_path, figures
     table = tmp_path / "gingham.exr"
     gingham = clothbake.Fabric(str(twill_path.parent / "gingham.wif"))
     clothbake.bake(gingham, res=(8, 16, 8, 16), spatial=True).save(table, precision="f32")
-    img_ours, img_mi = swatch_pair(table, tmp_path, periods=6)
+    img_ours, img_mi = swatch_pair(table, tmp_path, periods=6, spp=256, aa=8)
     save_png(np.concatenate([img_mi, img_ours], axis=1), figures_dir / "mitsuba-gingham-close.png")
     mask = np.ones(img_mi.shape[:2], dtype=bool)
     e = rel_rmse(img_mi, img_ours, mask)
@@ -233,3 +237,21 @@ def test_plugin_shows_the_weave_of_a_spatial_table(twill_path, tmp_path, figures
     print(f"relative RMSE plugin vs render --periods: {e:.4f} (vs the averaged picture {e_flat:.4f})")
     assert e < 0.08
     assert e_flat > 2 * e
+
+
+def test_plugin_shows_the_yarns_up_close(twill_path, tmp_path, figures_dir):
+    """weave= with periods=: the yarns traced up close (round, highlights along the floats,
+    shadows, gaps) by the plugin against `render --weave --periods --gaps`, the same fabric
+    and points of the weave period; the plugin's pixel filter averages single points, ours
+    integrates each sample's footprint."""
+    img_ours, img_mi = swatch_pair(None, tmp_path, periods=4, weave=twill_path, spp=1024, aa=8)
+    save_png(np.concatenate([img_mi, img_ours], axis=1), figures_dir / "mitsuba-twill-yarns.png")
+    mask = np.ones(img_mi.shape[:2], dtype=bool)
+    e = rel_rmse(img_mi, img_ours, mask)
+    # Far from the averaged model's picture: the yarns show.
+    flat, _ = swatch_pair(None, tmp_path, weave=twill_path)
+    e_flat = rel_rmse(img_mi, flat, mask)
+    print(f"relative RMSE plugin vs render --weave --periods 4 --gaps: {e:.4f} "
+          f"(vs the averaged picture {e_flat:.4f})")
+    assert e < 0.02
+    assert e_flat > 5 * e

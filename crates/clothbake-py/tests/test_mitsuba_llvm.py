@@ -107,7 +107,7 @@ def close(a, b, rtol=2e-3, atol=1e-5, share=0.0):
     return bad.mean() <= share, f"{bad.sum()} of {len(bad)} lanes differ"
 
 
-@pytest.mark.parametrize("kind", ["table", "weave", "periods"])
+@pytest.mark.parametrize("kind", ["table", "weave", "periods", "yarns"])
 def test_wavefront_matches_scalar_lane_by_lane(kind, twill_path, tables):
     """The same N lanes through the scalar plugin (one native call per lookup) and the llvm
     plugin (one batch call per method): eval, pdf and sample agree lane by lane."""
@@ -115,6 +115,7 @@ def test_wavefront_matches_scalar_lane_by_lane(kind, twill_path, tables):
         "table": {"type": "clothbake", "table": str(tables["twill"])},
         "weave": {"type": "clothbake", "weave": str(twill_path)},
         "periods": {"type": "clothbake", "table": str(tables["gingham"]), "periods": 3.0},
+        "yarns": {"type": "clothbake", "weave": str(twill_path), "periods": 3.0},
     }[kind]
     data = lanes()
     s = scalar_answers(props, data)
@@ -127,6 +128,10 @@ def test_wavefront_matches_scalar_lane_by_lane(kind, twill_path, tables):
         # Sampling the table inverts a CDF: where float32 rounding of the frame moves a lane
         # across a cell boundary its sample differs; allow that for a few lanes.
         share = 0.01 if name.startswith("sample") and kind != "weave" else 0.0
+        # The yarns traced: where float32 rounding moves a lane's eye ray across a yarn's
+        # edge or a shadow's, it meets another point; allow that for a few lanes.
+        if kind in ("yarns", "periods"):
+            share = max(share, 0.02)
         ok, why = close(b, a, share=share)
         assert ok, f"{kind} {name}: {why}"
 

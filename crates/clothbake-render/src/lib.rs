@@ -17,7 +17,7 @@ use camera::Camera;
 use clothbake_core::Footprint;
 use rayon::prelude::*;
 use scene::Scene;
-use shade::{radiance_at, Lighting, Shader};
+use shade::{shade_at, Lighting, Shader};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use tonemap::Image;
 
@@ -104,7 +104,10 @@ impl Weave {
     }
 }
 
-/// The value of pixel (i, j): the mean of its samples.
+/// The value of pixel (i, j): the mean of its samples. With `--gaps` each sample counts with
+/// its coverage; without, samples that show a gap (coverage 0, the point level) are left out
+/// of the mean of those that meet the cloth, which is then weighted by the share of the
+/// pixel's samples that meet the surface.
 #[allow(clippy::too_many_arguments)]
 fn pixel(
     scene: &Scene,
@@ -117,6 +120,7 @@ fn pixel(
     j: u32,
 ) -> [f32; 3] {
     let mut sum = [0.0f64; 3];
+    let (mut surface, mut gaps) = (0u32, 0u32);
     for b in 0..aa {
         for a in 0..aa {
             let (sx, sy) = (
@@ -131,13 +135,30 @@ fn pixel(
                     let t = (hit.point - ray.origin).length();
                     w.footprint(&hit, t, wo.z)
                 });
-                let v = radiance_at(shader, lighting, wi, wo, at);
-                for k in 0..3 {
-                    sum[k] += v[k];
+                let (v, c) = shade_at(shader, lighting, wi, wo, at);
+                surface += 1;
+                if shader.shows_gaps() {
+                    for k in 0..3 {
+                        sum[k] += v[k] * c;
+                    }
+                } else if c == 0.0 && at.is_some() && wo.z > 0.0 {
+                    gaps += 1;
+                } else {
+                    for k in 0..3 {
+                        sum[k] += v[k];
+                    }
                 }
             }
         }
     }
     let n = f64::from(aa * aa);
-    sum.map(|s| (s / n) as f32)
+    if gaps == 0 {
+        return sum.map(|s| (s / n) as f32);
+    }
+    let yarn = f64::from(surface - gaps);
+    if yarn == 0.0 {
+        return [0.0; 3];
+    }
+    let share = f64::from(surface) / n;
+    sum.map(|s| (s / yarn * share) as f32)
 }

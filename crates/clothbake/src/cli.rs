@@ -502,6 +502,12 @@ pub struct EvalArgs {
     #[arg(long, value_name = "U,V", value_parser = parse_period_point, allow_hyphen_values = true)]
     pub at: Option<clothbake_core::PeriodPoint>,
 
+    /// With --at: the side of the footprint around the point, in periods (0: the point itself;
+    /// 1 or more: the whole period). The footprint's level of detail answers: the yarns traced
+    /// at the point (one bounce), the crossing cells, or the period (docs/spatial.md).
+    #[arg(long, value_name = "W", value_parser = parse_width, requires = "at", allow_hyphen_values = true)]
+    pub width: Option<f64>,
+
     /// Print one JSON object instead of a table: keys I_d, I_s, I (reflected intensity for unit
     /// incident intensity) and brdf (1/sr), each [r, g, b]; with --bounces 2 also I_ss, I_sd,
     /// I_ds, I_dd and I_2 (I is then I_1 + I_2); raytrace adds std_err ([r, g, b], null when
@@ -1104,6 +1110,13 @@ pub struct RenderArgs {
     #[arg(long)]
     pub gaps: bool,
 
+    /// The ground-truth picture (with --weave and --periods): each sample's ray continues into
+    /// the fabric's explicit yarns, tiled over the surface in its tangent frame, with a shadow
+    /// ray through the same yarns (one bounce). The reference every level of detail is
+    /// measured against (docs/spatial.md).
+    #[arg(long)]
+    pub truth: bool,
+
     /// Ambient coefficient rho_a (thesis sec. 4.3 uses 0.3).
     #[arg(long, value_name = "RHO_A", value_parser = parse_ambient, default_value = "0.3")]
     pub ambient: f64,
@@ -1252,6 +1265,18 @@ pub fn parse_aa(s: &str) -> Result<u32, String> {
         Ok(n) if (1..=16).contains(&n) => Ok(n),
         _ => Err(format!(
             "`{}` is not a whole number from 1 to 16; give the samples per pixel side, e.g. --aa 2",
+            s.trim()
+        )),
+    }
+}
+
+/// Parses `--width`: a footprint's side in periods, 0 to 10^6.
+pub fn parse_width(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(w) if (0.0..=1e6).contains(&w) => Ok(w),
+        _ => Err(format!(
+            "`{}` is not a footprint width from 0 to 1000000 periods; give e.g. --width 0.1 \
+             (0: the point itself)",
             s.trim()
         )),
     }

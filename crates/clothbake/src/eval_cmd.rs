@@ -6,8 +6,9 @@ use crate::report::{self, Report};
 use clothbake_core::interreflection::Ranges;
 use clothbake_core::pathtrace::PathOptions;
 use clothbake_core::{
-    AnalyticModel, Caps, Fabric, FabricError, FacetModel, PlainNaming, RayTracer, Reflection,
-    Secondary, SecondaryMethod, SecondaryOptions, Transport, Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, Caps, Component, Fabric, FabricError, FacetModel, Footprint,
+    Level, PlainNaming, RayTracer, Reflection, Secondary, SecondaryMethod, SecondaryOptions,
+    Transport, UnitVec3, Variant,
 };
 use std::path::Path;
 
@@ -60,6 +61,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     let horizon = !(args.wi.above_horizon() && args.wo.above_horizon());
 
     let mut local = None;
+    let mut footprint_seen = None;
     let transport = full.then(|| {
         let samples = args.samples.unwrap_or(DEFAULT_SAMPLES);
         let seed = args.seed.unwrap_or(DEFAULT_SEED);
@@ -70,27 +72,40 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
         Method::Analytic => {
             let model = AnalyticModel::with_variant(&fabric, facet, args.model.variant.into());
             let coverage = if horizon { 0.0 } else { model.coverage(wo) };
-            // With --at, the cell's reflection and coverage from one evaluation.
             let at = args.at.map(|p| (p, model.cells().cell_at(p)));
-            let spot = at
-                .filter(|_| !horizon)
-                .map(|(p, _)| model.intensity_at(wi, wo, p, secondary.as_ref()));
             let r = if horizon {
                 Reflection {
                     secondary: secondary.map(|_| Secondary::default()),
                     ..Reflection::default()
                 }
-            } else if let Some(l) = &spot {
-                l.reflection
             } else {
                 model.intensity_with(wi, wo, secondary.as_ref())
             };
+            // With --at, the footprint through the BSDF (docs/spatial.md): f_r and coverage
+            // from one call, at the level of detail its width asks for.
+            let seen = at.map(|(p, _)| {
+                let fp = Footprint {
+                    u: p.u(),
+                    v: p.v(),
+                    width: args.width.unwrap_or(0.0),
+                };
+                footprint(
+                    &fabric,
+                    facet,
+                    args.model.variant.into(),
+                    secondary,
+                    fp,
+                    wi,
+                    wo,
+                )
+            });
             local = Some(report::Local {
                 directional_coverage: coverage,
                 warp_on_top: at
                     .is_some_and(|(_, cell)| fabric.weave().warp_over(cell.warp, cell.weft)),
-                at: at.map(|(p, cell)| (p, cell, spot.map_or(0.0, |l| l.coverage))),
+                at: at.map(|(p, cell)| (p, cell, seen.map_or(0.0, |s| s.1))),
             });
+            footprint_seen = seen.map(|s| s.0);
             (r, None)
         }
         Method::Raytrace => {
@@ -158,6 +173,8 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     });
     let brdf = if horizon {
         [0.0; 3]
+    } else if let Some(f) = &footprint_seen {
+        f.i.map(|i| i / (std::f64::consts::PI * wi.cos_theta()))
     } else if let Some(t) = &transport {
         clothbake_core::intensity_to_brdf(t.total, wi)
     } else {
@@ -198,8 +215,58 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
         raytrace,
         local,
         transport,
+        footprint: footprint_seen,
     };
     Ok(if args.json { rep.json() } else { rep.table() })
+}
+
+/// The reflection of a footprint through the model's BSDF (`Bsdf::local`), with the fabric's
+/// yarns for the point level at one bounce, and its coverage. With two bounces its I_2 from the
+/// same footprint (`Component::Secondary`: the crossing cells or the period).
+fn footprint(
+    fabric: &Fabric,
+    facet: FacetModel,
+    variant: Variant,
+    secondary: Option<SecondaryOptions>,
+    at: Footprint,
+    wi: UnitVec3,
+    wo: UnitVec3,
+) -> (report::AtFootprint, f64) {
+    let model = || AnalyticModel::with_variant(fabric, facet, variant);
+    let mut bsdf = AnalyticBsdf::new(model(), secondary);
+    if secondary.is_none() {
+        bsdf = bsdf.with_yarns(clothbake_core::point::yarns(fabric, facet));
+    }
+    let cell = bsdf.cell_width();
+    let level = match at.level(cell) {
+        Level::Period => "the period (averaged)",
+        Level::Local { point, points, .. } if secondary.is_none() && point >= 1.0 => {
+            if points == 1 {
+                "the point (the yarns traced)"
+            } else {
+                "the point level over the footprint (the yarns traced)"
+            }
+        }
+        Level::Local { point, .. } if secondary.is_none() && point > 0.0 => {
+            "the point level and the crossing cells, blended"
+        }
+        Level::Local { .. } => "the crossing cells",
+    };
+    let l = bsdf.local(at, wi, wo);
+    let k = std::f64::consts::PI * wi.cos_theta();
+    let i2 = secondary.and_then(|_| {
+        let b = AnalyticBsdf::new(model(), secondary).with_component(Component::Secondary)?;
+        Some(b.f_at(at, wi, wo).map(|f| f * k))
+    });
+    (
+        report::AtFootprint {
+            width: at.width,
+            level,
+            i: l.f.map(|f| f * k),
+            i2,
+        },
+        l.coverage,
+    )
 }
 
 /// How the analytic model computes I_2, in words: the solution with its quadrature orders or

@@ -118,6 +118,13 @@ pub fn run(args: &InfoArgs) -> Result<String, CliError> {
     if let Some(sp) = &m.spatial {
         spatial_lines(&mut s, sp);
     }
+    if let Some(y) = &m.yarns {
+        let _ = writeln!(
+            s,
+            "yarns      {} yarn segments of the period: footprints under a crossing cell trace them (the point level, docs/spatial.md)",
+            y.yarns().len()
+        );
+    }
     let [min, max, mean] = channel_stats(&t);
     let _ = writeln!(s, "values     {:>12} {:>12} {:>12}", "R", "G", "B");
     for (name, v) in [("min", min), ("max", max), ("mean", mean)] {

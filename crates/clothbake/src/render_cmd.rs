@@ -80,6 +80,35 @@ fn component_name(c: ComponentArg) -> &'static str {
     }
 }
 
+/// The ground truth's shader of `render --truth`: the fabric of --weave, one bounce, with
+/// --periods.
+fn truth_shader(a: &RenderArgs) -> Result<Shader, CliError> {
+    let b = &a.brdf;
+    let Some(weave) = &b.weave else {
+        return Err(CliError::new(
+            "--truth traces a fabric's yarns, and no --weave was given",
+            "give --weave FILE (e.g. tables/twill.json) with --truth",
+        ));
+    };
+    if a.periods.is_none() {
+        return Err(CliError::new(
+            "--truth needs --periods: the yarns are tiled over the surface N periods across",
+            "add --periods N (e.g. --periods 8)",
+        ));
+    }
+    if b.bounces.bounces != 1 || b.component != ComponentArg::Total {
+        return Err(CliError::new(
+            "--truth traces one bounce, whole",
+            "drop --bounces and --component with --truth",
+        ));
+    }
+    let fabric = apply_material(
+        crate::fabrics::read(weave, &Default::default())?,
+        &b.material,
+    )?;
+    Ok(Shader::truth(&fabric, FacetModel::from(b.model.facet), 1))
+}
+
 /// The shader of a baked table (the loader's interpolated lookup).
 fn table_shader(path: &Path) -> Result<Shader, CliError> {
     Shader::table(path).map_err(|e| table_error(&e))
@@ -164,6 +193,7 @@ const RENDER_BAR: &str = "{elapsed_precise} [{wide_bar}] {percent:>3}% {pos}/{le
 pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
     let mut srcs = sources(&a.brdf, 1)?;
     let (_, shader) = srcs.pop().expect("one source");
+    let shader = if a.truth { truth_shader(a)? } else { shader };
     let shader = if a.gaps { shader.with_gaps() } else { shader };
     let mut outputs = vec![(a.output.as_path(), "PNG image")];
     if let Some(e) = &a.exr {

@@ -27,6 +27,20 @@ pub struct Local {
     pub warp_on_top: bool,
 }
 
+/// What `--at` reports: the footprint's reflection through the BSDF (`Bsdf::local`), one value
+/// per level of detail, so without the split into I_d and I_s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AtFootprint {
+    /// The footprint's side in periods.
+    pub width: f64,
+    /// The level of detail that answered, in words.
+    pub level: &'static str,
+    /// The reflected intensity I = pi cos(theta_i) f_r.
+    pub i: [f64; 3],
+    /// With two bounces: its I_2 (the crossing cells' or the period's).
+    pub i2: Option<[f64; 3]>,
+}
+
 /// Full transport (`--bounces N > 2`, `all`): the energy of every order and the split of I_2.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Transport {
@@ -93,6 +107,8 @@ pub struct Report<'a> {
     pub local: Option<Local>,
     /// Present with --bounces N > 2 or all.
     pub transport: Option<Transport>,
+    /// Present with --at: the footprint's reflection, which replaces `reflection`'s rows.
+    pub footprint: Option<AtFootprint>,
 }
 
 impl Report<'_> {
@@ -105,7 +121,17 @@ impl Report<'_> {
             "I": self.reflection.total(),
             "brdf": self.brdf,
         });
-        if let Some(s2) = &self.reflection.secondary {
+        if let Some(f) = &self.footprint {
+            v = json!({
+                "I": f.i,
+                "brdf": self.brdf,
+                "width": f.width,
+                "level": f.level,
+            });
+            if let Some(i2) = f.i2 {
+                v["I_2"] = json!(i2);
+            }
+        } else if let Some(s2) = &self.reflection.secondary {
             v["I_ss"] = json!(s2.ss);
             v["I_sd"] = json!(s2.sd);
             v["I_ds"] = json!(s2.ds);
@@ -211,9 +237,16 @@ impl Report<'_> {
                 v[0], v[1], v[2]
             );
         };
-        row(&mut s, "I_d", self.reflection.i_d, "");
-        row(&mut s, "I_s", self.reflection.i_s, "");
-        if let Some(s2) = &self.reflection.secondary {
+        if let Some(f) = &self.footprint {
+            if let Some(i2) = f.i2 {
+                row(&mut s, "I_2", i2, "");
+            }
+            row(&mut s, "I", f.i, "");
+        } else {
+            row(&mut s, "I_d", self.reflection.i_d, "");
+            row(&mut s, "I_s", self.reflection.i_s, "");
+        }
+        if let (None, Some(s2)) = (&self.footprint, &self.reflection.secondary) {
             row(&mut s, "I_ss", s2.ss, "");
             row(&mut s, "I_sd", s2.sd, "");
             row(&mut s, "I_ds", s2.ds, "");
@@ -230,13 +263,17 @@ impl Report<'_> {
             row(&mut s, "I_2 perp", t.i2_split[1], &err(t.i2_split_err[1]));
             row(&mut s, "I_2..", t.multiple.0, &err(t.multiple.1));
             row(&mut s, "I", t.total, "");
-        } else {
+        } else if self.footprint.is_none() {
             row(&mut s, "I", self.reflection.total(), "");
         }
         row(&mut s, "brdf", self.brdf, "  1/sr");
         if let Some(l) = &self.local {
-            if let Some((_, _, c)) = l.at {
-                let _ = writeln!(s, "coverage {c:.6}  (visible yarn over the cell)");
+            if let (Some((_, _, c)), Some(f)) = (l.at, &self.footprint) {
+                let _ = writeln!(
+                    s,
+                    "coverage {c:.6}  (visible yarn over the footprint, {} periods wide: {})",
+                    f.width, f.level
+                );
             }
             let _ = writeln!(
                 s,

@@ -730,6 +730,37 @@ fn eval_at_a_point_of_the_period() {
         &["--wi", "60,0", "--wo", "20,180", "--at", "0.7,0.05"],
     ));
     assert!(text.contains("weft 0 over warp 2"), "{text}");
+    // A footprint of a period or more is the period's average; from two cells wide the
+    // crossing cells answer, below a cell the yarns traced; the level is named.
+    let wide = |p: &str, w: &str| {
+        let mut a = dirs.to_vec();
+        a.extend(["--at", p, "--width", w]);
+        eval_json(&twill, &a)
+    };
+    assert_eq!(wide("0.3,0.4", "1")["brdf"], avg["brdf"]);
+    assert!(wide("0.3,0.4", "1")["level"]
+        .as_str()
+        .unwrap()
+        .contains("period"));
+    assert!(wide("0.3,0.4", "0.7")["level"]
+        .as_str()
+        .unwrap()
+        .contains("cells"));
+    let point = wide("0.3,0.4", "0");
+    assert!(point["level"].as_str().unwrap().contains("point"));
+    assert_eq!(point["brdf"], at("0.3,0.4")["brdf"]);
+    assert!(point.get("I_d").is_none() && point.get("I").is_some());
+    fails(
+        &eval(&twill, &["--wi", "0,0", "--wo", "0,0", "--width", "0.1"]),
+        &["--at"],
+    );
+    fails(
+        &eval(
+            &twill,
+            &["--wi", "0,0", "--wo", "0,0", "--at", "0,0", "--width", "-1"],
+        ),
+        &["width"],
+    );
     // Bad points and the ray tracer are refused in one line.
     fails(
         &eval(&twill, &["--wi", "0,0", "--wo", "0,0", "--at", "nan,0"]),

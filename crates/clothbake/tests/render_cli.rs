@@ -334,3 +334,63 @@ fn periods_show_the_weave_up_close_and_the_average_from_afar() {
         c.len()
     );
 }
+
+/// The model's swatch (64 x 48, one sample a pixel) from `--weave` with `extra` flags.
+fn model_swatch(fabric: &str, extra: &[&str], name: &str) -> Vec<[f32; 3]> {
+    let (png_path, exr_path) = (temp(&format!("{name}.png")), temp(&format!("{name}.exr")));
+    let w = weave(fabric);
+    let mut args = vec![
+        "--weave", &w, "--scene", "swatch", "--eye", "0,-30,40", "--res", "64,48",
+    ];
+    args.extend(extra);
+    succeeds(&render_args(&args, &png_path, &exr_path));
+    read_rgb(&exr_path, 64)
+}
+
+#[test]
+fn the_yarns_up_close_are_the_ground_truths_picture() {
+    // Half a period across the swatch: every sample's footprint is under an eighth of a
+    // crossing cell, so the model answers at the point level with one look, which traces the
+    // same yarns as the ray tracer of `--truth` (an independent code) with one look too. The
+    // pictures agree pixel for pixel to rounding; far away the model's picture is the
+    // averaged one.
+    let yarns = model_swatch("twill", &["--periods", "0.5"], "yarns");
+    let truth = model_swatch("twill", &["--periods", "0.5", "--truth"], "truth");
+    let top = truth.iter().flatten().cloned().fold(0.0f32, f32::max);
+    assert!(top > 0.1);
+    let worst = yarns
+        .iter()
+        .flatten()
+        .zip(truth.iter().flatten())
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
+    assert!(worst <= 1e-4 * top, "{worst} of {top}");
+    // Up close the yarns show: dark gaps and shadows beside bright highlights, and the
+    // picture differs from the averaged one.
+    let avg = model_swatch("twill", &[], "avg-model");
+    let lum = |p: &[f32; 3]| p[0] + p[1] + p[2];
+    let spread = |px: &[[f32; 3]]| {
+        let l: Vec<f32> = px.iter().map(lum).filter(|&l| l > 0.0).collect();
+        let hi = l.iter().cloned().fold(0.0, f32::max);
+        let lo = l.iter().cloned().fold(f32::MAX, f32::min);
+        hi / lo.max(1e-6)
+    };
+    assert!(
+        spread(&yarns) > 2.0 * spread(&avg),
+        "{} {}",
+        spread(&yarns),
+        spread(&avg)
+    );
+    // Far away, every footprint a period or more: the averaged picture, value for value.
+    assert_eq!(
+        model_swatch("twill", &["--periods", "100000"], "far-model"),
+        avg
+    );
+    // --truth needs the fabric and --periods.
+    let (png, exr) = (temp("t.png"), temp("t.exr"));
+    let w = weave("twill");
+    fails(
+        &clothbake(&render_args(&["--weave", &w, "--truth"], &png, &exr)),
+        &["--truth", "--periods"],
+    );
+}

@@ -167,6 +167,8 @@ fn spatial_bakes_are_the_same_for_any_thread_count_and_shard_split() {
     identical(&d, "one.exr", "merged.exr");
     let info = succeeds(&run_in(&d, &["info", "merged.exr"]));
     assert!(info.contains("spatial    3 classes over 3 x 3"), "{info}");
+    // The period's yarns travel through shards and merge: the twill's 6 segments.
+    assert!(info.contains("yarns      6 yarn segments"), "{info}");
     // Against the averaged bake, `diff` compares the averaged parts: equal to rounding.
     succeeds(&run_in(
         &d,

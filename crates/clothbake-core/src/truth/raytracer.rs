@@ -252,6 +252,32 @@ impl RayTracer {
         })
     }
 
+    /// The reference plane's height, where a renderer's mesh of the cloth lies (docs/spatial.md,
+    /// "The reference plane"): halfway between the floor and the top of the highest yarn.
+    pub fn reference_height(&self) -> f64 {
+        0.5 * self.yarns.top()
+    }
+
+    /// f_r at the point (u, v) of the reference plane (period fractions, wrapped): the facet
+    /// intensity over pi cos(theta_i) where the eye ray crossing the plane there toward `wo`
+    /// meets a yarn (zero where the light is blocked), `None` where it shows a gap (the floor,
+    /// or a cap with [`Caps::Excluded`]) or a direction is at or below the horizon. The
+    /// ground-truth picture of `render --truth` is made of these.
+    pub fn look_at(&self, u: f64, v: f64, wi: UnitVec3, wo: UnitVec3) -> Option<[f64; 3]> {
+        if !(wi.above_horizon() && wo.above_horizon() && u.is_finite() && v.is_finite()) {
+            return None;
+        }
+        let (px, py) = self.yarns.period;
+        let z_ref = self.reference_height();
+        // Back along the eye ray from the plane to the top plane.
+        let back = (self.z_top - z_ref) / wo.z;
+        let o = Vec3::new(u.rem_euclid(1.0) * px, v.rem_euclid(1.0) * py, z_ref) + wo.get() * back;
+        let (s, c) = self.shade(o, wi, wo)?;
+        let albedo = self.cylinder(&c).finish.albedo;
+        let k = 1.0 / (std::f64::consts::PI * wi.cos_theta());
+        Some(albedo.map(|a| (s.diffuse * a + s.specular) * k))
+    }
+
     /// Traces `m` stratified primary rays over one period into `sums`.
     fn batch(&self, wi: UnitVec3, wo: UnitVec3, m: usize, rng: &mut Rng, sums: &mut BatchSums) {
         for o in self.origins(m, rng) {

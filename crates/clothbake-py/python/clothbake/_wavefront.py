@@ -48,12 +48,19 @@ def _directions(cloth, eye, light, active):
     return ok, eye, light, flip
 
 
-def _f(cloth, light, eye, uv):
-    """f_r (N, 3) float64 of each row: the table (at the points uv of the period when
-    ``periods`` is set) or the model."""
-    if cloth.table is not None and cloth.periods is not None:
-        f, _ = cloth.table.eval_at(light, eye, uv * cloth.periods, 0.0)
-        return np.asarray(f, dtype=np.float64)
+def _f(cloth, light, eye, uv, width=None):
+    """f_r (N, 3) float64 of each row: with ``periods``, at the points uv of the period
+    through footprints ``width`` periods wide, times their coverage (the cloth over black);
+    else the averaged table or the model."""
+    if cloth.periods is not None:
+        w = np.zeros(len(uv)) if width is None else width
+        if cloth.table is not None:
+            f, c = cloth.table.eval_at(light, eye, uv * cloth.periods, w)
+        else:
+            s = cloth.fabric.eval(light, eye, facet=cloth.facet, uv=uv * cloth.periods,
+                                  width=w, split=True)
+            f, c = s["brdf"], s["coverage"]
+        return np.asarray(f, dtype=np.float64) * np.asarray(c, dtype=np.float64)[:, None]
     if cloth.table is not None:
         return np.asarray(cloth.table.eval(light, eye), dtype=np.float64)
     return cloth.fabric.eval(light, eye, facet=cloth.facet)
@@ -110,8 +117,22 @@ def wavefront_class(mi, dr, Cloth):
                 return None
             return np.asarray(si.uv, dtype=np.float64).reshape(2, -1).T
 
+        def _width(self, si, n):
+            """Each lane's footprint side in periods from the ray differentials (0 without)."""
+            if self._cloth.periods is None:
+                return None
+            def length(d):
+                a = np.asarray(d, dtype=np.float64).reshape(2, -1)
+                if a.shape[1] not in (1, n):
+                    return np.zeros(n)  # not computed: the point
+                return np.broadcast_to(np.hypot(a[0], a[1]), (n,))
+
+            side = np.maximum(length(si.duv_dx), length(si.duv_dy))
+            return np.where(np.isfinite(side), side * self._cloth.periods, 0.0)
+
         def _value(self, si, ok, eye, light):
-            f = _f(self._cloth, light, eye, self._uv(si)) * light[:, 2:3]
+            uv = self._uv(si)
+            f = _f(self._cloth, light, eye, uv, self._width(si, len(eye))) * light[:, 2:3]
             return np.where(ok[:, None], f, 0.0)
 
         def _density(self, ok, eye, light):
@@ -147,14 +168,14 @@ def wavefront_class(mi, dr, Cloth):
                 if self._cloth.periods is not None:
                     # Sampled from the averaged table; weighted by the point's own f_r.
                     lu = _unit(np.where(ok[:, None], light, [0.0, 0.0, 1.0]))
-                    f = _f(self._cloth, lu, eye, self._uv(si))
+                    f = _f(self._cloth, lu, eye, self._uv(si), self._width(si, n))
                     weight = f * lu[:, 2:3] / np.where(ok, pdf, 1.0)[:, None]
             else:
                 w = _rows(mi.warp.square_to_cosine_hemisphere(sample2))
                 pdf = w[:, 2] / np.pi
                 ok &= pdf > 0.0
                 lu = _unit(np.where(ok[:, None], w, [0.0, 0.0, 1.0]))
-                weight = np.pi * self._cloth.fabric.eval(lu, eye, facet=self._cloth.facet)
+                weight = np.pi * _f(self._cloth, lu, eye, self._uv(si), self._width(si, n))
                 light = w
             weight = np.where(ok[:, None], weight, 0.0)
             pdf = np.where(ok, pdf, 0.0)

@@ -4,12 +4,19 @@ After ``register()``, scenes can use ``{"type": "clothbake", "table": "twill.exr
 baked table: interpolated lookup and the loader's importance sampling) or
 ``{"type": "clothbake", "weave": "tables/twill.json"}`` (the analytic model evaluated
 directly; cosine-weighted sampling). Optional parameters: ``facet`` ("huo" | "lewis", weave
-only), ``two_sided`` (bool, default True), ``periods`` (float, table only: weave periods per
-unit of the surface's UV; each lookup is then at the point (u, v) * periods of the weave period,
-so a table baked with ``spatial=True`` / ``--spatial`` shows the weave up close,
-docs/spatial.md; the pixel filter and the samples per pixel do the footprint's averaging, so
-use it where a pixel covers about a period or less; farther away leave it out and the
-averaged table answers).
+only), ``two_sided`` (bool, default True), ``periods`` (float: weave periods per unit of the
+surface's UV). With ``periods`` each lookup is at the point (u, v) * periods of the weave period
+through its footprint, at the footprint's level of detail (docs/spatial.md): with ``weave=``
+the yarns are traced up close (round yarns, highlights along the floats, shadows, gaps), the
+crossing cells answer from two cells wide and the average from a period; a table baked with
+``spatial=True`` / ``--spatial`` (one bounce) carries its yarns and answers alike, another
+spatial table shows its cells. The footprint is the UV footprint of the ray differentials
+where Mitsuba provides them (``si.duv_dx``, ``si.duv_dy``; its side the larger of the two
+lengths, times ``periods``); where they are zero the footprint is the point, and the pixel
+filter and the samples per pixel do the averaging. With ``periods`` the cloth is drawn over
+black, as ``clothbake render --periods N --gaps`` draws it: each value is f_r times the
+footprint's coverage, so a point that shows a gap between the yarns is black (the thesis's
+floor; no light passes through the cloth).
 
 Frame: the cloth's +X (the weft) follows the surface's ``dp_du`` (the U texture direction),
 made orthogonal to the shading normal; +Y (the warp) is ``n x s``, along V on a regular
@@ -54,10 +61,9 @@ class Cloth:
         self.facet = str(props.get("facet", "huo"))
         self.two_sided = bool(props.get("two_sided", True))
         self.periods = float(props["periods"]) if "periods" in props else None
-        if self.periods is not None and (self.table is None or not self.periods > 0.0):
+        if self.periods is not None and not (0.0 < self.periods < math.inf):
             raise ValueError(
-                "clothbake BSDF: periods= (weave periods per UV unit, > 0) goes with table= "
-                "(a table baked with spatial=True shows the weave)"
+                "clothbake BSDF: periods= is the weave periods per UV unit, a finite number > 0"
             )
         self.source = str(props["table"] if has_table else props["weave"])
 
@@ -151,10 +157,23 @@ def register():
                 return None
             return light, _unit(eye), frame, flip
 
+        def _width(self, si):
+            """The footprint's side in periods from the ray differentials (0 without them)."""
+            dx, dy = si.duv_dx, si.duv_dy
+            side = max(math.hypot(float(dx[0]), float(dx[1])),
+                       math.hypot(float(dy[0]), float(dy[1])))
+            return side * self._periods if math.isfinite(side) else 0.0
+
         def _f(self, light, eye, si=None):
-            if self._table is not None and self._periods is not None and si is not None:
+            """f_r, times the footprint's coverage with ``periods``."""
+            if self._periods is not None and si is not None:
                 u, v = float(si.uv[0]) * self._periods, float(si.uv[1]) * self._periods
-                return self._table.eval1_at(light, eye, u, v, 0.0)
+                w = self._width(si)
+                if self._table is not None:
+                    f, c = self._table.eval1_local(light, eye, u, v, w)
+                else:
+                    f, c = self._fabric.eval1_at(light, eye, u, v, w, self._facet)
+                return tuple(x * c for x in f)
             if self._table is not None:
                 return self._table.eval1(light, eye)
             return self._fabric.eval1(light, eye, self._facet)
@@ -201,7 +220,7 @@ def register():
                 w = mi.warp.square_to_cosine_hemisphere(sample2)
                 light = [float(w[0]), float(w[1]), float(w[2])]
                 pdf = light[2] / math.pi
-                f = self._fabric.eval1(_unit(light), eye, self._facet) if pdf > 0 else (0, 0, 0)
+                f = self._f(_unit(light), eye, si) if pdf > 0 else (0, 0, 0)
                 weight = tuple(math.pi * x for x in f)
             if pdf <= 0.0:
                 return bs, mi.Color3f(0.0)
