@@ -14,9 +14,19 @@
 //!   draft on the swatch seen close (eye (0, -20, 24), 40 degrees of view, light from the
 //!   side toward (0.8, -0.2, 0.56)),
 //!   each from its averaged table (left) and from its spatial table with 16 weave periods
-//!   across the swatch (`render --periods 16`, right); tables baked with `--spatial` on a
-//!   16 x 32 x 16 x 32 grid, direct reflection.
+//!   across the swatch (`render --periods 16`, right: the table carries its yarns, so up close
+//!   they are traced); tables baked with `--spatial` on a 16 x 32 x 16 x 32 grid, direct
+//!   reflection.
 //!
+//! * `yarns.png` (`yarns [--thunderloom DIR]`): the yarns up close (docs/spatial.md, the point
+//!   level): the twill, satin5, the denim draft, the gingham and an open plain weave (radius
+//!   1, spacing 3.1: gaps between the yarns) on the swatch seen close (eye (0, -14, 16), 40
+//!   degrees of view, about six threads across the view, light from the side toward
+//!   (0.8, -0.2, 0.56), no ambient, 3 x 3 samples a pixel), one row each: the model's levels
+//!   of detail (`render --weave --periods`), the ground truth (`render --truth`) and, with
+//!   `--thunderloom DIR`, ThunderLoom's Irawan model of the same pattern and thread colours at
+//!   the same shading points (`xtask/peer/thunderloom_shade.c`, compiled beside the fetched
+//!   `thunderloom.h` in DIR; ThunderLoom is not shipped). Without it the third column is black.
 //! * `plot-slices.png`, `plot-hemisphere.png`, `plot-polar.png` (`plots`): `clothbake plot`'s
 //!   three kinds with the model: the twill's slices (the defaults: theta_i 0, 30, 60, 75 in the
 //!   planes phi_i 0, 45, 90), its hemisphere map for wi (40, 90), and the silk charmeuse's polar
@@ -193,6 +203,228 @@ fn up_close(root: &Path, dir: &Path, width: u32, height: u32) {
     eprintln!("up-close: {:.1} s", start.elapsed().as_secs_f64());
 }
 
+/// An open plain weave: thinner yarns than the thesis's at its spacing, gaps between them.
+const OPEN_PLAIN: &str = r#"{"name": "open plain", "pattern": [[1, 0], [0, 1]],
+  "warp": {"radius": 1.0, "spacing": 3.1, "material": {"albedo": [0.55, 0.45, 0.3], "specular": 0.3, "exponent": 10}},
+  "weft": {"radius": 1.0, "spacing": 3.1, "material": {"albedo": [0.55, 0.45, 0.3], "specular": 0.3, "exponent": 10}}}"#;
+
+/// The shading points of a picture, per pixel sample (row-major, `aa x aa` a pixel): (u, v) in
+/// periods and the light and eye directions in the cloth frame, or `None` off the surface.
+fn shading_points(
+    scene: &Scene,
+    cam: &Camera,
+    light: Vec3,
+    aa: u32,
+    periods: f64,
+) -> Vec<Option<[f32; 8]>> {
+    let per_length = periods / scene.width();
+    let mut out = Vec::new();
+    for j in 0..cam.height {
+        for i in 0..cam.width {
+            for b in 0..aa {
+                for a in 0..aa {
+                    let (sx, sy) = (
+                        (f64::from(a) + 0.5) / f64::from(aa),
+                        (f64::from(b) + 0.5) / f64::from(aa),
+                    );
+                    let ray = cam.ray(i, j, sx, sy);
+                    out.push(scene.intersect(&ray).map(|hit| {
+                        let (wi, wo) = (hit.to_local(light), hit.to_local(-ray.dir));
+                        let (wi, wo) = (unit(wi), unit(wo));
+                        [
+                            (hit.surface.0 * per_length) as f32,
+                            (hit.surface.1 * per_length) as f32,
+                            wi.x as f32,
+                            wi.y as f32,
+                            wi.z as f32,
+                            wo.x as f32,
+                            wo.y as f32,
+                            wo.z as f32,
+                        ]
+                    }));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// ThunderLoom's picture of `fabric` at the shading points (see the module documentation):
+/// each sample tl_shade's intensity times E / pi, as the model's pixel is f_r cos E.
+fn thunderloom(
+    dir: &Path,
+    fabric: &Fabric,
+    points: &[Option<[f32; 8]>],
+    irradiance: f64,
+    (w, h, aa): (u32, u32, u32),
+) -> Image {
+    use std::io::Write as _;
+    use std::process::{Command, Stdio};
+    let exe = dir.join("tl_shade");
+    if !exe.exists() {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("peer/thunderloom_shade.c");
+        let ok = Command::new("g++")
+            .args(["-x", "c++", "-O2", "-o"])
+            .arg(&exe)
+            .arg(&src)
+            .arg("-I")
+            .arg(dir)
+            .status()
+            .map(|s| s.success())
+            .unwrap_or(false);
+        assert!(
+            ok,
+            "could not compile {} beside {}",
+            src.display(),
+            dir.display()
+        );
+    }
+    let weave = fabric.weave();
+    let (nx, ny) = (weave.n_warp(), weave.n_weft());
+    let mut colours: Vec<[f32; 3]> = Vec::new();
+    let (mut above, mut types) = (Vec::new(), Vec::new());
+    for y in 0..ny {
+        for x in 0..nx {
+            let warp = weave.warp_over(x, y);
+            let m = if warp {
+                fabric.thread_material(clothbake_core::Group::Warp, x)
+            } else {
+                fabric.thread_material(clothbake_core::Group::Weft, y)
+            };
+            let c = m.albedo.map(|a| a as f32);
+            let k = colours.iter().position(|&d| d == c).unwrap_or_else(|| {
+                colours.push(c);
+                colours.len() - 1
+            });
+            above.push(u8::from(warp));
+            types.push((k + 1) as u8);
+        }
+    }
+    let mut input = Vec::new();
+    for v in [nx as u32, ny as u32, colours.len() as u32] {
+        input.extend(v.to_le_bytes());
+    }
+    input.extend(&above);
+    input.extend(&types);
+    for c in &colours {
+        for x in c {
+            input.extend(x.to_le_bytes());
+        }
+    }
+    let lit: Vec<&[f32; 8]> = points.iter().flatten().collect();
+    input.extend((lit.len() as u32).to_le_bytes());
+    for p in &lit {
+        for x in p.iter() {
+            input.extend(x.to_le_bytes());
+        }
+    }
+    let mut child = Command::new(&exe)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("tl_shade runs");
+    // Written from a thread: the child's answers fill its output pipe as it reads.
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || stdin.write_all(&input));
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap().expect("tl_shade reads its input");
+    assert!(out.status.success(), "tl_shade failed");
+    let vals: Vec<f32> = out
+        .stdout
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    let k = (irradiance / std::f64::consts::PI) as f32;
+    let mut next = vals.chunks_exact(3);
+    let n = (aa * aa) as usize;
+    let mut pixels = Vec::with_capacity((w * h) as usize);
+    for px in points.chunks(n) {
+        let mut sum = [0f32; 3];
+        for p in px {
+            if p.is_some() {
+                let c = next.next().expect("one colour a point");
+                for ch in 0..3 {
+                    sum[ch] += c[ch] * k;
+                }
+            }
+        }
+        pixels.push(sum.map(|x| x / n as f32));
+    }
+    Image {
+        width: w,
+        height: h,
+        pixels,
+    }
+}
+
+/// The yarns up close: the model's levels, the ground truth and ThunderLoom, a row a fabric.
+fn yarns(root: &Path, dir: &Path, thunderloom_dir: Option<&Path>, width: u32, height: u32) {
+    let start = Instant::now();
+    let lighting = Lighting {
+        light: unit(Vec3::new(0.8, -0.2, 0.56)),
+        irradiance: std::f64::consts::PI,
+        ambient: 0.0,
+    };
+    let scene = Scene::swatch(30.0);
+    let eye = Vec3::new(0.0, -14.0, 16.0);
+    let cam = Camera::new(eye, Vec3::default(), 40.0, width, height).expect("valid camera");
+    let aa = 3;
+    let mut images = Vec::new();
+    for file in [
+        "twill.json",
+        "satin5.json",
+        "denim.wif",
+        "gingham.wif",
+        "open-plain",
+    ] {
+        let f = if file == "open-plain" {
+            Fabric::from_json_str(OPEN_PLAIN, "open plain").unwrap()
+        } else {
+            Fabric::from_path(&root.join("tables").join(file)).unwrap()
+        };
+        // About six threads across the view (the swatch is 60 wide, the view about 13 at its
+        // centre), about 50 pixels a thread.
+        let threads = f.weave().n_warp().max(f.weave().n_weft()) as f64;
+        let periods = 6.0 / threads * 60.0 / 13.0;
+        let model = Shader::model(
+            &f,
+            FacetModel::Huo,
+            Variant::Refined,
+            None,
+            Component::Total,
+        )
+        .unwrap();
+        let truth = Shader::truth(&f, FacetModel::Huo, 1);
+        for s in [&model, &truth] {
+            let never = AtomicBool::new(false);
+            let img = render_weave(
+                &scene,
+                &cam,
+                &lighting,
+                s,
+                aa,
+                Some(periods),
+                &|_| {},
+                &never,
+            );
+            images.push(img.expect("not cancelled"));
+        }
+        images.push(match thunderloom_dir {
+            Some(d) => {
+                let pts = shading_points(&scene, &cam, lighting.light, aa, periods);
+                thunderloom(d, &f, &pts, lighting.irradiance, (width, height, aa))
+            }
+            None => Image {
+                width,
+                height,
+                pixels: vec![[0.0; 3]; (width * height) as usize],
+            },
+        });
+    }
+    save(&dir.join("yarns.png"), &montage(&images, 3), 1.0);
+    eprintln!("yarns: {:.1} s", start.elapsed().as_secs_f64());
+}
+
 /// `clothbake plot`'s three kinds, drawn with the model.
 fn plots(root: &Path, dir: &Path) {
     use clothbake_render::plot::{self, Plot, Source};
@@ -271,5 +503,13 @@ pub fn run(root: &Path, only: &[String]) {
     }
     if wanted("plots") {
         plots(root, &dir);
+    }
+    if wanted("yarns") {
+        let tl = only
+            .iter()
+            .position(|o| o == "--thunderloom")
+            .and_then(|k| only.get(k + 1))
+            .map(Path::new);
+        yarns(root, &dir, tl, 320, 200);
     }
 }

@@ -10,7 +10,8 @@
 //!   perpendicular share of I_2 and the orders past the second per shipped fabric, the furnace
 //!   test and the orders at n = 1, into `docs/transport.md` (between its `transport` markers).
 //! * `figures`: the thesis's rendered scenes (Figs 4.5, 5.10, 5.11, 5.17), the weave up
-//!   close (`up-close`) and `clothbake plot`'s three kinds (`plots`) into `docs/figures/`.
+//!   close (`up-close`), the yarns against the truth and ThunderLoom (`yarns`) and `clothbake
+//!   plot`'s three kinds (`plots`) into `docs/figures/`.
 //! * `gallery [--quick] [--envmap FILE.exr]`: pictures of every shipped fabric rendered by
 //!   Mitsuba 3 (draped over a ball under a sky, path traced) into `docs/gallery/` (see
 //!   `gallery.rs`).
@@ -79,7 +80,7 @@ fn main() {
         "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | lod | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots] | gallery [--quick] [--envmap FILE.exr] [--only NAME,...] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
+                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | lod | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots|yarns [--thunderloom DIR]] | gallery [--quick] [--envmap FILE.exr] [--only NAME,...] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
             );
             std::process::exit(2);
         }
