@@ -149,10 +149,11 @@ def plan(settings, baker):
         table = baker.table(name + "-spatial", path, s.spatial_res, "--spatial")
         pics.append(Picture(
             f"{name}-close", f"`{path.name}` up close: its spatially varying table "
-            f"(`bake --spatial` on the {s.spatial_res} grid) through the "
-            f"clothbake plugin with `periods` = {scene.PERIODS:g} weave periods per UV unit "
+            f"(`bake --spatial` on the {s.spatial_res} grid), which carries its yarns, through "
+            f"the clothbake plugin with `periods` = {scene.PERIODS:g} weave periods per UV unit "
             f"(about {scene.PERIODS / (2 * scene.drape.HALF_SIDE):.0f} per unit of length, "
-            "the ball's radius being 1).", "close",
+            "the ball's radius being 1): each sample traces the yarns at its point "
+            "(docs/spatial.md, the point level).", "close",
             scene.plugin(table, periods=scene.PERIODS)))
     fab = dict(fabrics())
     if BOUNCES_FABRIC in fab:

@@ -1,7 +1,9 @@
 //! `clothbake.Fabric`: a validated fabric description and its BRDF from the analytic model
 //! (thesis ch. 3-4, ch. 5 with two bounces) or the ray-traced ground truth.
 
-use crate::vectors::{check_unit, period_rows, same_len, to_array, to_array1, unit_rows, widths};
+use crate::vectors::{
+    check_footprint, check_unit, period_rows, same_len, to_array, to_array1, unit_rows, widths,
+};
 use clothbake_core::{
     intensity_to_brdf, AnalyticBsdf, AnalyticModel, Bsdf, Component, Fabric, FacetModel, Footprint,
     Local, PeriodPoint, RayTracer, Reflection, SecondaryOptions, Transport, UnitVec3, Vec3,
@@ -373,16 +375,7 @@ impl PyFabric {
     ) -> PyResult<((f64, f64, f64), f64)> {
         check_unit("wi", 0, wi)?;
         check_unit("wo", 0, wo)?;
-        if !(u.is_finite() && v.is_finite()) {
-            return Err(PyValueError::new_err(format!(
-                "u, v: ({u}, {v}); give finite period fractions"
-            )));
-        }
-        if !(width.is_finite() && width >= 0.0) {
-            return Err(PyValueError::new_err(format!(
-                "width: {width} is not a footprint; give the square's side in periods, >= 0"
-            )));
-        }
+        check_footprint(u, v, width)?;
         let l =
             self.levels(facet_model(facet)?)
                 .local(Footprint { u, v, width }, unit(wi), unit(wo));

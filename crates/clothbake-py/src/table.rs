@@ -2,7 +2,8 @@
 //! (`clothbake_loader::Brdf`) and importance sampling.
 
 use crate::vectors::{
-    check_unit, period_rows, rows, same_len, to_array, to_array1, unit_rows, unit_rows_f32, widths,
+    check_footprint, check_unit, period_rows, rows, same_len, to_array, to_array1, unit_rows,
+    unit_rows_f32, widths,
 };
 use clothbake_loader::{
     write_binary, write_exr, Brdf, Memory, Options, Precision, StoredTable, TableError,
@@ -303,17 +304,7 @@ impl PyTable {
     /// f_r at point (u, v) of the weave period through a footprint of side `width` periods,
     /// for one pair of unit vectors (see `eval_at`): the scalar path of the Mitsuba plugin.
     fn eval1_at(&self, wi: [f64; 3], wo: [f64; 3], u: f64, v: f64, width: f64) -> PyResult<Triple> {
-        check_unit("wi", 0, wi)?;
-        check_unit("wo", 0, wo)?;
-        if !(u.is_finite() && v.is_finite() && width.is_finite() && width >= 0.0) {
-            return Err(PyValueError::new_err(format!(
-                "({u}, {v}) with width {width}: give finite period fractions and a width >= 0"
-            )));
-        }
-        let f = self
-            .brdf
-            .eval_at(wi.map(|x| x as f32), wo.map(|x| x as f32), u, v, width);
-        Ok((f[0], f[1], f[2]))
+        Ok(self.eval1_local(wi, wo, u, v, width)?.0)
     }
 
     /// As `eval1_at`, with the footprint's coverage from the same lookup: ((r, g, b),
@@ -328,11 +319,7 @@ impl PyTable {
     ) -> PyResult<(Triple, f32)> {
         check_unit("wi", 0, wi)?;
         check_unit("wo", 0, wo)?;
-        if !(u.is_finite() && v.is_finite() && width.is_finite() && width >= 0.0) {
-            return Err(PyValueError::new_err(format!(
-                "({u}, {v}) with width {width}: give finite period fractions and a width >= 0"
-            )));
-        }
+        check_footprint(u, v, width)?;
         let (f, c) = self
             .brdf
             .local_at(wi.map(|x| x as f32), wo.map(|x| x as f32), u, v, width);

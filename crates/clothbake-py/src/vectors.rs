@@ -127,6 +127,17 @@ pub fn unit_rows_f32(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<(Vec<[f32; 
 
 /// Reads `uv`, points of the weave period as `(N, 2)` (or `(2,)`) period fractions, one per row
 /// of `wi` (`n` rows); a row that is not finite is an error naming it.
+/// Checks one footprint of the scalar paths: (u, v) finite period fractions, a width finite
+/// and >= 0 (periods).
+pub fn check_footprint(u: f64, v: f64, width: f64) -> PyResult<()> {
+    if !(u.is_finite() && v.is_finite() && width.is_finite() && width >= 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "({u}, {v}) with width {width}: give finite period fractions and a width >= 0"
+        )));
+    }
+    Ok(())
+}
+
 /// Reads a footprint width: one number for every row, or an array of `n` (one a row), each
 /// finite and >= 0 (the side of a square in periods).
 pub fn widths(obj: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<f64>> {
