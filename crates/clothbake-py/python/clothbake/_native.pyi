@@ -34,19 +34,30 @@ class Fabric:
              ) -> Dict[str, npt.NDArray[np.float64]]: ...
     def eval(self, wi: npt.ArrayLike, wo: npt.ArrayLike, method: str = "analytic",
              bounces: int = 1, facet: str = "huo", split: bool = False,
-             samples: int = 100000, seed: int = 1) -> Any:
+             samples: int = 100000, seed: int = 1, uv: Optional[npt.ArrayLike] = None,
+             width: Union[float, npt.ArrayLike, None] = None, level: str = "auto") -> Any:
         """f_r(wi, wo) in 1/sr, (N, 3) float64, for unit vectors (N, 3) or (3,).
         method "analytic" | "raytrace"; bounces 1 | 2; facet "huo" | "lewis"; split=True
-        returns {"brdf", "diffuse", "specular", "secondary"}."""
+        returns {"brdf", "diffuse", "specular", "secondary"}. With uv (N, 2): through a
+        footprint of `width` periods at each point (level "auto": the yarns traced up close;
+        "cells": the crossing cells); split=True then returns {"brdf", "coverage"} (and
+        "secondary" with bounces=2)."""
     def eval1(self, wi: Vec3, wo: Vec3, facet: str = "huo") -> Vec3:
         """f_r of one pair (analytic, direct reflection), 1/sr."""
+    def eval1_at(self, wi: Vec3, wo: Vec3, u: float, v: float, width: float = 0.0,
+                 facet: str = "huo") -> Tuple[Vec3, float]:
+        """(f_r, coverage) of one pair through a footprint at (u, v), every level of detail."""
 
 class Table:
     """A baked f_r table (1/sr, RGB) with interpolated lookup and importance sampling."""
 
     @staticmethod
-    def open(path: Union[str, "os.PathLike[str]"], reciprocal: bool = False) -> "Table":
+    def open(path: Union[str, "os.PathLike[str]"], reciprocal: bool = False,
+             point_level: bool = True) -> "Table":
         """Opens an .exr or binary table; FileNotFoundError / ValueError on failure."""
+    @property
+    def has_point_level(self) -> bool: ...
+    def without_point_level(self) -> "Table": ...
     @property
     def grid(self) -> Dict[str, int]: ...
     @property
@@ -64,8 +75,11 @@ class Table:
         """Density (per sr) of sample() drawing wi for wo, (N,)."""
     def eval1(self, wi: Vec3, wo: Vec3) -> Vec3: ...
     def eval_at(self, wi: npt.ArrayLike, wo: npt.ArrayLike, uv: npt.ArrayLike,
-                width: float = 0.0) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+                width: Union[float, npt.ArrayLike, None] = None
+                ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
     def eval1_at(self, wi: Vec3, wo: Vec3, u: float, v: float, width: float) -> Vec3: ...
+    def eval1_local(self, wi: Vec3, wo: Vec3, u: float, v: float,
+                    width: float) -> Tuple[Vec3, float]: ...
     def sample1(self, wo: Vec3, u1: float, u2: float) -> Tuple[Vec3, Vec3, float]: ...
     def pdf1(self, wo: Vec3, wi: Vec3) -> float: ...
     def save(self, path: Union[str, "os.PathLike[str]"], precision: str = "f16",
