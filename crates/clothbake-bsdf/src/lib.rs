@@ -93,7 +93,7 @@ impl Footprint {
     /// from 1 to [`MAX_POINTS_ACROSS`]. A NaN width is a point.
     #[inline]
     pub fn level(&self, cell: f64) -> Level {
-        if !(self.u.is_finite() && self.v.is_finite()) || self.width >= 1.0 {
+        if !self.within_period() {
             return Level::Period;
         }
         let width = if self.width.is_nan() {
@@ -118,6 +118,16 @@ impl Footprint {
             width,
             points,
         }
+    }
+}
+
+impl Footprint {
+    /// Whether the footprint asks for less than the whole period (a point of finite u and v,
+    /// a width under one period or NaN): the first test of [`Footprint::level`], for lookups
+    /// that need only it.
+    #[inline(always)]
+    pub fn within_period(&self) -> bool {
+        self.u.is_finite() && self.v.is_finite() && (self.width < 1.0 || self.width.is_nan())
     }
 }
 

@@ -22,7 +22,7 @@ use crate::lookup::{has_value, pad4, SimdPath};
 use crate::nodes::{Lane, MirrorLanes, Nodes, Values};
 use crate::stored::Samples;
 use crate::table::Grid;
-use clothbake_bsdf::{Footprint, Level};
+use clothbake_bsdf::Footprint;
 
 /// Most crossing cells a spatial table's period may have (2^16): the layout is stored as JSON
 /// in the header.
@@ -960,13 +960,13 @@ impl SpatialLookup {
     }
 
     /// Whether this table answers f_r and coverage at (u, v) through a footprint of side
-    /// `width` ([`crate::Brdf::eval_at`]): where the level rule ([`Footprint::level`]) asks
-    /// for less than the period (below a period, NaN a point, at a finite point); elsewhere
-    /// the averaged table answers. A table has no point level: inside the period its cells
-    /// answer.
+    /// `width` ([`crate::Brdf::eval_at`]): where the level rule asks for less than the period
+    /// ([`Footprint::within_period`], the first test of [`Footprint::level`]: below a period,
+    /// NaN a point, at a finite point); elsewhere the averaged table answers. Inside the
+    /// period the cells answer, or the point level where the table has it (`Brdf`).
     #[inline(always)]
     pub(crate) fn answers(u: f64, v: f64, width: f64) -> bool {
-        matches!(Footprint { u, v, width }.level(1.0), Level::Local { .. })
+        Footprint { u, v, width }.within_period()
     }
 
     /// f_r through the footprint, where the table [`answers`](SpatialLookup::answers): the
