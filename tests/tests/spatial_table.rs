@@ -444,7 +444,7 @@ fn a_spatial_table_of_one_bounce_carries_its_yarns_and_traces_them_up_close() {
     // point level's own look; from two cells wide, its cells; from a period, its average.
     let f = fabric("twill.json");
     let t = baked(&f, true);
-    let period = clothbake_core::point::period(&f, FacetModel::Huo);
+    let period = clothbake_core::point::period(&f, FacetModel::Huo).unwrap();
     assert_eq!(t.meta.yarns.as_ref(), Some(&period));
     assert!(baked_with(&f, true, 2).meta.yarns.is_none());
     assert!(baked(&f, false).meta.yarns.is_none());

@@ -90,7 +90,7 @@ fn cells_table(root: &Path) -> String {
     for path in clothbake_bake::golden::fabric_files(&root.join("tables")).expect("tables") {
         let f = Fabric::from_path(&path).expect("shipped fabric");
         let model = AnalyticModel::new(&f, FacetModel::Huo);
-        let yarns = clothbake_core::point::yarns(&f, FacetModel::Huo);
+        let yarns = clothbake_core::point::yarns(&f, FacetModel::Huo).expect("a small period");
         let (eu, ev) = model.cells().edge_fractions();
         let (nx, ny) = model.cells().dims();
         let mean = |x: [f64; 3]| (x[0] + x[1] + x[2]) / 3.0;

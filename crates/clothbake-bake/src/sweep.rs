@@ -598,7 +598,9 @@ impl Baker {
         };
         // A spatial table of one bounce carries its period's yarns: its point level.
         let yarns = (spatial.is_some() && opts.bounces == 1)
-            .then(|| clothbake_core::point::period(fabric, opts.facet));
+            .then(|| clothbake_core::point::period(fabric, opts.facet))
+            .flatten()
+            .filter(|p| p.yarns().len() <= clothbake_core::point::TABLE_YARNS);
         let meta = Metadata {
             spatial,
             yarns,

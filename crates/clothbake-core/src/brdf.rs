@@ -378,7 +378,7 @@ mod tests {
             &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/twill.json"),
         )
         .unwrap();
-        let y = crate::point::yarns(&f, FacetModel::Huo);
+        let y = crate::point::yarns(&f, FacetModel::Huo).unwrap();
         let cells = AnalyticBsdf::new(AnalyticModel::new(&f, FacetModel::Huo), None);
         let b = AnalyticBsdf::new(AnalyticModel::new(&f, FacetModel::Huo), None).with_yarns(y);
         let (wi, wo) = (

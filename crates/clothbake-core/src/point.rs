@@ -17,10 +17,19 @@ pub fn facet(model: FacetModel) -> Facet {
     }
 }
 
+/// The most yarn segments a spatial table carries (`Metadata::yarns`), so that its header stays
+/// well under the container's 16 MiB: larger periods' tables show their crossing cells.
+pub const TABLE_YARNS: usize = 4096;
+const _: () = assert!(TABLE_YARNS <= clothbake_point::MAX_YARNS);
+
 /// The period of a validated fabric, its segments shaded with `model`'s facet terms: one
-/// finish per distinct thread material.
-pub fn period(fabric: &Fabric, model: FacetModel) -> Period {
+/// finish per distinct thread material; `None` for a period of more than
+/// [`clothbake_point::MAX_YARNS`] segments (no point level: the crossing cells are the finest).
+pub fn period(fabric: &Fabric, model: FacetModel) -> Option<Period> {
     let geo = Geometry::new(fabric);
+    if geo.segments.len() > clothbake_point::MAX_YARNS {
+        return None;
+    }
     let mut finishes: Vec<Finish> = Vec::new();
     let mut yarns = Vec::with_capacity(geo.segments.len());
     for s in &geo.segments {
@@ -49,13 +58,15 @@ pub fn period(fabric: &Fabric, model: FacetModel) -> Period {
             finish: k as u32,
         });
     }
-    Period::new(geo.period, yarns, finishes, facet(model))
-        .expect("a validated fabric's geometry is a valid period")
+    Some(
+        Period::new(geo.period, yarns, finishes, facet(model))
+            .expect("a validated fabric's geometry is a valid period"),
+    )
 }
 
 /// [`period`], sorted for tracing.
-pub fn yarns(fabric: &Fabric, model: FacetModel) -> Yarns {
-    Yarns::new(period(fabric, model))
+pub fn yarns(fabric: &Fabric, model: FacetModel) -> Option<Yarns> {
+    period(fabric, model).map(Yarns::new)
 }
 
 #[cfg(test)]
@@ -99,7 +110,7 @@ mod tests {
         // the same yarn, point and normal, the same shadowing, the same f_r.
         for facet_model in [FacetModel::Huo, FacetModel::Lewis] {
             for (name, fabric) in shipped() {
-                let y = yarns(&fabric, facet_model);
+                let y = yarns(&fabric, facet_model).unwrap();
                 let rt = RayTracer::new(&fabric, facet_model);
                 let mut rng = Rng::new(7);
                 let (mut hits, mut shadowed) = (0, 0);
@@ -194,7 +205,7 @@ mod tests {
             &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/parallel.json"),
         )
         .unwrap();
-        let y = yarns(&f, FacetModel::Huo);
+        let y = yarns(&f, FacetModel::Huo).unwrap();
         let b = crate::AnalyticBsdf::new(crate::AnalyticModel::new(&f, FacetModel::Huo), None);
         for (ti, pi, to, po) in PAIRS {
             let (wi, wo) = (
@@ -227,7 +238,7 @@ mod tests {
                     .join(name),
             )
             .unwrap();
-            let y = yarns(&f, FacetModel::Huo);
+            let y = yarns(&f, FacetModel::Huo).unwrap();
             let rt = RayTracer::new(&f, FacetModel::Huo);
             for (k, (ti, pi, to, po)) in PAIRS.into_iter().enumerate() {
                 let (wi, wo) = (
@@ -258,7 +269,7 @@ mod tests {
             &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/twill.json"),
         )
         .unwrap();
-        let y = yarns(&f, FacetModel::Huo);
+        let y = yarns(&f, FacetModel::Huo).unwrap();
         let (wi, wo) = (
             UnitVec3::from_degrees(40.0, 30.0),
             UnitVec3::from_degrees(35.0, 200.0),
@@ -291,6 +302,33 @@ mod tests {
                 y.look(0.2, 0.7, wi, wo)
             );
         }
+    }
+
+    #[test]
+    fn a_period_of_too_many_segments_has_no_point_level() {
+        // A 512 x 512 plain weave: 2^18 floats, more than MAX_YARNS.
+        let n = 512;
+        let rows: Vec<String> = (0..n)
+            .map(|j| {
+                let r: Vec<&str> = (0..n)
+                    .map(|i| if (i + j) % 2 == 0 { "1" } else { "0" })
+                    .collect();
+                format!("[{}]", r.join(","))
+            })
+            .collect();
+        let json = format!(
+            r#"{{"pattern": [{}], "warp": {{"radius": 1.5, "spacing": 3.1}}, "weft": {{"radius": 1.5, "spacing": 3.1}}}}"#,
+            rows.join(",")
+        );
+        let f = Fabric::from_json_str(&json, "big").unwrap();
+        assert!(period(&f, FacetModel::Huo).is_none());
+        assert!(yarns(&f, FacetModel::Huo).is_none());
+        // A 32 x 32 one is traced, and has more segments than a table carries.
+        let small = Fabric::from_path(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/plain.json"),
+        )
+        .unwrap();
+        assert_eq!(period(&small, FacetModel::Huo).unwrap().yarns().len(), 4);
     }
 
     #[test]

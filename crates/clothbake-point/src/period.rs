@@ -127,6 +127,12 @@ impl Period {
             if !positive(y.radius) {
                 return err(format!("yarns[{k}].radius: {} is not > 0", y.radius));
             }
+            if 2.0 * y.radius > across_size {
+                return err(format!(
+                    "yarns[{k}].radius: {} is more than half the period across ({across_size}): the thread would overlap its own next copy",
+                    y.radius
+                ));
+            }
             if !(y.height.is_finite() && y.height.abs() < y.radius) {
                 return err(format!(
                     "yarns[{k}].height: {} is not within the radius {}",
@@ -153,6 +159,25 @@ impl Period {
                     finishes.len()
                 ));
             }
+        }
+        // Solids that do not overlap lie in two layers at most (warp over weft): their shadows
+        // on the floor cover the period at most about twice. A description far beyond that is
+        // not cloth, and would make the tracing grid's work unbounded.
+        let shadow: f64 = yarns
+            .iter()
+            .map(|y| {
+                let along = match y.along {
+                    Along::Y => size.1,
+                    Along::X => size.0,
+                };
+                2.0 * y.radius * y.extent.map_or(along, |(lo, hi)| hi - lo)
+            })
+            .sum();
+        if shadow > 4.0 * size.0 * size.1 {
+            return err(format!(
+                "yarns: their footprints cover the period {:.1} times; yarns that do not overlap cover it at most about twice",
+                shadow / (size.0 * size.1)
+            ));
         }
         Ok(Period {
             size,
@@ -294,6 +319,22 @@ mod tests {
             assert!(e.contains(field), "{e}");
         }
         assert!(Period::new((0.0, 1.0), vec![], vec![], Facet::Huo).is_err());
+        // A radius wider than the period, and yarns piled on one another, are not cloth.
+        let fat = Yarn {
+            radius: 1.5,
+            height: 0.0,
+            ..yarn()
+        };
+        assert!(ok(fat).unwrap_err().0.contains("half the period"));
+        let pile = vec![
+            Yarn {
+                extent: None,
+                ..yarn()
+            };
+            40
+        ];
+        let e = Period::new((2.0, 3.0), pile, vec![finish()], Facet::Huo).unwrap_err();
+        assert!(e.0.contains("cover the period"), "{e}");
         let bad_finish = Finish {
             specular: 2.0,
             ..finish()

@@ -74,8 +74,11 @@ impl PyFabric {
             FacetModel::Lewis => 1,
         };
         self.levels[k].get_or_init(|| {
-            AnalyticBsdf::new(self.model(facet).clone(), None)
-                .with_yarns(clothbake_core::point::yarns(&self.fabric, facet))
+            let b = AnalyticBsdf::new(self.model(facet).clone(), None);
+            match clothbake_core::point::yarns(&self.fabric, facet) {
+                Some(y) => b.with_yarns(y),
+                None => b,
+            }
         })
     }
 }

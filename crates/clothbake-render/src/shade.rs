@@ -80,7 +80,9 @@ impl Shader {
         .with_component(component)
         .ok_or("the secondary reflection's components need two bounces")?;
         if one_bounce {
-            bsdf = bsdf.with_yarns(clothbake_core::point::yarns(fabric, facet));
+            if let Some(y) = clothbake_core::point::yarns(fabric, facet) {
+                bsdf = bsdf.with_yarns(y);
+            }
         }
         Ok(Shader::new(Box::new(bsdf), fabric_tint(fabric)))
     }

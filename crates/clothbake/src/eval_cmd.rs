@@ -235,7 +235,9 @@ fn footprint(
     let model = || AnalyticModel::with_variant(fabric, facet, variant);
     let mut bsdf = AnalyticBsdf::new(model(), secondary);
     if secondary.is_none() {
-        bsdf = bsdf.with_yarns(clothbake_core::point::yarns(fabric, facet));
+        if let Some(y) = clothbake_core::point::yarns(fabric, facet) {
+            bsdf = bsdf.with_yarns(y);
+        }
     }
     let cell = bsdf.cell_width();
     let level = match at.level(cell) {
