@@ -394,7 +394,7 @@ fn yarns(root: &Path, dir: &Path, thunderloom_dir: Option<&Path>, width: u32, he
             Component::Total,
         )
         .unwrap();
-        let truth = Shader::truth(&f, FacetModel::Huo, 1);
+        let truth = Shader::truth(&f, FacetModel::Huo, 1, None);
         for s in [&model, &truth] {
             let never = AtomicBool::new(false);
             let img = render_weave(

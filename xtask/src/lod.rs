@@ -176,7 +176,7 @@ pub fn run(root: &Path) {
             Component::Total,
         )
         .expect("one bounce");
-        let truth = [1, 2].map(|seed| Shader::truth(&fabric, FacetModel::Huo, seed));
+        let truth = [1, 2].map(|seed| Shader::truth(&fabric, FacetModel::Huo, seed, None));
         for (scene_name, eye) in scenes {
             let scene = Scene::by_name(scene_name).expect("scene");
             let (lo, hi) = scene.bounds();

@@ -92,13 +92,21 @@ impl Shader {
     /// surface, with a shadow ray through the same yarns. A sample's footprint is integrated by
     /// [`truth_points`] stratified jittered points in it (one for a footprint under an eighth
     /// of a crossing cell), so that distant truth converges instead of aliasing; `seed` picks
-    /// the jitter. Without a footprint, the period's average is ray-traced with 16 384
-    /// rays per pair.
-    pub fn truth(fabric: &Fabric, facet: FacetModel, seed: u64) -> Shader {
+    /// the jitter. With `paths`, each point is one path with every bounce up to its
+    /// `max_bounces` (`RayTracer::look_paths_at`, radiometric kernel) instead of one bounce.
+    /// Without a footprint, the period's average is ray-traced with 16 384 rays per pair (one
+    /// bounce).
+    pub fn truth(
+        fabric: &Fabric,
+        facet: FacetModel,
+        seed: u64,
+        paths: Option<clothbake_core::PathOptions>,
+    ) -> Shader {
         Shader::new(
             Box::new(Truth {
                 rt: RayTracer::new(fabric, facet),
                 seed,
+                paths,
                 cell: 1.0 / fabric.weave().n_warp().max(fabric.weave().n_weft()) as f64,
             }),
             fabric_tint(fabric),
@@ -146,6 +154,8 @@ impl Shader {
 struct Truth {
     rt: RayTracer,
     seed: u64,
+    /// Every bounce up to its `max_bounces`, a path a point; `None`: one bounce.
+    paths: Option<clothbake_core::PathOptions>,
     /// The smallest crossing cell's side, about, in periods.
     cell: f64,
 }
@@ -199,7 +209,11 @@ impl Bsdf for Truth {
                         at.v + width * ((b as f64 + rng.next_f64()) / k as f64 - 0.5),
                     )
                 };
-                if let Some(f) = self.rt.look_at(u, v, light, wo) {
+                let seen = match self.paths {
+                    None => self.rt.look_at(u, v, light, wo),
+                    Some(o) => self.rt.look_paths_at(u, v, light, wo, o, &mut rng),
+                };
+                if let Some(f) = seen {
                     hits += 1;
                     for c in 0..3 {
                         sum[c] += f[c];

@@ -1112,8 +1112,9 @@ pub struct RenderArgs {
 
     /// The ground-truth picture (with --weave and --periods): each sample's ray continues into
     /// the fabric's explicit yarns, tiled over the surface in its tangent frame, with a shadow
-    /// ray through the same yarns (one bounce). The reference every level of detail is
-    /// measured against (docs/spatial.md).
+    /// ray through the same yarns; with --bounces N (or all), a path a point with every bounce
+    /// up to N between the yarns. The reference every level of detail is measured against
+    /// (docs/spatial.md).
     #[arg(long)]
     pub truth: bool,
 

@@ -96,17 +96,28 @@ fn truth_shader(a: &RenderArgs) -> Result<Shader, CliError> {
             "add --periods N (e.g. --periods 8)",
         ));
     }
-    if b.bounces.bounces != 1 || b.component != ComponentArg::Total {
+    if b.component != ComponentArg::Total || b.bounces.secondary_flag().is_some() {
         return Err(CliError::new(
-            "--truth traces one bounce, whole",
-            "drop --bounces and --component with --truth",
+            "--truth traces the yarns whole: --component and the secondary-reflection options do not apply",
+            "drop --component, --secondary, --kernel, --orders and --sampling with --truth",
         ));
     }
+    // Every bounce up to --bounces N (all: the highest order full transport follows), a
+    // path a point, with Russian roulette and the radiometric kernel as full transport has.
+    let paths = (b.bounces.bounces > 1).then(|| clothbake_core::PathOptions {
+        max_bounces: (b.bounces.bounces as usize).min(clothbake_core::transport::MAX_ORDER),
+        ..clothbake_core::PathOptions::default()
+    });
     let fabric = apply_material(
         crate::fabrics::read(weave, &Default::default())?,
         &b.material,
     )?;
-    Ok(Shader::truth(&fabric, FacetModel::from(b.model.facet), 1))
+    Ok(Shader::truth(
+        &fabric,
+        FacetModel::from(b.model.facet),
+        1,
+        paths,
+    ))
 }
 
 /// The shader of a baked table (the loader's interpolated lookup).

@@ -386,6 +386,16 @@ fn the_yarns_up_close_are_the_ground_truths_picture() {
         model_swatch("twill", &["--periods", "100000"], "far-model"),
         avg
     );
+    // With every bounce, the truth's yarns are brighter (light between the yarns), not more
+    // than twice.
+    let every = model_swatch(
+        "twill",
+        &["--periods", "0.5", "--truth", "--bounces", "all"],
+        "every",
+    );
+    let sum = |px: &[[f32; 3]]| px.iter().flatten().map(|&x| f64::from(x)).sum::<f64>();
+    let (one, all) = (sum(&truth), sum(&every));
+    assert!(all > 1.01 * one && all < 2.0 * one, "{all} vs {one}");
     // --truth needs the fabric and --periods.
     let (png, exr) = (temp("t.png"), temp("t.exr"));
     let w = weave("twill");

@@ -153,6 +153,47 @@ impl RayTracer {
         summarise(&accs, k_max)
     }
 
+    /// f_r at the point (u, v) of the reference plane with every bounce up to
+    /// `opts.max_bounces`: one path from the eye ray that crosses the plane there toward `wo`
+    /// (as [`RayTracer::render_paths`] traces them: light sampled at each bounce, the path
+    /// continued uniformly over the hemisphere), so one unbiased, noisy sample. `None` where
+    /// the eye ray shows a gap or a direction is at or below the horizon. With one bounce it is
+    /// [`RayTracer::look_at`].
+    pub fn look_paths_at(
+        &self,
+        u: f64,
+        v: f64,
+        wi: UnitVec3,
+        wo: UnitVec3,
+        opts: PathOptions,
+        rng: &mut Rng,
+    ) -> Option<[f64; 3]> {
+        if !(wi.above_horizon() && wo.above_horizon() && u.is_finite() && v.is_finite()) {
+            return None;
+        }
+        let k_max = opts.max_bounces.max(1);
+        let mut acc = Acc {
+            orders: vec![[0.0; 3]; k_max],
+            ..Default::default()
+        };
+        self.path(
+            self.eye_origin(u, v, wo),
+            wi,
+            wo,
+            k_max,
+            opts,
+            rng,
+            &mut acc,
+        );
+        if acc.hits == 0 {
+            return None;
+        }
+        let k = 1.0 / (PI * wi.cos_theta());
+        Some(std::array::from_fn(|c| {
+            acc.orders.iter().map(|o| o[c]).sum::<f64>() * k
+        }))
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn path(
         &self,
@@ -302,6 +343,39 @@ mod tests {
             "pf",
         )
         .unwrap()
+    }
+
+    #[test]
+    fn a_points_path_of_one_bounce_is_its_look_and_more_bounces_add_light() {
+        let f = Fabric::from_path(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/twill.json"),
+        )
+        .unwrap();
+        let rt = RayTracer::new(&f, FacetModel::Huo);
+        let (wi, wo) = (
+            UnitVec3::from_degrees(40.0, 20.0),
+            UnitVec3::from_degrees(30.0, 200.0),
+        );
+        let one = PathOptions {
+            max_bounces: 1,
+            ..PathOptions::default()
+        };
+        let mut rng = Rng::new(3);
+        let (mut direct, mut all) = (0.0, 0.0);
+        for k in 0..4000 {
+            let (u, v) = (k as f64 * 0.618_034 % 1.0, k as f64 * 0.414_214 % 1.0);
+            let look = rt.look_at(u, v, wi, wo);
+            assert_eq!(rt.look_paths_at(u, v, wi, wo, one, &mut rng), look);
+            direct += look.map_or(0.0, |f| f[0]);
+            all += rt
+                .look_paths_at(u, v, wi, wo, PathOptions::default(), &mut rng)
+                .map_or(0.0, |f| f[0]);
+        }
+        // The later orders add light (albedo 0.4: some percent), not more than the direct.
+        assert!(
+            all > 1.01 * direct && all < 2.0 * direct,
+            "{all} vs {direct}"
+        );
     }
 
     #[test]

@@ -267,15 +267,21 @@ impl RayTracer {
         if !(wi.above_horizon() && wo.above_horizon() && u.is_finite() && v.is_finite()) {
             return None;
         }
-        let (px, py) = self.yarns.period;
-        let z_ref = self.reference_height();
-        // Back along the eye ray from the plane to the top plane.
-        let back = (self.z_top - z_ref) / wo.z;
-        let o = Vec3::new(u.rem_euclid(1.0) * px, v.rem_euclid(1.0) * py, z_ref) + wo.get() * back;
+        let o = self.eye_origin(u, v, wo);
         let (s, c) = self.shade(o, wi, wo)?;
         let albedo = self.cylinder(&c).finish.albedo;
         let k = 1.0 / (std::f64::consts::PI * wi.cos_theta());
         Some(albedo.map(|a| (s.diffuse * a + s.specular) * k))
+    }
+
+    /// Where the eye ray through the point (u, v) of the reference plane (period fractions,
+    /// wrapped) toward `wo` starts on the top plane (`wo` above the horizon).
+    pub(crate) fn eye_origin(&self, u: f64, v: f64, wo: UnitVec3) -> Vec3 {
+        let (px, py) = self.yarns.period;
+        let z_ref = self.reference_height();
+        // Back along the eye ray from the plane to the top plane.
+        let back = (self.z_top - z_ref) / wo.z;
+        Vec3::new(u.rem_euclid(1.0) * px, v.rem_euclid(1.0) * py, z_ref) + wo.get() * back
     }
 
     /// Traces `m` stratified primary rays over one period into `sums`.
