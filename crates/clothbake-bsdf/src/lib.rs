@@ -141,6 +141,24 @@ pub struct Local {
     pub coverage: f64,
 }
 
+impl Local {
+    /// The blend of two levels' answers for one footprint ([`Level::Local`]): `a` with weight
+    /// `wa` and `b` with weight 1 - `wa`, each f_r weighted by its coverage (so that the
+    /// blend's f c is the weighted mean of the levels' f c).
+    pub fn blend(wa: f64, a: Local, b: Local) -> Local {
+        let (ca, cb) = (wa * a.coverage, (1.0 - wa) * b.coverage);
+        let c = ca + cb;
+        Local {
+            f: if c > 0.0 {
+                [0, 1, 2].map(|k| (ca * a.f[k] + cb * b.f[k]) / c)
+            } else {
+                [0.0; 3]
+            },
+            coverage: c,
+        }
+    }
+}
+
 /// A bidirectional reflectance distribution: f_r, a sampler of incident directions and its
 /// density, on local-frame unit directions.
 pub trait Bsdf: Sync {

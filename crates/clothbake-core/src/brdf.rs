@@ -4,7 +4,7 @@
 //! export, pictures and Python all evaluate the model through it.
 
 use crate::analytic::{AnalyticModel, SecondaryOptions};
-use crate::cells::PeriodPoint;
+use crate::cells::{Cell, PeriodPoint};
 use crate::reflect::{intensity_to_brdf, Reflection};
 use clothbake_bsdf::{Bsdf, Footprint, Level, Local, Rgb, UnitVec3};
 use clothbake_point::Yarns;
@@ -118,21 +118,25 @@ impl AnalyticBsdf {
         }
     }
 
-    /// The box filter of side `width` periods at (u, v) over the crossing cells: the cells'
-    /// f_r weighted by their covered share times their coverage, and the mean coverage
-    /// (thesis units, docs/spatial.md).
-    fn cells(&self, u: f64, v: f64, width: f64, wi: UnitVec3, wo: UnitVec3) -> Local {
-        let Some(p) = PeriodPoint::new(u, v) else {
-            return self.period(wi, wo);
-        };
+    /// The crossing cells the square of side `width` periods at the footprint's point covers,
+    /// each with its covered share of the period (`width` 0: the cell at the point). Called
+    /// only where the level rule gave a local level, so the point is finite.
+    fn cells_under(&self, at: Footprint, width: f64) -> Vec<(Cell, f64)> {
+        let p = PeriodPoint::new(at.u, at.v).expect("the level rule gives a finite point");
         let grid = self.model.cells();
-        let cells = if width <= 0.0 {
+        if width <= 0.0 {
             vec![(grid.cell_at(p), 1.0)]
         } else {
             grid.overlaps(p, width)
-        };
+        }
+    }
+
+    /// The box filter of side `width` periods over the crossing cells: the cells' f_r
+    /// weighted by their covered share times their coverage, and the mean coverage (thesis
+    /// units, docs/spatial.md).
+    fn cells(&self, at: Footprint, width: f64, wi: UnitVec3, wo: UnitVec3) -> Local {
         let (mut num, mut den, mut area) = ([0.0; 3], 0.0, 0.0);
-        for (cell, share) in cells {
+        for (cell, share) in self.cells_under(at, width) {
             let l = self
                 .model
                 .intensity_in(wi, wo, cell, self.secondary.as_ref());
@@ -154,16 +158,10 @@ impl AnalyticBsdf {
         }
     }
 
-    /// The mean coverage of the box filter of side `width` periods at the footprint's point.
+    /// The mean coverage of the cells' box filter, from the cells' coverage alone (no facet
+    /// terms).
     fn cells_coverage(&self, at: Footprint, width: f64, wo: UnitVec3) -> f64 {
-        let Some(p) = PeriodPoint::new(at.u, at.v) else {
-            return self.model.coverage(wo);
-        };
-        let grid = self.model.cells();
-        if width <= 0.0 {
-            return self.model.coverage_in(grid.cell_at(p), wo);
-        }
-        let cells = grid.overlaps(p, width);
+        let cells = self.cells_under(at, width);
         let total: f64 = cells.iter().map(|c| c.1).sum();
         cells
             .iter()
@@ -178,20 +176,6 @@ impl AnalyticBsdf {
             f: self.f(wi, wo),
             coverage: self.model.coverage(wo),
         }
-    }
-}
-
-/// `a` and `b` blended with weights `wa` and 1 - `wa`, each f_r weighted by its coverage.
-fn blend(wa: f64, a: Local, b: Local) -> Local {
-    let (ca, cb) = (wa * a.coverage, (1.0 - wa) * b.coverage);
-    let c = ca + cb;
-    Local {
-        f: if c > 0.0 {
-            [0, 1, 2].map(|k| (ca * a.f[k] + cb * b.f[k]) / c)
-        } else {
-            [0.0; 3]
-        },
-        coverage: c,
     }
 }
 
@@ -247,11 +231,8 @@ impl Bsdf for AnalyticBsdf {
                 points,
             } => (point, width, points),
         };
-        // The coverage does not depend on the light: the look under an overhead one.
-        let seen = |y: &Yarns| {
-            y.look_within(at.u, at.v, width, points, UnitVec3::Z, wo)
-                .coverage
-        };
+        // The coverage does not depend on the light: the eye rays alone.
+        let seen = |y: &Yarns| y.coverage_within(at.u, at.v, width, points, wo);
         match self.point_level().filter(|_| point > 0.0) {
             Some(y) if point >= 1.0 => seen(y),
             Some(y) => point * seen(y) + (1.0 - point) * self.cells_coverage(at, width, wo),
@@ -283,7 +264,7 @@ impl Bsdf for AnalyticBsdf {
         };
         let yarns = self.point_level().filter(|_| point > 0.0);
         let Some(yarns) = yarns else {
-            return self.cells(at.u, at.v, width, wi, wo);
+            return self.cells(at, width, wi, wo);
         };
         let look = yarns.look_within(at.u, at.v, width, points, wi, wo);
         let seen = Local {
@@ -293,14 +274,13 @@ impl Bsdf for AnalyticBsdf {
         if point >= 1.0 {
             return seen;
         }
-        blend(point, seen, self.cells(at.u, at.v, width, wi, wo))
+        Local::blend(point, seen, self.cells(at, width, wi, wo))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cells::Cell;
     use crate::{Fabric, FacetModel};
 
     fn shipped(name: &str) -> AnalyticModel {

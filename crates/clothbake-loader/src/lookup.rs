@@ -37,7 +37,7 @@ use crate::sampling::Sampler;
 use crate::spatial::SpatialLookup;
 use crate::stored::{Samples, StoredTable};
 use crate::table::{Grid, Metadata, Precision, Table};
-use clothbake_bsdf::{Footprint, Level};
+use clothbake_bsdf::{Footprint, Level, Local};
 
 /// True when a pair has a value: both directions above the horizon, no component NaN.
 #[inline(always)]
@@ -259,10 +259,11 @@ impl Brdf {
 
     /// f_r and coverage at the point level where the level rule ([`Footprint::level`]) gives
     /// it a share: the yarns' look over the footprint, blended with the cells' box filter
-    /// between one and two cells wide. `None` where the cells or the period answer alone.
+    /// between one and two cells wide (`Local::blend`). Without `wi`, the coverage alone (the
+    /// eye rays alone; f_r 0). `None` where the cells or the period answer alone.
     fn point_local(
         &self,
-        wi: [f32; 3],
+        wi: Option<[f32; 3]>,
         wo: [f32; 3],
         u: f64,
         v: f64,
@@ -280,37 +281,38 @@ impl Brdf {
         if point <= 0.0 {
             return None;
         }
-        let (Some(i), Some(o)) = (unit(wi), unit(wo)) else {
+        let Some(o) = unit(wo) else {
             return Some(([0.0; 3], 0.0));
         };
-        // The coverage does not depend on the light: where it is below the horizon, the look
-        // under an overhead one gives it.
-        let look = p.yarns.look_within(u, v, width, points, i, o);
-        let (f, c) = if i.above_horizon() {
-            (look.f, look.coverage)
-        } else {
-            let z = clothbake_bsdf::UnitVec3::Z;
-            (
-                [0.0; 3],
-                p.yarns.look_within(u, v, width, points, z, o).coverage,
-            )
-        };
-        if point >= 1.0 {
-            return Some((f.map(|x| x as f32), c as f32));
-        }
-        let s = self.spatial.as_ref()?;
-        let fc = s.eval_within(self.simd, wi, wo, u, v, width);
-        let cc = f64::from(s.coverage_at(wo, u, v, width).unwrap_or(1.0));
-        let (a, b) = (point * c, (1.0 - point) * cc);
-        let sum = a + b;
-        let blend = |k: usize| {
-            if sum > 0.0 {
-                ((a * f[k] + b * f64::from(fc[k])) / sum) as f32
-            } else {
-                0.0
+        // The coverage does not depend on the light: with none above the horizon, the eye
+        // rays alone give it.
+        let seen = match wi.and_then(unit).filter(|i| i.above_horizon()) {
+            Some(i) => {
+                let l = p.yarns.look_within(u, v, width, points, i, o);
+                Local {
+                    f: l.f,
+                    coverage: l.coverage,
+                }
             }
+            None => Local {
+                f: [0.0; 3],
+                coverage: p.yarns.coverage_within(u, v, width, points, o),
+            },
         };
-        Some(([blend(0), blend(1), blend(2)], sum as f32))
+        let l = if point >= 1.0 {
+            seen
+        } else {
+            let s = self.spatial.as_ref()?;
+            let cells = Local {
+                f: match wi {
+                    Some(wi) => s.eval_within(self.simd, wi, wo, u, v, width).map(f64::from),
+                    None => [0.0; 3],
+                },
+                coverage: f64::from(s.coverage_at(wo, u, v, width).unwrap_or(1.0)),
+            };
+            Local::blend(point, seen, cells)
+        };
+        Some((l.f.map(|x| x as f32), l.coverage as f32))
     }
 
     /// f_r through a footprint of the weave period (docs/spatial.md): at (u, v) in period
@@ -323,7 +325,7 @@ impl Brdf {
     #[inline]
     pub fn eval_at(&self, wi: [f32; 3], wo: [f32; 3], u: f64, v: f64, width: f64) -> [f32; 3] {
         if self.point.is_some() {
-            if let Some((f, _)) = self.point_local(wi, wo, u, v, width) {
+            if let Some((f, _)) = self.point_local(Some(wi), wo, u, v, width) {
                 return f;
             }
         }
@@ -347,7 +349,7 @@ impl Brdf {
         width: f64,
     ) -> ([f32; 3], f32) {
         if self.point.is_some() {
-            if let Some(l) = self.point_local(wi, wo, u, v, width) {
+            if let Some(l) = self.point_local(Some(wi), wo, u, v, width) {
                 return l;
             }
         }
@@ -363,7 +365,7 @@ impl Brdf {
     /// averaged table carries no coverage and answers 1 (opaque).
     pub fn coverage_at(&self, wo: [f32; 3], u: f64, v: f64, width: f64) -> f32 {
         if self.point.is_some() {
-            if let Some((_, c)) = self.point_local([0.0, 0.0, 1.0], wo, u, v, width) {
+            if let Some((_, c)) = self.point_local(None, wo, u, v, width) {
                 return c;
             }
         }

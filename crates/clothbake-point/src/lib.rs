@@ -63,6 +63,39 @@ pub struct Sight {
     key: grid::Key,
 }
 
+/// The points a footprint of side `width` periods centred on (u, v) is integrated with:
+/// `points` x `points` stratified over the square, each jittered within its stratum by a hash
+/// of the centre (so the same footprint gives the same points, and a growing one moves them
+/// smoothly); (u, v) alone for one point or a width not above 0.
+pub fn footprint_points(
+    u: f64,
+    v: f64,
+    width: f64,
+    points: usize,
+) -> impl Iterator<Item = (f64, f64)> {
+    let one = points <= 1 || width.is_nan() || width <= 0.0;
+    let k = if one { 1 } else { points };
+    let mut h = u.to_bits() ^ v.to_bits().rotate_left(29);
+    let mut jitter = move || {
+        // SplitMix64.
+        h = h.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = h;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    };
+    (0..k * k).map(move |i| {
+        if one {
+            return (u, v);
+        }
+        let (a, b) = ((i / k) as f64, (i % k) as f64);
+        let kf = k as f64;
+        let x = u + width * ((a + jitter()) / kf - 0.5);
+        let y = v + width * ((b + jitter()) / kf - 0.5);
+        (x, y)
+    })
+}
+
 /// A [`Period`] ready to trace: its yarns sorted into a grid over the period.
 #[derive(Clone, Debug)]
 pub struct Yarns {
@@ -160,12 +193,10 @@ impl Yarns {
         self.shade(&s, wi, wo)
     }
 
-    /// The mean look over the square of side `width` periods centred on (u, v): `points` x
-    /// `points` stratified points, each jittered within its stratum by a hash of the square's
-    /// centre (so the same footprint gives the same answer, and a growing one moves its points
-    /// smoothly). Coverage is the share of the points
-    /// that meet a yarn; f_r the mean over those (zero where none does). One point (or a width
-    /// of 0) is [`Yarns::look`] at the centre.
+    /// The mean look over the square of side `width` periods centred on (u, v): the
+    /// [`footprint_points`] of the square. Coverage is the share of the points that meet a
+    /// yarn; f_r the mean over those (zero where none does). One point (or a width of 0) is
+    /// [`Yarns::look`] at the centre.
     pub fn look_within(
         &self,
         u: f64,
@@ -175,34 +206,17 @@ impl Yarns {
         wi: UnitVec3,
         wo: UnitVec3,
     ) -> Look {
-        if points <= 1 || width.is_nan() || width <= 0.0 {
-            return self.look(u, v, wi, wo);
-        }
-        let mut h = u.to_bits() ^ v.to_bits().rotate_left(29);
-        let mut jitter = move || {
-            // SplitMix64.
-            h = h.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = h;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            ((z ^ (z >> 31)) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-        };
-        let k = points as f64;
-        let (mut sum, mut hits) = ([0.0; 3], 0usize);
-        for a in 0..points {
-            for b in 0..points {
-                let x = u + width * ((a as f64 + jitter()) / k - 0.5);
-                let y = v + width * ((b as f64 + jitter()) / k - 0.5);
-                let l = self.look(x, y, wi, wo);
-                if l.coverage > 0.0 {
-                    hits += 1;
-                    for (s, f) in sum.iter_mut().zip(l.f) {
-                        *s += f;
-                    }
+        let (mut sum, mut hits, mut n) = ([0.0; 3], 0usize, 0usize);
+        for (x, y) in footprint_points(u, v, width, points) {
+            n += 1;
+            let l = self.look(x, y, wi, wo);
+            if l.coverage > 0.0 {
+                hits += 1;
+                for (s, f) in sum.iter_mut().zip(l.f) {
+                    *s += f;
                 }
             }
         }
-        let n = points * points;
         Look {
             f: if hits > 0 {
                 sum.map(|s| s / hits as f64)
@@ -211,6 +225,20 @@ impl Yarns {
             },
             coverage: hits as f64 / n as f64,
         }
+    }
+
+    /// The coverage of [`Yarns::look_within`] (under any light above the horizon), from the
+    /// eye rays alone: the share of the same points whose eye ray meets a yarn's side.
+    pub fn coverage_within(&self, u: f64, v: f64, width: f64, points: usize, wo: UnitVec3) -> f64 {
+        let (mut hits, mut n) = (0usize, 0usize);
+        for (x, y) in footprint_points(u, v, width, points) {
+            n += 1;
+            let side = self
+                .sight(x, y, wo)
+                .is_some_and(|s| s.surface == Surface::Side);
+            hits += usize::from(side);
+        }
+        hits as f64 / n as f64
     }
 
     /// The look of a point met by an eye ray toward `wo`, lit from `wi`.

@@ -73,7 +73,8 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
             let model = AnalyticModel::with_variant(&fabric, facet, args.model.variant.into());
             let coverage = if horizon { 0.0 } else { model.coverage(wo) };
             let at = args.at.map(|p| (p, model.cells().cell_at(p)));
-            let r = if horizon {
+            // With --at the footprint's reflection replaces the period's in the report.
+            let r = if horizon || at.is_some() {
                 Reflection {
                     secondary: secondary.map(|_| Secondary::default()),
                     ..Reflection::default()
@@ -89,15 +90,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
                     v: p.v(),
                     width: args.width.unwrap_or(0.0),
                 };
-                footprint(
-                    &fabric,
-                    facet,
-                    args.model.variant.into(),
-                    secondary,
-                    fp,
-                    wi,
-                    wo,
-                )
+                footprint(&fabric, model, secondary, fp, wi, wo)
             });
             local = Some(report::Local {
                 directional_coverage: coverage,
@@ -225,41 +218,42 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
 /// same footprint (`Component::Secondary`: the crossing cells or the period).
 fn footprint(
     fabric: &Fabric,
-    facet: FacetModel,
-    variant: Variant,
+    model: AnalyticModel,
     secondary: Option<SecondaryOptions>,
     at: Footprint,
     wi: UnitVec3,
     wo: UnitVec3,
 ) -> (report::AtFootprint, f64) {
-    let model = || AnalyticModel::with_variant(fabric, facet, variant);
-    let mut bsdf = AnalyticBsdf::new(model(), secondary);
+    let facet = model.facet();
+    let i2_bsdf = secondary.and_then(|_| {
+        AnalyticBsdf::new(model.clone(), secondary).with_component(Component::Secondary)
+    });
+    let mut bsdf = AnalyticBsdf::new(model, secondary);
     if secondary.is_none() {
         if let Some(y) = clothbake_core::point::yarns(fabric, facet) {
             bsdf = bsdf.with_yarns(y);
         }
     }
-    let cell = bsdf.cell_width();
-    let level = match at.level(cell) {
+    // The point level answers only where the BSDF has the yarns (one bounce, a period of at
+    // most MAX_YARNS segments).
+    let traced = bsdf.yarns().is_some();
+    let level = match at.level(bsdf.cell_width()) {
         Level::Period => "the period (averaged)",
-        Level::Local { point, points, .. } if secondary.is_none() && point >= 1.0 => {
+        Level::Local { point, points, .. } if traced && point >= 1.0 => {
             if points == 1 {
                 "the point (the yarns traced)"
             } else {
                 "the point level over the footprint (the yarns traced)"
             }
         }
-        Level::Local { point, .. } if secondary.is_none() && point > 0.0 => {
+        Level::Local { point, .. } if traced && point > 0.0 => {
             "the point level and the crossing cells, blended"
         }
         Level::Local { .. } => "the crossing cells",
     };
     let l = bsdf.local(at, wi, wo);
     let k = std::f64::consts::PI * wi.cos_theta();
-    let i2 = secondary.and_then(|_| {
-        let b = AnalyticBsdf::new(model(), secondary).with_component(Component::Secondary)?;
-        Some(b.f_at(at, wi, wo).map(|f| f * k))
-    });
+    let i2 = i2_bsdf.map(|b| b.f_at(at, wi, wo).map(|f| f * k));
     (
         report::AtFootprint {
             width: at.width,
