@@ -13,7 +13,10 @@
 //! analytic model as the baker evaluates it (`clothbake_core::AnalyticBsdf`) or a baked table
 //! (`clothbake_loader::Brdf`).
 
+pub mod fitted;
+pub mod gltf;
 pub mod merl;
+pub mod openpbr;
 pub mod rgl;
 pub mod spectrum;
 

@@ -326,7 +326,9 @@ pub struct InfoArgs {
 /// `clothbake export`.
 #[derive(Args, Debug)]
 #[command(
-    after_help = "The MERL format is isotropic and cloth is not: each MERL cell holds f_r \
+    after_help = "--gltf, --mtlx, --usd and --blender write standard materials fitted to the \
+                  cloth (per crossing cell where the source resolves cells), and print how \
+                  far each is from the averaged BRDF. The MERL format is isotropic and cloth is not: each MERL cell holds f_r \
                   averaged over rotations about the normal (--phi-samples angles) and over \
                   swapping light and eye; the spread lost is printed. The RGL file keeps the \
                   anisotropy. See docs/export.md."
@@ -354,6 +356,30 @@ pub struct ExportArgs {
     /// Write the 90x90x180 MERL binary (isotropic: averaged over rotations about the normal).
     #[arg(long, value_name = "OUT.binary")]
     pub merl: Option<PathBuf>,
+
+    /// Write a glTF 2.0 binary (`.glb`): a swatch with the fitted material
+    /// (KHR_materials_sheen, KHR_materials_anisotropy, textures over one period).
+    #[arg(long, value_name = "OUT.glb")]
+    pub gltf: Option<PathBuf>,
+
+    /// Write a MaterialX 1.39 document with the fitted OpenPBR material (`open_pbr_surface`);
+    /// its texture maps go beside it as OUT.base.png, OUT.scalars.png, OUT.tangent.png.
+    #[arg(long, value_name = "OUT.mtlx")]
+    pub mtlx: Option<PathBuf>,
+
+    /// Write a USD stage (`.usda`): the fitted OpenPBR material with a UsdPreviewSurface
+    /// fallback, bound to a swatch mesh; its maps go beside it as for --mtlx.
+    #[arg(long, value_name = "OUT.usda")]
+    pub usd: Option<PathBuf>,
+
+    /// Write a Blender module: run inside Blender, it builds the fitted material as a
+    /// Principled BSDF node tree.
+    #[arg(long, value_name = "OUT.py")]
+    pub blender: Option<PathBuf>,
+
+    /// Fitted materials: weave periods per UV unit (the textures' tiling).
+    #[arg(long, value_name = "P", value_parser = parse_periods_per_uv, default_value = "8")]
+    pub periods_per_uv: f64,
 
     /// RGL grid: polar and azimuth steps of the view direction, nodes per side of each slice.
     #[arg(long, value_name = "NT,NP,NS", value_parser = parse_rgl_res, default_value = "16,24,32")]
@@ -413,6 +439,17 @@ pub fn parse_rgl_res(s: &str) -> Result<RglResArg, String> {
     };
     g.validate().map_err(|e| format!("{e}; {FIX}"))?;
     Ok(RglResArg(g))
+}
+
+/// Parses `--periods-per-uv P`: a number from 1/1024 to 1024.
+pub fn parse_periods_per_uv(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(p) if p.is_finite() && (1.0 / 1024.0..=1024.0).contains(&p) => Ok(p),
+        _ => Err(format!(
+            "`{s}` is not a number from 1/1024 to 1024; give the weave periods per UV unit, \
+             e.g. 8"
+        )),
+    }
 }
 
 /// Parses `--phi-samples N`, 1 <= N <= 4096.

@@ -1,6 +1,7 @@
 //! `clothbake export`: the BRDF of the analytic model (`--weave`) or of a baked table
 //! (`--table`, through the loader's lookup) as an RGL `.bsdf` (RGB for Mitsuba 3, spectral for
-//! pbrt-v4 and Mitsuba's spectral variants) and/or a MERL binary, each written atomically.
+//! pbrt-v4 and Mitsuba's spectral variants), a MERL binary, and/or fitted standard materials
+//! (glTF, MaterialX, USD, Blender: `fitted_cmd`), each written atomically.
 //! Formats and conventions: `docs/export.md`.
 
 use crate::bake_cmd::preflight;
@@ -9,6 +10,7 @@ use crate::error::CliError;
 use crate::eval_cmd::apply_material;
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel};
+use clothbake_export::fitted::material::{Cells, Source};
 use clothbake_export::{self as export, merl, rgl, spectrum, Bsdf};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -16,15 +18,24 @@ use std::time::Instant;
 
 /// Runs `clothbake export` and returns the summary for stdout (empty with --quiet).
 pub fn run(args: &ExportArgs) -> Result<String, CliError> {
-    let outputs: Vec<&PathBuf> = [&args.rgl, &args.rgl_spectral, &args.merl]
-        .into_iter()
-        .flatten()
-        .collect();
+    let outputs: Vec<&PathBuf> = [
+        &args.rgl,
+        &args.rgl_spectral,
+        &args.merl,
+        &args.gltf,
+        &args.mtlx,
+        &args.usd,
+        &args.blender,
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
     if outputs.is_empty() {
         return Err(CliError::new(
             "nothing to export",
             "give --rgl OUT.bsdf (Mitsuba 3), --rgl-spectral OUT.bsdf (pbrt-v4, Mitsuba 3 \
-             spectral) and/or --merl OUT.binary",
+             spectral), --merl OUT.binary, or a fitted material: --gltf OUT.glb (the web), \
+             --mtlx OUT.mtlx (MaterialX), --usd OUT.usda, --blender OUT.py",
         ));
     }
     for (i, a) in outputs.iter().enumerate() {
@@ -57,17 +68,28 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);
             let model = AnalyticModel::with_variant(&fabric, facet, variant.into());
             let variant_name = model.variant().name();
+            let analytic = AnalyticBsdf::new(model, secondary);
+            let (u_edges, v_edges) = analytic.model().cells().edge_fractions();
             // Full transport: the analytic terms plus the path-traced orders (docs/transport.md).
-            let brdf: Box<dyn Bsdf> = if args.bounces.bounces > 2 {
-                Box::new(clothbake_bake::transport::FullTransport::new(
+            let full = (args.bounces.bounces > 2).then(|| {
+                clothbake_bake::transport::FullTransport::new(
                     &fabric,
                     facet,
                     variant.into(),
                     args.bounces.bounces,
-                ))
-            } else {
-                Box::new(AnalyticBsdf::new(model, secondary))
+                )
+            });
+            let brdf: &dyn Bsdf = match &full {
+                Some(f) => f,
+                None => &analytic,
             };
+            // The crossing cells resolve the fitted materials' textures (the model without
+            // its yarns answers a point with its cell); full transport has no cells.
+            let cells = full.is_none().then_some(Cells {
+                bsdf: &analytic,
+                u_edges,
+                v_edges,
+            });
             let source = format!(
                 "fabric {}; f_r cos(theta_light) of the analytic model (facet {}, variant {}, \
                  bounces {})",
@@ -78,12 +100,13 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             );
             // A fabric unchanged by a half turn has a BRDF unchanged by it: half the rotations.
             let half_turn = symmetries(&fabric).contains(&Symmetry::Rotate180);
-            write_all(args, brdf.as_ref(), &source, half_turn)
+            write_all(args, brdf, cells, fabric.name(), &source, half_turn)
         }
         (None, Some(table)) => {
             refuse_model_options(args)?;
             let options = clothbake_loader::Options {
                 sampling: false,
+                point_level: false,
                 ..Default::default()
             };
             let lookup = clothbake_loader::Brdf::open(table, options)?;
@@ -107,9 +130,16 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
                 meta.options_json,
                 meta.fabric_json
             );
+            // A spatial table resolves the crossing cells (its point level is off: a point
+            // answers with its cell).
+            let cells = meta.spatial.as_ref().map(|s| Cells {
+                bsdf: &lookup,
+                u_edges: s.u_edges.clone(),
+                v_edges: s.v_edges.clone(),
+            });
             // No half-turn shortcut for a table: lookups are cheap, and the interpolated table
             // need not be exactly symmetric.
-            write_all(args, &lookup, &source, false)
+            write_all(args, &lookup, cells, &name, &source, false)
         }
     }
 }
@@ -138,7 +168,8 @@ fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
 
 /// Checks every output before any work is done ([`preflight`]).
 fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
-    let outputs: Vec<(&std::path::Path, &str)> = [
+    let fitted = crate::fitted_cmd::outputs(args);
+    let mut outputs: Vec<(&std::path::Path, &str)> = [
         (&args.rgl, "RGL file"),
         (&args.rgl_spectral, "spectral RGL file"),
         (&args.merl, "MERL file"),
@@ -146,6 +177,7 @@ fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
     .into_iter()
     .filter_map(|(p, what)| Some((p.as_deref()?, what)))
     .collect();
+    outputs.extend(fitted.iter().map(|(p, what)| (p.as_path(), *what)));
     let inputs: Vec<&std::path::Path> = [&args.weave, &args.table]
         .into_iter()
         .filter_map(|p| p.as_deref())
@@ -157,12 +189,19 @@ fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
 fn write_all(
     args: &ExportArgs,
     brdf: &dyn Bsdf,
+    cells: Option<Cells<'_>>,
+    name: &str,
     source: &str,
     half_turn: bool,
 ) -> Result<String, CliError> {
     let threads = crate::bake_cmd::thread_count(args.run.threads);
     let pool = crate::bake_cmd::thread_pool(threads)?;
     let mut summary = String::new();
+    let src = Source {
+        average: brdf,
+        cells,
+    };
+    summary += &pool.install(|| crate::fitted_cmd::write(args, &src, name))?;
     let g = args.rgl_res.0;
     // One evaluation of the slices serves both RGL files.
     let mut slices = None;

@@ -10,6 +10,7 @@ mod error;
 mod eval_cmd;
 mod export_cmd;
 mod fabrics;
+mod fitted_cmd;
 mod help_cmd;
 mod info_cmd;
 mod merge_cmd;

@@ -1,0 +1,166 @@
+//! `clothbake export --gltf/--mtlx/--usd/--blender`: fitted standard materials
+//! (docs/export.md, "Fitted materials").
+
+use crate::cli::ExportArgs;
+use crate::error::CliError;
+use clothbake_export::fitted::material::{Fitted, Source};
+use clothbake_export::fitted::microfacet::Albedos;
+use clothbake_export::fitted::{Family, IOR};
+use clothbake_export::{self as export, gltf, openpbr};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The outputs of the fitted targets with what each is, for the existing-file check; the
+/// maps beside the MaterialX and USD files included when the material may be textured.
+pub fn outputs(args: &ExportArgs) -> Vec<(PathBuf, &'static str)> {
+    let mut out: Vec<(PathBuf, &'static str)> = Vec::new();
+    for (p, what) in [
+        (&args.gltf, "glTF file"),
+        (&args.mtlx, "MaterialX file"),
+        (&args.usd, "USD file"),
+        (&args.blender, "Blender module"),
+    ] {
+        if let Some(p) = p {
+            out.push((p.clone(), what));
+        }
+    }
+    for stem in map_stems(args) {
+        for m in openpbr::map_names(&stem.1) {
+            let path = stem.0.join(m);
+            if !out.iter().any(|(p, _)| *p == path) {
+                out.push((path, "texture map"));
+            }
+        }
+    }
+    out
+}
+
+/// The folders and stems of the MaterialX and USD outputs (their maps' names).
+fn map_stems(args: &ExportArgs) -> Vec<(PathBuf, String)> {
+    let mut v: Vec<(PathBuf, String)> = Vec::new();
+    for p in [&args.mtlx, &args.usd].into_iter().flatten() {
+        let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
+        let stem = p
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "cloth".into());
+        if !v.contains(&(dir.clone(), stem.clone())) {
+            v.push((dir, stem));
+        }
+    }
+    v
+}
+
+/// Whether any fitted target was asked for.
+pub fn wanted(args: &ExportArgs) -> bool {
+    args.gltf.is_some() || args.mtlx.is_some() || args.usd.is_some() || args.blender.is_some()
+}
+
+fn percent(r: &clothbake_export::fitted::fit::Residual) -> String {
+    format!(
+        "albedo error {:.1}% mean, {:.1}% max; L2 of f_r cos {:.1}%",
+        100.0 * r.albedo_mean,
+        100.0 * r.albedo_max,
+        100.0 * r.l2
+    )
+}
+
+/// Fits and writes every fitted target asked for; returns the summary lines.
+pub fn write(args: &ExportArgs, src: &Source<'_>, name: &str) -> Result<String, CliError> {
+    let mut summary = String::new();
+    if !wanted(args) {
+        return Ok(summary);
+    }
+    let start = Instant::now();
+    let tables = Albedos::new(IOR);
+    let p = args.periods_per_uv;
+    let force = args.run.force;
+    if let Some(out) = &args.gltf {
+        let m = Fitted::new(Family::Gltf, src, &tables);
+        let file = gltf::glb(&m, name, p);
+        export::write_file(out, &file.bytes, force)?;
+        let res = file
+            .held
+            .residual_against(src.average, Family::Gltf.convention(), &tables);
+        let _ = writeln!(
+            summary,
+            "wrote {}: glTF 2.0 (KHR_materials_sheen, KHR_materials_anisotropy), {}, {} periods \
+             per UV unit; fit against the averaged BRDF: {}",
+            out.display(),
+            texture_words(&m),
+            p,
+            percent(&res)
+        );
+    }
+    if args.mtlx.is_some() || args.usd.is_some() || args.blender.is_some() {
+        let m = Fitted::new(Family::OpenPbr, src, &tables);
+        let maps = (!m.is_uniform()).then(|| openpbr::OpenPbrMaps::new(&m));
+        let held = maps.as_ref().map_or_else(|| m.clone(), |x| x.held(&m));
+        let res = held.residual_against(src.average, Family::OpenPbr.convention(), &tables);
+        for (dir, stem) in map_stems(args) {
+            if let Some(maps) = &maps {
+                let names = openpbr::map_names(&stem);
+                // MaterialX and USD put texture coordinate (0, 0) at the lower left.
+                for (n, map) in names.iter().zip([&maps.base, &maps.scalars, &maps.tangent]) {
+                    export::write_file(&dir.join(n), &map.flipped().png(), force)?;
+                }
+            }
+        }
+        let names_for = |path: &Path| {
+            let stem = path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "cloth".into());
+            maps.as_ref().map(|_| openpbr::map_names(&stem))
+        };
+        if let Some(out) = &args.mtlx {
+            let doc = openpbr::mtlx(&m, name, names_for(out).as_ref(), p);
+            export::write_file(out, doc.as_bytes(), force)?;
+            let _ = writeln!(
+                summary,
+                "wrote {}: MaterialX 1.39 open_pbr_surface, {}; fit against the averaged BRDF: {}",
+                out.display(),
+                texture_words(&m),
+                percent(&res)
+            );
+        }
+        if let Some(out) = &args.usd {
+            let doc = openpbr::usda(&m, name, names_for(out).as_ref(), p);
+            export::write_file(out, doc.as_bytes(), force)?;
+            let _ = writeln!(
+                summary,
+                "wrote {}: USD, OpenPBR (MaterialX) with a UsdPreviewSurface fallback, on a \
+                 swatch mesh, {}",
+                out.display(),
+                texture_words(&m)
+            );
+        }
+        if let Some(out) = &args.blender {
+            let (src_py, _) = openpbr::blender(&m, name, p);
+            export::write_file(out, src_py.as_bytes(), force)?;
+            let _ = writeln!(
+                summary,
+                "wrote {}: Blender module (Principled BSDF; run it inside Blender), {}",
+                out.display(),
+                texture_words(&m)
+            );
+        }
+    }
+    let _ = writeln!(
+        summary,
+        "fitted in {:.1} s (the residuals: docs/export.md, \"Fitted materials\")",
+        start.elapsed().as_secs_f64()
+    );
+    Ok(summary)
+}
+
+fn texture_words(m: &Fitted) -> String {
+    if m.is_uniform() {
+        "one set of parameters for the whole cloth".into()
+    } else {
+        let (w, h) = m.texture_size();
+        let (nu, nv) = m.dims();
+        format!("textures {w} x {h} over one period of {nu} x {nv} crossing cells")
+    }
+}
