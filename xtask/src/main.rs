@@ -15,6 +15,8 @@
 //! * `gallery [--quick] [--envmap FILE.exr]`: pictures of every shipped fabric rendered by
 //!   Mitsuba 3 (draped over a ball under a sky, path traced) into `docs/gallery/` (see
 //!   `gallery.rs`).
+//! * `fitted`: the residuals of the fitted standard materials of every shipped fabric, into
+//!   `docs/export.md` (see `fitted.rs`).
 //! * `lod`: the level-of-detail pictures (point, cells, period) against the ground-truth
 //!   pictures at six distances, into `docs/validation.md` (see `lod.rs`).
 //! * `validate-spatial`: the model per crossing cell against the truth sorted into the same
@@ -36,6 +38,7 @@ use clothbake_bake::golden::{bake_golden, golden_path, shipped_fabrics};
 use clothbake_bake::{bake, BakeOptions};
 mod ch5;
 mod figures;
+mod fitted;
 mod gallery;
 mod install_capi;
 mod ir_accuracy;
@@ -67,6 +70,7 @@ fn main() {
         "validate" => validate(),
         "validate-spatial" => spatial::run(&root()),
         "lod" => lod::run(&root()),
+        "fitted" => fitted::run(&root()),
         "ch5" => ch5::run(&root()),
         "transport" => transport::run(&root(), std::env::args().nth(2).as_deref()),
         "figures" => figures::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
@@ -80,7 +84,7 @@ fn main() {
         "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | lod | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots|yarns [--thunderloom DIR]] | gallery [--quick] [--envmap FILE.exr] [--only NAME,...] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
+                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | lod | fitted | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots|yarns [--thunderloom DIR]] | gallery [--quick] [--envmap FILE.exr] [--only NAME,...] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
             );
             std::process::exit(2);
         }

@@ -22,6 +22,28 @@ pub struct Glb {
     pub held: Fitted,
 }
 
+/// The material as a glTF file holds it: a uniform one as f32 factors, a textured one as the
+/// 8-bit codes of its maps ([`Maps::quantised`]).
+pub fn held(m: &Fitted) -> Fitted {
+    if m.is_uniform() {
+        let f = |x: f64| x as f32 as f64;
+        let p = m.cells[0];
+        let (s, c) = p.tangent_deg.to_radians().sin_cos();
+        let rotation = f(s.atan2(c));
+        m.map(|_| Params {
+            base: p.base.map(f),
+            roughness: f(p.roughness),
+            anisotropy: f(p.anisotropy),
+            tangent_deg: rotation.to_degrees(),
+            sheen: f(p.sheen),
+            sheen_roughness: f(p.sheen_roughness),
+            diffuse_roughness: 0.0,
+        })
+    } else {
+        Maps::new(m).quantised(m)
+    }
+}
+
 /// The glTF file of `m` (fitted for [`crate::fitted::Family::Gltf`]), named `name`, with
 /// `periods_per_uv` periods of the weave per UV unit.
 pub fn glb(m: &Fitted, name: &str, periods_per_uv: f64) -> Glb {
@@ -65,20 +87,10 @@ pub fn glb(m: &Fitted, name: &str, periods_per_uv: f64) -> Glb {
         {"bufferView": uv, "componentType": 5126, "count": 4, "type": "VEC2"},
         {"bufferView": ind, "componentType": 5123, "count": 6, "type": "SCALAR"},
     ]);
-    let f = |x: f64| x as f32 as f64;
-    let (material, images, held) = if m.is_uniform() {
-        let p = m.cells[0];
-        let (s, c) = p.tangent_deg.to_radians().sin_cos();
-        let rotation = f(s.atan2(c));
-        let held = m.map(|_| Params {
-            base: p.base.map(f),
-            roughness: f(p.roughness),
-            anisotropy: f(p.anisotropy),
-            tangent_deg: rotation.to_degrees(),
-            sheen: f(p.sheen),
-            sheen_roughness: f(p.sheen_roughness),
-            diffuse_roughness: 0.0,
-        });
+    let held = held(m);
+    let (material, images) = if m.is_uniform() {
+        let (s, c) = m.cells[0].tangent_deg.to_radians().sin_cos();
+        let rotation = s.atan2(c) as f32 as f64;
         let q = held.cells[0];
         let mat = json!({
             "name": name,
@@ -98,10 +110,9 @@ pub fn glb(m: &Fitted, name: &str, periods_per_uv: f64) -> Glb {
                 },
             },
         });
-        (mat, Vec::new(), held)
+        (mat, Vec::new())
     } else {
         let maps = Maps::new(m);
-        let held = maps.quantised(m);
         // glTF's image row 0 is at UV v = 0, which is the top of the swatch (y = 1).
         let pngs: Vec<Vec<u8>> = [&maps.base, &maps.roughness, &maps.anisotropy, &maps.sheen]
             .iter()
@@ -139,7 +150,7 @@ pub fn glb(m: &Fitted, name: &str, periods_per_uv: f64) -> Glb {
                 },
             },
         });
-        (mat, images, held)
+        (mat, images)
     };
     while !bin.len().is_multiple_of(4) {
         bin.push(0);

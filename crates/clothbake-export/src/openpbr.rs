@@ -589,15 +589,11 @@ pub fn usda(m: &Fitted, name: &str, maps: Option<&[String; 3]>, periods_per_uv: 
     s
 }
 
-/// The Blender module of `m` (fitted for OpenPBR, converted to the Principled BSDF's
-/// parameters by [`cycles_params`]): a Python file that, run inside Blender (or imported
-/// from `bpy`), defines `build_material(name)`, which builds a Principled BSDF node tree with
-/// its maps as float images made in memory, and returns the material. Run as a script
-/// (`blender --python FILE`), it builds the material and assigns it to the selected objects.
-/// Returns the source and the material as it holds it (Principled parameters, f32).
-pub fn blender(m: &Fitted, name: &str, periods_per_uv: f64) -> (String, Fitted) {
+/// The Principled BSDF's parameters of the OpenPBR fit `m` ([`cycles_params`]), as the
+/// Blender module holds them (f32).
+pub fn blender_held(m: &Fitted) -> Fitted {
     let f = |x: f64| x as f32 as f64;
-    let held = m.map(|p| {
+    m.map(|p| {
         let c = cycles_params(p);
         Params {
             base: c.base.map(f),
@@ -608,7 +604,17 @@ pub fn blender(m: &Fitted, name: &str, periods_per_uv: f64) -> (String, Fitted) 
             sheen_roughness: f(c.sheen_roughness),
             diffuse_roughness: f(c.diffuse_roughness),
         }
-    });
+    })
+}
+
+/// The Blender module of `m` (fitted for OpenPBR, converted to the Principled BSDF's
+/// parameters by [`cycles_params`]): a Python file that, run inside Blender (or imported
+/// from `bpy`), defines `build_material(name)`, which builds a Principled BSDF node tree with
+/// its maps as float images made in memory, and returns the material. Run as a script
+/// (`blender --python FILE`), it builds the material and assigns it to the selected objects.
+/// Returns the source and the material as it holds it (Principled parameters, f32).
+pub fn blender(m: &Fitted, name: &str, periods_per_uv: f64) -> (String, Fitted) {
+    let held = blender_held(m);
     let (w, h) = m.texture_size();
     let cells = m.texel_cells(w, h);
     // Two RGBA float maps, rows from v = 0 (Blender's image origin is the lower left):

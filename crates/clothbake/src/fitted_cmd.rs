@@ -3,9 +3,9 @@
 
 use crate::cli::ExportArgs;
 use crate::error::CliError;
-use clothbake_export::fitted::material::{Fitted, Source};
+use clothbake_export::fitted::material::{Fits, Fitted, Source};
 use clothbake_export::fitted::microfacet::Albedos;
-use clothbake_export::fitted::{Family, IOR};
+use clothbake_export::fitted::IOR;
 use clothbake_export::{self as export, gltf, openpbr};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -76,28 +76,24 @@ pub fn write(args: &ExportArgs, src: &Source<'_>, name: &str) -> Result<String, 
     let tables = Albedos::new(IOR);
     let p = args.periods_per_uv;
     let force = args.run.force;
+    let want_openpbr = args.mtlx.is_some() || args.usd.is_some() || args.blender.is_some();
+    let fits = Fits::new(src, &tables, args.gltf.is_some(), want_openpbr);
     if let Some(out) = &args.gltf {
-        let m = Fitted::new(Family::Gltf, src, &tables);
-        let file = gltf::glb(&m, name, p);
+        let file = gltf::glb(&fits.gltf, name, p);
         export::write_file(out, &file.bytes, force)?;
-        let res = file
-            .held
-            .residual_against(src.average, Family::Gltf.convention(), &tables);
         let _ = writeln!(
             summary,
             "wrote {}: glTF 2.0 (KHR_materials_sheen, KHR_materials_anisotropy), {}, {} periods \
-             per UV unit; fit against the averaged BRDF: {}",
+             per UV unit; against the averaged BRDF: {}",
             out.display(),
-            texture_words(&m),
+            texture_words(&fits.gltf),
             p,
-            percent(&res)
+            percent(&fits.gltf_residual)
         );
     }
-    if args.mtlx.is_some() || args.usd.is_some() || args.blender.is_some() {
-        let m = Fitted::new(Family::OpenPbr, src, &tables);
-        let maps = (!m.is_uniform()).then(|| openpbr::OpenPbrMaps::new(&m));
-        let held = maps.as_ref().map_or_else(|| m.clone(), |x| x.held(&m));
-        let res = held.residual_against(src.average, Family::OpenPbr.convention(), &tables);
+    if want_openpbr {
+        let m = &fits.openpbr;
+        let maps = (!m.is_uniform()).then(|| openpbr::OpenPbrMaps::new(m));
         for (dir, stem) in map_stems(args) {
             if let Some(maps) = &maps {
                 let names = openpbr::map_names(&stem);
@@ -115,41 +111,44 @@ pub fn write(args: &ExportArgs, src: &Source<'_>, name: &str) -> Result<String, 
             maps.as_ref().map(|_| openpbr::map_names(&stem))
         };
         if let Some(out) = &args.mtlx {
-            let doc = openpbr::mtlx(&m, name, names_for(out).as_ref(), p);
+            let doc = openpbr::mtlx(m, name, names_for(out).as_ref(), p);
             export::write_file(out, doc.as_bytes(), force)?;
             let _ = writeln!(
                 summary,
-                "wrote {}: MaterialX 1.39 open_pbr_surface, {}; fit against the averaged BRDF: {}",
+                "wrote {}: MaterialX 1.39 open_pbr_surface, {}; against the averaged BRDF: {}",
                 out.display(),
-                texture_words(&m),
-                percent(&res)
+                texture_words(m),
+                percent(&fits.openpbr_residual)
             );
         }
         if let Some(out) = &args.usd {
-            let doc = openpbr::usda(&m, name, names_for(out).as_ref(), p);
+            let doc = openpbr::usda(m, name, names_for(out).as_ref(), p);
             export::write_file(out, doc.as_bytes(), force)?;
             let _ = writeln!(
                 summary,
                 "wrote {}: USD, OpenPBR (MaterialX) with a UsdPreviewSurface fallback, on a \
-                 swatch mesh, {}",
+                 swatch mesh, {}; against the averaged BRDF: {}",
                 out.display(),
-                texture_words(&m)
+                texture_words(m),
+                percent(&fits.openpbr_residual)
             );
         }
         if let Some(out) = &args.blender {
-            let (src_py, _) = openpbr::blender(&m, name, p);
+            let (src_py, _) = openpbr::blender(m, name, p);
             export::write_file(out, src_py.as_bytes(), force)?;
             let _ = writeln!(
                 summary,
-                "wrote {}: Blender module (Principled BSDF; run it inside Blender), {}",
+                "wrote {}: Blender module (Principled BSDF; run it inside Blender), {}; \
+                 against the averaged BRDF under Cycles' rules: {}",
                 out.display(),
-                texture_words(&m)
+                texture_words(m),
+                percent(&fits.blender_residual)
             );
         }
     }
     let _ = writeln!(
         summary,
-        "fitted in {:.1} s (the residuals: docs/export.md, \"Fitted materials\")",
+        "fitted in {:.1} s (what the residuals measure: docs/export.md, \"Fitted materials\")",
         start.elapsed().as_secs_f64()
     );
     Ok(summary)

@@ -87,15 +87,32 @@ impl Samples {
         Samples { dirs, f }
     }
 
-    /// The reflectance of `b` at one point of the period, `at`.
-    pub fn at(b: &dyn Bsdf, at: Footprint, dirs: Directions) -> Samples {
-        let mut f = Vec::with_capacity(dirs.dirs.len().pow(2));
+    /// The reflectance of `b` at one point of the period, `at`, weighted by the share of the
+    /// point's projected area that is yarn there ([`Bsdf::local`]): f_r c on every pair, and
+    /// c for each view direction.
+    pub fn local_at(b: &dyn Bsdf, at: Footprint, dirs: Directions) -> (Samples, Vec<f64>) {
+        let n = dirs.dirs.len();
+        let mut f = Vec::with_capacity(n * n);
+        let mut cover = Vec::with_capacity(n);
         for &o in &dirs.dirs {
+            let c = b.coverage_at(at, o);
+            cover.push(c);
             for &i in &dirs.dirs {
-                f.push(b.f_at(at, i, o));
+                f.push(b.f_at(at, i, o).map(|x| x * c));
             }
         }
-        Samples { dirs, f }
+        (Samples { dirs, f }, cover)
+    }
+
+    /// Every value of view direction `o` divided by `d[o]` (where positive).
+    pub fn divide_by_view(&mut self, d: &[f64]) {
+        let n = self.dirs.dirs.len();
+        for (k, v) in self.f.iter_mut().enumerate() {
+            let q = d[k / n];
+            if q > 0.0 {
+                *v = v.map(|x| x / q);
+            }
+        }
     }
 
     /// A fitted material's values on the same pairs.

@@ -46,6 +46,8 @@ pub struct Fitted {
 impl Fitted {
     /// Fits `family`'s material to `src`: each distinct cell on its own (cells whose sampled
     /// reflectances are identical share one fit), or the average when `src` has no cells.
+    /// A cell is fitted to its f_r times its coverage over the period's coverage, so that the
+    /// texture's mean is the averaged f_r.
     pub fn new(family: Family, src: &Source<'_>, tables: &Albedos) -> Fitted {
         let conv = family.convention();
         let (u_edges, v_edges, cells) = match &src.cells {
@@ -64,11 +66,31 @@ impl Fitted {
                         )
                     })
                     .collect();
-                let samples: Vec<Samples> = centres
+                // Each cell's f_r times its coverage, over the period's coverage
+                // sum_k a_k c_k: the texels' area-weighted mean is then the averaged f_r,
+                // which is that coverage-weighted mean (docs/spatial.md). A material has no
+                // gaps: a cell whose yarn covers half its area shows half its f_r.
+                let locals: Vec<(Samples, Vec<f64>)> = centres
                     .par_iter()
                     .map(|&(u, v)| {
                         let at = Footprint { u, v, width: 0.0 };
-                        Samples::at(c.bsdf, at, Directions::fitting())
+                        Samples::local_at(c.bsdf, at, Directions::fitting())
+                    })
+                    .collect();
+                let n_o = locals[0].1.len();
+                let mut period = vec![0.0; n_o];
+                for (k, (_, cover)) in locals.iter().enumerate() {
+                    let (i, j) = (k % nu, k / nu);
+                    let a = (c.u_edges[i + 1] - c.u_edges[i]) * (c.v_edges[j + 1] - c.v_edges[j]);
+                    for (p, x) in period.iter_mut().zip(cover) {
+                        *p += a * x;
+                    }
+                }
+                let samples: Vec<Samples> = locals
+                    .into_iter()
+                    .map(|(mut s, _)| {
+                        s.divide_by_view(&period);
+                        s
                     })
                     .collect();
                 // Distinct reflectances, in first-seen order.
@@ -232,5 +254,98 @@ impl Fitted {
         }
         m.tangent_deg = if along >= 0.0 { 0.0 } else { 90.0 };
         m
+    }
+}
+
+/// Both families fitted to one source, as their files hold them, with the residual of each
+/// against the averaged reflectance under the rules it is rendered by: glTF under its
+/// specification, OpenPBR under OpenPBR's, and the same fit converted for Blender under
+/// Cycles' ([`super::cycles_params`]).
+pub struct Fits {
+    /// The glTF fit.
+    pub gltf: Fitted,
+    /// As the `.glb` holds it.
+    pub gltf_held: Fitted,
+    /// Its residual.
+    pub gltf_residual: Residual,
+    /// The OpenPBR fit.
+    pub openpbr: Fitted,
+    /// As the MaterialX and USD files (and their maps) hold it.
+    pub openpbr_held: Fitted,
+    /// Its residual.
+    pub openpbr_residual: Residual,
+    /// The Blender module's parameters (f32 Principled inputs).
+    pub blender_held: Fitted,
+    /// Their residual under Cycles' rules.
+    pub blender_residual: Residual,
+}
+
+impl Fits {
+    /// Fits the families `want` asks for (glTF, OpenPBR) to `src`; the other's fields hold
+    /// the one fitted (with zero residuals) when only one is asked for.
+    pub fn new(src: &Source<'_>, t: &Albedos, want_gltf: bool, want_openpbr: bool) -> Fits {
+        let fam = |f: Family| Fitted::new(f, src, t);
+        let gltf = if want_gltf {
+            Some(fam(Family::Gltf))
+        } else {
+            None
+        };
+        let openpbr = if want_openpbr {
+            Some(fam(Family::OpenPbr))
+        } else {
+            None
+        };
+        let any = gltf
+            .clone()
+            .or_else(|| openpbr.clone())
+            .expect("one family asked for");
+        let gltf = gltf.unwrap_or_else(|| any.clone());
+        let openpbr = openpbr.unwrap_or(any);
+        let zero = Residual {
+            l2: 0.0,
+            albedo_mean: 0.0,
+            albedo_max: 0.0,
+        };
+        let gltf_held = crate::gltf::held(&gltf);
+        let gltf_residual = if want_gltf {
+            gltf_held.residual_against(src.average, Convention::GltfSpec, t)
+        } else {
+            zero
+        };
+        let openpbr_held = if openpbr.is_uniform() {
+            openpbr.map(|p| {
+                let f = |x: f64| x as f32 as f64;
+                Params {
+                    base: p.base.map(f),
+                    roughness: f(p.roughness),
+                    anisotropy: f(p.anisotropy),
+                    tangent_deg: p.tangent_deg,
+                    sheen: f(p.sheen),
+                    sheen_roughness: f(p.sheen_roughness),
+                    diffuse_roughness: f(p.diffuse_roughness),
+                }
+            })
+        } else {
+            crate::openpbr::OpenPbrMaps::new(&openpbr).held(&openpbr)
+        };
+        let blender_held = crate::openpbr::blender_held(&openpbr);
+        let (openpbr_residual, blender_residual) = if want_openpbr {
+            (
+                openpbr_held.residual_against(src.average, Convention::OpenPbr, t),
+                blender_held.residual_against(src.average, Convention::Cycles, t),
+            )
+        } else {
+            (zero, zero)
+        };
+        Fits {
+            gltf,
+            gltf_held,
+            gltf_residual,
+            openpbr,
+            openpbr_held,
+            openpbr_residual,
+            blender_held,
+            blender_residual,
+        }
     }
 }
