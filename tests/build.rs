@@ -11,6 +11,7 @@ fn main() {
     println!("cargo::rerun-if-changed=build.rs");
     println!("cargo::rerun-if-changed=../crates/clothbake-loader/build/probe.rs");
     println!("cargo::rerun-if-changed=llvm_probe.rs");
+    println!("cargo::rerun-if-changed=renderers/package-lock.json");
     println!("cargo::rerun-if-env-changed=DRJIT_LIBLLVM_PATH");
     emit(&[
         PYTHON,
@@ -18,6 +19,9 @@ fn main() {
         MITSUBA,
         MITSUBA_LLVM,
         OPENEXR,
+        MATERIALX,
+        BLENDER,
+        WEB,
         SLURM,
         PKG_CONFIG,
         AVX2,

@@ -3,6 +3,7 @@
 
 pub mod accuracy;
 pub mod fixtures;
+pub mod renderers;
 
 /// The optional dependencies of some tests (Python packages, SLURM, AVX2): the same probes the
 /// build script turns into `missing_<name>` cfgs; tests call [`probe::Dependency::require`] to

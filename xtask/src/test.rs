@@ -1,20 +1,31 @@
 //! `cargo xtask test [ARGS]`: the whole suite on a fresh machine, nothing skipped that pip can
 //! install. Creates the virtual environment `.venv` in the repository root (once, with
-//! `python3 -m venv`), installs numpy, pytest, OpenEXR and mitsuba into it (the first time takes
+//! `python3 -m venv`), installs numpy, pytest, OpenEXR, mitsuba, bpy, materialx and usd-core
+//! into it and the npm packages of tests/renderers with `npm ci` (the first time takes
 //! minutes), then runs `cargo fmt --all -- --check`, `cargo clippy --workspace --all-targets --
 //! -D warnings` and `cargo test --workspace [ARGS]` with the environment's `bin` first on PATH
 //! and VIRTUAL_ENV set, so that the Python, Mitsuba and OpenEXR tests run, and with
 //! DRJIT_LIBLLVM_PATH set (when unset) to a libLLVM >= 17 if one is found, for Mitsuba's llvm
-//! variant. SLURM and LLVM are not pip packages: `.ci/run` installs them with apt and then runs
-//! this with `CI=true`.
+//! variant. SLURM, LLVM, Chromium and Node.js are not pip packages: `.ci/run` installs them with
+//! apt and then runs this with `CI=true`.
 
 use clothbake_tests::probe::{libllvm, LLVM_MIN};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The Python packages the tests import.
-const PACKAGES: [&str; 4] = ["numpy", "pytest", "OpenEXR", "mitsuba"];
+/// The Python packages the tests import: (the name pip installs, the name Python imports).
+/// bpy is Blender as a module (its wheels exist for the Python version Blender ships with);
+/// materialx and usd-core check the fitted OpenPBR material.
+const PACKAGES: [(&str, &str); 7] = [
+    ("numpy", "numpy"),
+    ("pytest", "pytest"),
+    ("OpenEXR", "OpenEXR"),
+    ("mitsuba", "mitsuba"),
+    ("bpy", "bpy"),
+    ("materialx", "MaterialX"),
+    ("usd-core", "pxr"),
+];
 
 /// Runs `cmd`, printing it first; exits with its status when it fails.
 fn run(what: &str, cmd: &mut Command) {
@@ -50,19 +61,20 @@ pub fn venv(root: &Path) -> PathBuf {
             );
         }
     }
-    let imports = format!("import {}", PACKAGES.join(", "));
+    let imports = format!("import {}", PACKAGES.map(|(_, import)| import).join(", "));
+    let pip_names = PACKAGES.map(|(pip, _)| pip);
     let ready = Command::new(&python)
         .args(["-c", &imports])
         .output()
         .is_ok_and(|o| o.status.success());
     if ready {
-        println!("==> .venv has {}", PACKAGES.join(", "));
+        println!("==> .venv has {}", pip_names.join(", "));
     } else {
         run(
             &format!(
-                "pip install {} into .venv (quietly; the first time installs about 300 MB, \
+                "pip install {} into .venv (quietly; the first time installs about 1 GB, \
                  up to a few minutes)",
-                PACKAGES.join(" ")
+                pip_names.join(" ")
             ),
             Command::new(&python)
                 .args([
@@ -72,10 +84,41 @@ pub fn venv(root: &Path) -> PathBuf {
                     "--quiet",
                     "--disable-pip-version-check",
                 ])
-                .args(PACKAGES),
+                .args(pip_names),
         );
     }
     dir
+}
+
+/// The npm packages of tests/renderers (three.js, playwright-core, the glTF validator),
+/// installed with `npm ci` from its lock file when `node_modules` is missing or older than the
+/// lock file. Without npm, says so: the tests needing them are ignored (and fail under CI).
+pub fn node_modules(root: &Path) {
+    let dir = root.join("tests/renderers");
+    let lock = dir.join("package-lock.json");
+    let marker = dir.join("node_modules/.package-lock.json");
+    let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let fresh = matches!((modified(&marker), modified(&lock)), (Some(m), Some(l)) if m >= l);
+    if fresh {
+        println!("==> tests/renderers/node_modules is installed");
+        return;
+    }
+    if Command::new("npm").arg("--version").output().is_err() {
+        println!(
+            "==> npm not found (apt-get install nodejs npm chromium): the three.js tests \
+             will be ignored (and fail under CI)"
+        );
+        return;
+    }
+    run(
+        "npm ci in tests/renderers (three.js, playwright-core, gltf-validator; once)",
+        Command::new("npm").current_dir(&dir).args([
+            "ci",
+            "--no-audit",
+            "--no-fund",
+            "--loglevel=error",
+        ]),
+    );
 }
 
 /// PATH with `bin` first.
@@ -95,6 +138,7 @@ pub fn cargo() -> OsString {
 /// The task: see the module documentation. `args` go to `cargo test` after `--workspace`.
 pub fn run_all(root: &Path, args: &[String]) {
     let venv = venv(root);
+    node_modules(root);
     let cargo = cargo();
     let path = path_with(&venv.join("bin"));
     // Mitsuba's llvm variant (its tests and the gallery's) needs a libLLVM >= 17.

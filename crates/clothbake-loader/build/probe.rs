@@ -64,6 +64,68 @@ pub const OPENEXR: Dependency = Dependency {
     check: || python_imports("import OpenEXR, numpy"),
 };
 
+/// MaterialX and usd-core (the fitted OpenPBR material's checks).
+#[allow(dead_code)]
+pub const MATERIALX: Dependency = Dependency {
+    name: "materialx",
+    needs: "the MaterialX and usd-core Python packages",
+    install: "python3 -m pip install materialx usd-core, or run `cargo xtask test`",
+    uses_path: true,
+    check: || python_imports("import MaterialX; from pxr import Usd, UsdShade"),
+};
+
+/// Blender as a Python module (`bpy`), for rendering the fitted material with Cycles.
+#[allow(dead_code)]
+pub const BLENDER: Dependency = Dependency {
+    name: "blender",
+    needs: "Blender's Python module bpy (with numpy)",
+    install: "python3 -m pip install bpy (its wheels need the Python version Blender ships \
+              with), or run `cargo xtask test`",
+    uses_path: true,
+    check: || python_imports("import bpy, numpy"),
+};
+
+/// Node.js, Chromium and the npm packages of tests/renderers (three.js, playwright-core,
+/// gltf-validator), for rendering the fitted glTF material in a browser.
+#[allow(dead_code)]
+pub const WEB: Dependency = Dependency {
+    name: "web",
+    needs: "node, Chromium (/usr/bin/chromium or $CHROMIUM) and tests/renderers/node_modules",
+    install: "apt-get install chromium nodejs npm, then npm ci in tests/renderers (or run \
+              `cargo xtask test`, which runs npm ci)",
+    uses_path: true,
+    check: web_ready,
+};
+
+/// The folder tests/renderers of this workspace, found upward from CARGO_MANIFEST_DIR.
+#[allow(dead_code)]
+pub fn renderers_dir() -> Option<std::path::PathBuf> {
+    let start = std::path::PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR")?);
+    start
+        .ancestors()
+        .map(|d| d.join("tests/renderers"))
+        .find(|d| d.join("package.json").is_file())
+}
+
+#[allow(dead_code)]
+fn web_ready() -> Result<(), String> {
+    let node = std::process::Command::new("node").arg("--version").output();
+    if !node.is_ok_and(|o| o.status.success()) {
+        return Err("node cannot be run".into());
+    }
+    let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
+    if !std::path::Path::new(&chromium).is_file() {
+        return Err(format!("no Chromium at {chromium}"));
+    }
+    let dir = renderers_dir().ok_or("no tests/renderers/package.json above CARGO_MANIFEST_DIR")?;
+    for m in ["three", "playwright-core", "gltf-validator"] {
+        if !dir.join("node_modules").join(m).join("package.json").is_file() {
+            return Err(format!("tests/renderers/node_modules/{m} is missing"));
+        }
+    }
+    Ok(())
+}
+
 /// A single-node SLURM (and munge) that this user, root, may start.
 #[allow(dead_code)]
 pub const SLURM: Dependency = Dependency {

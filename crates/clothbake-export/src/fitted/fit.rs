@@ -15,7 +15,7 @@
 //! its maximum over the view directions, on a finer set of directions than the fit's.
 
 use super::microfacet::Albedos;
-use super::{Convention, Params, Rgb};
+use super::{Convention, Params, Rgb, Terms};
 use crate::luminance;
 use clothbake_core::{Bsdf, Footprint, UnitVec3};
 use std::f64::consts::PI;
@@ -218,10 +218,12 @@ fn solve_base(conv: Convention, p: &Params, t: &Albedos, r: &Samples) -> (Rgb, f
     let n = dirs.len();
     // Moments: aa, mm, am, then per channel ad, md, dd with d = k - y.
     let (mut aa, mut mm, mut am) = (0.0, 0.0, 0.0);
+    let mut shape = Terms::default();
     let (mut ad, mut md, mut dd) = ([0.0; 3], [0.0; 3], [0.0; 3]);
     for (o, wo) in dirs.iter().enumerate() {
         for (i, wi) in dirs.iter().enumerate() {
             let tm = conv.terms(p, t, wi.get(), wo.get());
+            shape = tm;
             let y = r.f[o * n + i];
             let w = wi.cos_theta().powi(2);
             aa += w * tm.a * tm.a;
@@ -235,16 +237,11 @@ fn solve_base(conv: Convention, p: &Params, t: &Albedos, r: &Samples) -> (Rgb, f
             }
         }
     }
-    let sigma = p.diffuse_roughness;
     let mut base = [0.0; 3];
     let mut err = 0.0;
     for c in 0..3 {
         let j = |b: f64| {
-            let h = if mm > 0.0 {
-                super::microfacet::eon_colour(b, sigma)
-            } else {
-                0.0
-            };
+            let h = if mm > 0.0 { shape.h(b) } else { 0.0 };
             b * b * aa + h * h * mm + 2.0 * b * h * am + 2.0 * b * ad[c] + 2.0 * h * md[c] + dd[c]
         };
         let b = if mm == 0.0 {

@@ -66,6 +66,9 @@ impl Ggx {
 /// Fresnel reflectance of unpolarised light from outside a dielectric of relative index
 /// `eta`, at cosine `c` between the direction and the microfacet normal.
 pub fn fresnel_dielectric(c: f64, eta: f64) -> f64 {
+    if eta.is_infinite() {
+        return 1.0;
+    }
     let c = c.clamp(0.0, 1.0);
     let s2 = (1.0 - c * c) / (eta * eta);
     if s2 >= 1.0 {
@@ -120,15 +123,30 @@ pub fn charlie_lobe(l: Vec3, v: Vec3, a: f64) -> f64 {
     d / ((1.0 + charlie_lambda(v.z, a) + charlie_lambda(l.z, a)) * 4.0 * v.z * l.z)
 }
 
-/// The Charlie lobe with the visibility of Neubelt & Pettineo 2013 (Ashikhmin's),
-/// D / (4 (cos l + cos v - cos l cos v)), which three.js uses.
-pub fn charlie_lobe_neubelt(l: Vec3, v: Vec3, a: f64) -> f64 {
+/// three.js's Charlie lobe (r187 `BRDF_Sheen`): D with alpha `a` and sin^2(theta_h) at least
+/// 2^-7, times Neubelt's visibility clamped to 1.
+pub fn charlie_lobe_threejs(l: Vec3, v: Vec3, a: f64) -> f64 {
     let h = l + v;
     let n = h.length();
     if n == 0.0 {
         return 0.0;
     }
-    charlie_d(h.z / n, a) / (4.0 * (l.z + v.z - l.z * v.z))
+    let c = h.z / n;
+    let sin2 = (1.0 - c * c).max(0.0078125);
+    let inv = 1.0 / a;
+    let d = (2.0 + inv) * sin2.powf(0.5 * inv) / (2.0 * PI);
+    let vis = (1.0 / (4.0 * (l.z + v.z - l.z * v.z))).min(1.0);
+    d * vis
+}
+
+/// Filament's fit of the Charlie sheen's directional albedo (three.js `IBLSheenBRDF`), at cos
+/// theta `c` and sheen roughness `r`, clamped to [0, 1].
+pub fn filament_sheen_albedo(c: f64, r: f64) -> f64 {
+    let c = c.clamp(0.0, 1.0);
+    let r_inv = 1.0 / (r + 0.1);
+    let a = -1.9362 + 1.0678 * r + 0.4573 * r * r - 0.8469 * r_inv;
+    let b = -0.6014 + 0.5538 * r - 0.4670 * r * r - 0.1255 * r_inv;
+    (a * c + b).exp().clamp(0.0, 1.0)
 }
 
 /// Zeltner et al. 2022's fit of the LTC sheen's directional albedo R(cos v, roughness).
@@ -214,8 +232,8 @@ pub fn eon_colour(c: f64, sigma: f64) -> f64 {
 pub struct Albedos {
     eta: f64,
     spec: Table2,
+    white: Table2,
     charlie: Table2,
-    charlie_neubelt: Table2,
 }
 
 /// A table over cos theta in [0, 1] (`nx` nodes) and a parameter in [lo, 1] (`ny` nodes).
@@ -261,11 +279,9 @@ impl Albedos {
         Albedos {
             eta,
             spec: Table2::build(n, n, ALPHA_MIN, |c, a| ggx_albedo(c, a, eta)),
+            white: Table2::build(n, n, ALPHA_MIN, |c, a| ggx_albedo(c, a, f64::INFINITY)),
             charlie: Table2::build(n, n, ALPHA_MIN, |c, a| {
                 hemisphere_albedo(c, |l, v| charlie_lobe(l, v, a))
-            }),
-            charlie_neubelt: Table2::build(n, n, ALPHA_MIN, |c, a| {
-                hemisphere_albedo(c, |l, v| charlie_lobe_neubelt(l, v, a))
             }),
         }
     }
@@ -280,14 +296,15 @@ impl Albedos {
         self.spec.at(c, a)
     }
 
+    /// The GGX lobe's directional albedo with a Fresnel factor of 1 (the single-scattering
+    /// energy of the white furnace) at alpha `a`.
+    pub fn white_specular(&self, c: f64, a: f64) -> f64 {
+        self.white.at(c, a)
+    }
+
     /// The Charlie sheen's directional albedo (specification's visibility) at alpha `a`.
     pub fn charlie(&self, c: f64, a: f64) -> f64 {
         self.charlie.at(c, a)
-    }
-
-    /// The Charlie sheen's directional albedo with Neubelt's visibility.
-    pub fn charlie_neubelt(&self, c: f64, a: f64) -> f64 {
-        self.charlie_neubelt.at(c, a)
     }
 }
 
@@ -380,7 +397,7 @@ mod tests {
         // single-scattering loss is that of GGX at alpha 0.5 (about a third of the light).
         let g = Ggx { ax: 0.5, ay: 0.5 };
         let e = hemisphere_albedo(0.9, |l, v| g.lobe(l, v));
-        let e_vndf = ggx_albedo(0.9, 0.5, 1e9);
+        let e_vndf = ggx_albedo(0.9, 0.5, f64::INFINITY);
         assert!(e < 1.0 && e > 0.5, "{e}");
         assert!((e - e_vndf).abs() < 5e-3, "{e} {e_vndf}");
     }

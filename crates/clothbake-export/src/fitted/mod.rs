@@ -12,8 +12,10 @@
 //! * [`Convention::GltfSpec`]: glTF 2.0 Appendix B (`fresnel_mix` with Schlick's Fresnel, F0
 //!   0.04), KHR_materials_anisotropy, KHR_materials_sheen's Charlie sheen with its visibility
 //!   and the albedo scaling of the base, exactly as the specifications state.
-//! * [`Convention::ThreeJs`]: three.js's implementation of the same glTF parameters (pinned
-//!   in tests/renderers/package.json).
+//! * [`Convention::ThreeJs`]: three.js's implementation of the same glTF parameters (r187,
+//!   pinned in tests/renderers/package.json): Charlie with alpha = sheenRoughness^2 and
+//!   Neubelt's visibility, Filament's fit of the sheen albedo, and a multiple-scattering
+//!   compensation of the specular.
 //! * [`Convention::OpenPbr`]: OpenPBR 1.1 (MaterialX 1.39 `open_pbr_surface`): exact dielectric
 //!   Fresnel, the base's diffuse scaled by the specular layer's directional albedo, the fuzz
 //!   layer of Zeltner et al. 2022 (LTC sheen) scaling what lies under it.
@@ -103,7 +105,12 @@ pub enum Convention {
 
 /// The GGX roughnesses (along the rough direction, across it) a convention gives `p`.
 pub fn alphas(conv: Convention, p: &Params) -> (f64, f64) {
-    let a = (p.roughness * p.roughness).max(microfacet::ALPHA_MIN);
+    // three.js raises the roughness to 0.045 at least.
+    let r = match conv {
+        Convention::ThreeJs => p.roughness.max(0.045),
+        _ => p.roughness,
+    };
+    let a = (r * r).max(microfacet::ALPHA_MIN);
     let s = p.anisotropy.clamp(0.0, 1.0);
     match conv {
         // KHR_materials_anisotropy: alpha_t = mix(alpha, 1, s^2), alpha_b = alpha.
@@ -152,7 +159,7 @@ impl Convention {
     /// toward the eye, local frame (+X the weft, +Z the normal); zero at or below the horizon.
     pub fn f(self, p: &Params, tables: &Albedos, l: Vec3, v: Vec3) -> Rgb {
         let t = self.terms(p, tables, l, v);
-        p.base.map(|b| t.of(b, p.diffuse_roughness))
+        p.base.map(|b| t.of(b))
     }
 
     /// f_r per channel as base A + h(base) M + K ([`Terms`]): every layer but the base colour
@@ -169,6 +176,7 @@ impl Convention {
         let vh = (v.dot(h) / h.length()).clamp(0.0, 1.0);
         let lobe = g.lobe(lt, vt);
         let s = p.sheen.clamp(0.0, 1.0);
+        let mut sigma = 0.0;
         let ((diffuse, multi), specular, sheen, scale) = match self {
             Convention::GltfSpec => {
                 // fresnel_mix(ior, diffuse, specular) under the sheen's albedo scaling.
@@ -184,23 +192,43 @@ impl Convention {
                 )
             }
             Convention::ThreeJs => {
-                // three.js (r187, src/renderers/shaders/ShaderChunk): Lambert not scaled by
-                // the Fresnel, Charlie with alpha = roughness^2 and Neubelt's visibility, and
-                // the base scaled by 1 - 0.157 max(sheen colour).
-                let f = microfacet::fresnel_schlick(f0(tables.eta()), vh);
-                let a = (p.sheen_roughness * p.sheen_roughness).max(microfacet::ALPHA_MIN);
+                // three.js r187 (src/renderers/shaders/ShaderChunk, lights_physical_*):
+                // Epic's exp2 form of Schlick's Fresnel, the diffuse scaled by 1 - F
+                // (fresnel_mix), the specular times the multiple-scattering compensation
+                // 1 + F0 (1 / E_ss - 1), Charlie with alpha = roughness^2 and sin^2 >= 2^-7,
+                // Neubelt's visibility clamped to 1, and the base scaled by
+                // 1 - max(sheen) max(E(v), E(l)) with Filament's fit of E.
+                let x = vh;
+                let phi = 2f64.powf((-5.55473 * x - 6.98316) * x);
+                let f0 = f0(tables.eta());
+                let f = f0 * (1.0 - phi) + phi;
+                let comp = 1.0 + f0 * (1.0 / tables.white_specular(v.z, g.ay).max(1e-3) - 1.0);
+                let r = p.sheen_roughness;
+                let scale = 1.0
+                    - s * microfacet::filament_sheen_albedo(v.z, r)
+                        .max(microfacet::filament_sheen_albedo(l.z, r));
                 (
-                    (1.0 / PI, 0.0),
-                    f * lobe,
-                    s * microfacet::charlie_lobe_neubelt(l, v, a),
-                    1.0 - 0.157 * s,
+                    ((1.0 - f) / PI, 0.0),
+                    f * lobe * comp,
+                    s * microfacet::charlie_lobe_threejs(l, v, r * r),
+                    scale,
                 )
             }
             Convention::OpenPbr | Convention::Cycles => {
                 let f = microfacet::fresnel_dielectric(vh, tables.eta());
-                let e = tables.specular(v.z, g.mean_alpha());
+                let e = match self {
+                    // Cycles layers by the albedo of the specular lobe with its
+                    // multiple scattering restored (measured: the single-scattering
+                    // albedo over the white furnace's).
+                    Convention::Cycles => {
+                        tables.specular(v.z, g.mean_alpha())
+                            / tables.white_specular(v.z, g.mean_alpha()).max(1e-3)
+                    }
+                    _ => tables.specular(v.z, g.mean_alpha()),
+                };
                 let r = p.sheen_roughness.clamp(0.01, 1.0);
-                let (d1, dm) = microfacet::eon_terms(l, v, p.diffuse_roughness.clamp(0.0, 1.0));
+                sigma = p.diffuse_roughness.clamp(0.0, 1.0);
+                let (d1, dm) = microfacet::eon_terms(l, v, sigma);
                 (
                     ((1.0 - e) * d1, (1.0 - e) * dm),
                     f * lobe,
@@ -213,12 +241,14 @@ impl Convention {
             a: diffuse * scale,
             m: multi * scale,
             k: specular * scale + sheen,
+            sigma,
+            colour_twice: self == Convention::Cycles,
         }
     }
 }
 
 /// f_r of one channel of base colour c: c a + h(c) m + k, h the colour of the diffuse's
-/// multiple scattering ([`microfacet::eon_colour`]; zero `m` without diffuse roughness).
+/// multiple scattering ([`Terms::h`]; zero `m` without diffuse roughness).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Terms {
     /// The coefficient of the base colour.
@@ -227,17 +257,32 @@ pub struct Terms {
     pub m: f64,
     /// The grey rest (specular and sheen).
     pub k: f64,
+    /// The Oren-Nayar roughness of the diffuse (what h depends on).
+    pub sigma: f64,
+    /// Whether the multiple scattering's colour is weighted by the base colour again (Cycles).
+    pub colour_twice: bool,
 }
 
 impl Terms {
-    /// The channel's f_r for base colour `c` and diffuse roughness `sigma`.
-    pub fn of(&self, c: f64, sigma: f64) -> f64 {
-        let h = if self.m != 0.0 {
-            microfacet::eon_colour(c, sigma)
+    /// The channel's f_r for base colour `c`.
+    pub fn of(&self, c: f64) -> f64 {
+        c * self.a + self.h(c) * self.m + self.k
+    }
+
+    /// The colour of the diffuse's multiple scattering for base colour `c`: EON's
+    /// c^2 E / (1 - c (1 - E)) ([`microfacet::eon_colour`]), times c once more in Cycles,
+    /// which weights the Oren-Nayar closure (multiple scattering included) by the base
+    /// colour (Blender 5.0 `svm_closure.h`, `bsdf_oren_nayar.h`; measured).
+    pub fn h(&self, c: f64) -> f64 {
+        if self.m == 0.0 {
+            return 0.0;
+        }
+        let h = microfacet::eon_colour(c, self.sigma);
+        if self.colour_twice {
+            c * h
         } else {
-            0.0
-        };
-        c * self.a + h * self.m + self.k
+            h
+        }
     }
 }
 
