@@ -238,6 +238,11 @@ def write_readme(out, pics, results, settings, light, bake_seconds):
         r = results[pic.name]
         lines += [f"## {pic.name}", "", f"![{pic.name}]({pic.name}.png)", "",
                   f"{pic.caption} Rendered in {r['seconds']:.0f} s.", ""]
+    import mainstream
+
+    name = f"{mainstream.FABRIC}-three-renderers"
+    if (out / f"{name}.png").exists():
+        lines += [f"## {name}", "", f"![{name}]({name}.png)", "", mainstream.CAPTION, ""]
     (out / "README.md").write_text("\n".join(lines))
 
 

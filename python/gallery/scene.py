@@ -67,9 +67,10 @@ VIEWS = {
 }
 
 
-def build(mi, view, cloth_bsdf, mesh, emitter, settings, half=None):
+def build(mi, view, cloth_bsdf, mesh, emitter, settings, half=None, extra=None):
     """The scene for one view and one cloth BSDF; ``half`` "left" or "right" renders only
-    that half of the picture (a crop of the same camera)."""
+    that half of the picture (a crop of the same camera); ``extra``: more scene objects (by
+    name), e.g. a second emitter."""
     origin, target, fov = VIEWS[view]
     film = {"type": "hdrfilm", "width": settings.width, "height": settings.height,
             "pixel_format": "rgb"}
@@ -79,6 +80,7 @@ def build(mi, view, cloth_bsdf, mesh, emitter, settings, half=None):
                      "crop_width": w if half == "left" else settings.width - w,
                      "crop_height": settings.height})
     return mi.load_dict({
+        **(extra or {}),
         "type": "scene",
         "integrator": {"type": "path", "max_depth": 5},
         "sensor": {

@@ -1,6 +1,7 @@
 //! `cargo xtask gallery [--quick] [--envmap FILE.exr] [--only NAME,...]`: regenerates
 //! `docs/gallery/` (the PNGs and their README) with Mitsuba 3, through
-//! `python/gallery/gallery.py`. Builds the `clothbake` binary and the Python extension in
+//! `python/gallery/gallery.py`, then (full gallery) `python/gallery/mainstream.py`, the
+//! fitted materials in three.js and Cycles beside the plugin. Builds the `clothbake` binary and the Python extension in
 //! release mode, stages the `clothbake` package under `target/gallery/python`, installs
 //! numpy, pytest, OpenEXR and mitsuba into `.venv` when they are missing (as `cargo xtask
 //! test`), sets DRJIT_LIBLLVM_PATH to a libLLVM >= 17 when it is unset (Mitsuba's llvm variant
@@ -77,6 +78,40 @@ pub fn run(root: &Path, args: &[String]) {
     println!("==> python/gallery/gallery.py {}", args.join(" "));
     let status = cmd
         .args(args)
+        .status()
+        .unwrap_or_else(|e| fail(&format!("cannot run python: {e}")));
+    if !status.success() {
+        std::process::exit(status.code().unwrap_or(1));
+    }
+    // The fitted materials in three.js and Cycles beside the plugin (full gallery only, or
+    // when --only names it).
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1));
+    let wanted = only.is_none_or(|o| {
+        o.split(',')
+            .any(|n| "gingham-three-renderers".starts_with(n))
+    });
+    if args.iter().any(|a| a == "--quick") || !wanted {
+        return;
+    }
+    crate::test::node_modules(root);
+    println!("==> python/gallery/mainstream.py");
+    let status = Command::new("nice")
+        .current_dir(root)
+        .env("PATH", &path)
+        .env("VIRTUAL_ENV", &venv)
+        .env("PYTHONPATH", &staged)
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .env("DRJIT_LIBLLVM_PATH", &llvm)
+        .args(["-n", "10"])
+        .arg(venv.join("bin/python3"))
+        .arg("python/gallery/mainstream.py")
+        .arg("--clothbake")
+        .arg(release.join("clothbake"))
+        .arg("--cache")
+        .arg(target.join("gallery"))
         .status()
         .unwrap_or_else(|e| fail(&format!("cannot run python: {e}")));
     if !status.success() {
