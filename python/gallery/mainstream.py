@@ -52,8 +52,10 @@ CAPTION = (
     "32 samples a pixel, three.js 3 x 3 supersampled (`python/gallery/mainstream.py`). The "
     "fitted materials draw the checks and each cell's yarn direction but not the yarns "
     "themselves, and no gaps. Mean luminance, far: Mitsuba 0.224, three.js 0.251, Cycles "
-    "0.241; close: 0.49, 0.58, 0.56. The fitted pictures are 8-18% brighter here, more than "
-    "the fit's albedo residual for this cloth (3% mean, docs/export.md); not yet explained.")
+    "0.241; close: 0.49, 0.58, 0.56. The fitted pictures are brighter because the plugin "
+    "with `periods` draws the cloth over its black floor (each value times the coverage, "
+    "0.83-0.93 for this cloth at these views), while a fitted material, like the table's RGL "
+    "export, is the averaged BRDF, which has no gaps (docs/export.md).")
 WIDTH, HEIGHT = 400, 300
 SUN_IRRADIANCE = 3.0
 SKY_RADIANCE = 0.35
