@@ -1,5 +1,6 @@
 //! Probes the optional dependencies of these tests (Python packages, Mitsuba's llvm variant, SLURM,
-//! AVX2 for the direct model's batch) and sets
+//! AVX2 for the direct model's batch, the real renderers of the fitted materials: Blender's bpy,
+//! MaterialX with usd-core, node with Chromium and tests/renderers/node_modules) and sets
 //! `missing_<name>` for each one absent, so that the tests needing it show as ignored, with the
 //! reason, instead of passing without running (and fail under `CI`); see the shared probes in
 //! crates/clothbake-loader/build/probe.rs.
@@ -11,7 +12,9 @@ fn main() {
     println!("cargo::rerun-if-changed=build.rs");
     println!("cargo::rerun-if-changed=../crates/clothbake-loader/build/probe.rs");
     println!("cargo::rerun-if-changed=llvm_probe.rs");
-    println!("cargo::rerun-if-changed=renderers/package-lock.json");
+    // The web probe looks into renderers/node_modules (which `npm ci` replaces) and at $CHROMIUM.
+    println!("cargo::rerun-if-changed=renderers");
+    println!("cargo::rerun-if-env-changed=CHROMIUM");
     println!("cargo::rerun-if-env-changed=DRJIT_LIBLLVM_PATH");
     emit(&[
         PYTHON,

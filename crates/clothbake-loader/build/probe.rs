@@ -97,11 +97,13 @@ pub const WEB: Dependency = Dependency {
     check: web_ready,
 };
 
-/// The folder tests/renderers of this workspace, found upward from CARGO_MANIFEST_DIR.
+/// The folder tests/renderers of this workspace, found upward from CARGO_MANIFEST_DIR (set by
+/// cargo for build scripts and tests; the one this file was compiled in otherwise).
 #[allow(dead_code)]
 pub fn renderers_dir() -> Option<std::path::PathBuf> {
-    let start = std::path::PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR")?);
-    start
+    let start = std::env::var_os("CARGO_MANIFEST_DIR")
+        .or_else(|| option_env!("CARGO_MANIFEST_DIR").map(Into::into))?;
+    std::path::PathBuf::from(start)
         .ancestors()
         .map(|d| d.join("tests/renderers"))
         .find(|d| d.join("package.json").is_file())
@@ -119,7 +121,12 @@ fn web_ready() -> Result<(), String> {
     }
     let dir = renderers_dir().ok_or("no tests/renderers/package.json above CARGO_MANIFEST_DIR")?;
     for m in ["three", "playwright-core", "gltf-validator"] {
-        if !dir.join("node_modules").join(m).join("package.json").is_file() {
+        if !dir
+            .join("node_modules")
+            .join(m)
+            .join("package.json")
+            .is_file()
+        {
             return Err(format!("tests/renderers/node_modules/{m} is missing"));
         }
     }
