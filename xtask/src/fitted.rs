@@ -9,25 +9,9 @@ use clothbake_export::fitted::fit::Residual;
 use clothbake_export::fitted::material::{Cells, Fits, Source};
 use clothbake_export::fitted::microfacet::Albedos;
 use clothbake_export::fitted::IOR;
+use clothbake_tests::fixtures::shipped_files;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-
-/// The shipped fabrics: every `.json` and `.wif` directly in tables/, by name.
-pub fn shipped(root: &Path) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(root.join("tables"))
-        .expect("tables/")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.is_file()
-                && matches!(
-                    p.extension().and_then(|e| e.to_str()),
-                    Some("json") | Some("wif")
-                )
-        })
-        .collect();
-    v.sort();
-    v
-}
+use std::path::Path;
 
 fn cell(r: &Residual) -> String {
     format!(
@@ -42,7 +26,8 @@ fn cell(r: &Residual) -> String {
 pub fn run(root: &Path) {
     let t = Albedos::new(IOR);
     let mut rows = String::new();
-    for path in shipped(root) {
+    let shipped = [shipped_files("json"), shipped_files("wif")].concat();
+    for path in shipped {
         let fabric = Fabric::from_path(&path).expect("a shipped fabric reads");
         let b = AnalyticBsdf::new(AnalyticModel::new(&fabric, FacetModel::Huo), None);
         let (u_edges, v_edges) = b.model().cells().edge_fractions();
@@ -77,13 +62,6 @@ pub fn run(root: &Path) {
          | fabric | cells | glTF (specification) | OpenPBR (MaterialX, USD) | Blender (Cycles) |\n\
          |---|---|---|---|---|\n{rows}<!-- fitted-residuals:end -->"
     );
-    let path = root.join("docs/export.md");
-    let doc = std::fs::read_to_string(&path).expect("docs/export.md");
-    let end = "<!-- fitted-residuals:end -->";
-    let new = match (doc.find("<!-- fitted-residuals:begin -->"), doc.find(end)) {
-        (Some(a), Some(b)) => format!("{}{}{}", &doc[..a], out, &doc[b + end.len()..]),
-        _ => format!("{}\n\n{out}\n", doc.trim_end()),
-    };
-    std::fs::write(&path, new).expect("write docs/export.md");
+    crate::replace_section(&root.join("docs/export.md"), "fitted-residuals", &out);
     println!("{out}");
 }

@@ -58,20 +58,25 @@ pub fn run(root: &Path, args: &[String]) {
              install libllvm19, or set DRJIT_LIBLLVM_PATH to one"
         ))
     });
-    let mut cmd = Command::new("nice");
-    cmd.current_dir(root)
-        .env("PATH", &path)
-        .env("VIRTUAL_ENV", &venv)
-        .env("PYTHONPATH", &staged)
-        .env("PYTHONDONTWRITEBYTECODE", "1")
-        .env("DRJIT_LIBLLVM_PATH", &llvm)
-        .args(["-n", "10"])
-        .arg(venv.join("bin/python3"))
-        .arg("python/gallery/gallery.py")
-        .arg("--clothbake")
-        .arg(release.join("clothbake"))
-        .arg("--cache")
-        .arg(target.join("gallery"));
+    // One of python/gallery's scripts, under nice, with the staged package and Mitsuba's LLVM.
+    let script = |name: &str| {
+        let mut cmd = Command::new("nice");
+        cmd.current_dir(root)
+            .env("PATH", &path)
+            .env("VIRTUAL_ENV", &venv)
+            .env("PYTHONPATH", &staged)
+            .env("PYTHONDONTWRITEBYTECODE", "1")
+            .env("DRJIT_LIBLLVM_PATH", &llvm)
+            .args(["-n", "10"])
+            .arg(venv.join("bin/python3"))
+            .arg(Path::new("python/gallery").join(name))
+            .arg("--clothbake")
+            .arg(release.join("clothbake"))
+            .arg("--cache")
+            .arg(target.join("gallery"));
+        cmd
+    };
+    let mut cmd = script("gallery.py");
     if args.iter().any(|a| a == "--quick") {
         cmd.arg("--out").arg(target.join("gallery/quick"));
     }
@@ -98,20 +103,7 @@ pub fn run(root: &Path, args: &[String]) {
     }
     crate::test::node_modules(root);
     println!("==> python/gallery/mainstream.py");
-    let status = Command::new("nice")
-        .current_dir(root)
-        .env("PATH", &path)
-        .env("VIRTUAL_ENV", &venv)
-        .env("PYTHONPATH", &staged)
-        .env("PYTHONDONTWRITEBYTECODE", "1")
-        .env("DRJIT_LIBLLVM_PATH", &llvm)
-        .args(["-n", "10"])
-        .arg(venv.join("bin/python3"))
-        .arg("python/gallery/mainstream.py")
-        .arg("--clothbake")
-        .arg(release.join("clothbake"))
-        .arg("--cache")
-        .arg(target.join("gallery"))
+    let status = script("mainstream.py")
         .status()
         .unwrap_or_else(|e| fail(&format!("cannot run python: {e}")));
     if !status.success() {

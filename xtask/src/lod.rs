@@ -240,13 +240,6 @@ pub fn run(root: &Path) {
         cells_table(root)
     )
     .unwrap();
-    let path = root.join("docs/validation.md");
-    let doc = std::fs::read_to_string(&path).expect("docs/validation.md");
-    let end = "<!-- lod-validation:end -->";
-    let new = match (doc.find("<!-- lod-validation:begin -->"), doc.find(end)) {
-        (Some(a), Some(b)) => format!("{}{}{}", &doc[..a], out, &doc[b + end.len()..]),
-        _ => format!("{}\n{out}\n", doc.trim_end()),
-    };
-    std::fs::write(&path, new).expect("write docs/validation.md");
+    crate::replace_section(&root.join("docs/validation.md"), "lod-validation", &out);
     println!("{out}");
 }

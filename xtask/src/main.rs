@@ -57,6 +57,22 @@ use std::time::Instant;
 
 const TABLES: [&str; 6] = ["plain", "basket", "twill", "twill31", "satin5", "parallel"];
 
+/// Replaces the section of the document `path` between `<!-- name:begin -->` and
+/// `<!-- name:end -->` by `section` (which holds both markers), or appends it.
+pub fn replace_section(path: &Path, name: &str, section: &str) {
+    let doc = std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let (begin, end) = (
+        format!("<!-- {name}:begin -->"),
+        format!("<!-- {name}:end -->"),
+    );
+    let new = match (doc.find(&begin), doc.find(&end)) {
+        (Some(a), Some(b)) => format!("{}{}{}", &doc[..a], section, &doc[b + end.len()..]),
+        _ => format!("{}\n\n{section}\n", doc.trim_end()),
+    };
+    std::fs::write(path, new).unwrap_or_else(|e| panic!("cannot write {}: {e}", path.display()));
+}
+
 fn root() -> PathBuf {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     p.canonicalize().unwrap_or(p)
