@@ -105,6 +105,9 @@ fn inputs(d: &Path) {
     w("wide.json", period(1, 35_000).as_bytes());
     w("cells.json", period(2000, 1000).as_bytes());
     std::fs::copy(fabric("twill"), d.join("self.json")).unwrap();
+    // Another bake's lock and checkpoint (what `-o` must not take).
+    w("x.exr.lock", b"12345\n");
+    w("x.exr.checkpoint", b"CLTHBAKE rows of another bake");
     std::fs::create_dir(d.join("folder")).unwrap();
     // A sparse file of 1 GiB: refused from its size.
     std::fs::File::create(d.join("huge.json"))
@@ -236,6 +239,24 @@ const CASES: &[(&str, &str)] = &[
     ("info of a FIFO", "info fifo.exr"),
     ("diff of binary data", "diff noise.bin noise.exr"),
     ("merge -o one of its inputs", "merge noise.bin -o noise.bin"),
+    // Names a bake owns: its lock and checkpoint, and temporary files, even with --force.
+    (
+        "bake -o a lock, --force",
+        "bake --weave TWILL --res 2,4,2,4 -o x.exr.lock --force",
+    ),
+    (
+        "bake -o a checkpoint, --force",
+        "bake --weave TWILL --res 2,4,2,4 -o x.exr.checkpoint --force",
+    ),
+    (
+        "render --exr a checkpoint",
+        "render --weave TWILL -o r.png --exr y.exr.checkpoint --force",
+    ),
+    (
+        "export -o a temporary name",
+        "export --weave TWILL --rgl .e.bsdf.tmp-1-0 --force",
+    ),
+    ("merge -o a lock", "merge noise.bin -o t.exr.lock --force"),
 ];
 
 /// The arguments of a case's command line: `TWILL` replaced by `twill`, `LIST<n>` by n angles;
@@ -259,8 +280,9 @@ fn case_args(line: &str, twill: &str) -> Vec<String> {
     v
 }
 
-/// The kind of each special file a case could replace, and the fabric a case could overwrite.
-fn guarded(d: &Path) -> (Vec<String>, Vec<u8>) {
+/// The kind of each special file a case could replace, and the files a case could overwrite
+/// (the fabric, another bake's lock and checkpoint).
+fn guarded(d: &Path) -> (Vec<String>, Vec<Vec<u8>>) {
     let kinds = [
         Path::new("/dev/null").to_path_buf(),
         Path::new("/dev/zero").to_path_buf(),
@@ -270,7 +292,11 @@ fn guarded(d: &Path) -> (Vec<String>, Vec<u8>) {
     .into_iter()
     .map(|p| format!("{:?}", std::fs::symlink_metadata(p).map(|m| m.file_type())))
     .collect();
-    (kinds, std::fs::read(d.join("self.json")).unwrap())
+    let files = ["self.json", "x.exr.lock", "x.exr.checkpoint"]
+        .iter()
+        .map(|f| std::fs::read(d.join(f)).unwrap())
+        .collect();
+    (kinds, files)
 }
 
 #[test]
@@ -320,4 +346,171 @@ fn every_hostile_input_gets_one_line_and_exit_2_with_nothing_written() {
             ru.ru_maxrss >> 10
         );
     }
+}
+
+/// A command that writes, for the signal replay: its arguments (`TWILL` for the twill's path),
+/// its outputs, and the output whose temporary file, once seen, the signal is sent at (the last
+/// one written, so that the others are already written and waiting).
+struct Writer {
+    name: &'static str,
+    line: &'static str,
+    outputs: &'static [&'static str],
+    at: &'static str,
+}
+
+const WRITERS: &[Writer] = &[
+    Writer {
+        name: "render with --exr",
+        line: "render --weave TWILL -o r.png --exr r.exr --res 700 --aa 1",
+        outputs: &["r.png", "r.exr"],
+        at: "r.exr",
+    },
+    Writer {
+        name: "export of three files",
+        line: "export --weave TWILL --rgl e.bsdf --rgl-spectral s.bsdf --merl m.binary \
+               --rgl-res 8,12,32 --phi-samples 1",
+        outputs: &["e.bsdf", "s.bsdf", "m.binary"],
+        at: "m.binary",
+    },
+    Writer {
+        name: "merge",
+        line: "merge -o t.exr --precision f32 a.shard b.shard",
+        outputs: &["t.exr"],
+        at: "t.exr",
+    },
+    Writer {
+        name: "bake",
+        line: "bake --weave TWILL --res 16,32,32,64 -o b.exr --precision f32",
+        outputs: &["b.exr"],
+        at: "b.exr",
+    },
+];
+
+/// Whether `name` is a temporary, probe, lock or checkpoint file (what an interrupted write
+/// could leave).
+fn leftover(name: &str) -> bool {
+    name.contains(".tmp-")
+        || name.contains(".probe-")
+        || name.ends_with(".lock")
+        || name.ends_with(".checkpoint")
+}
+
+/// SIGINT, SIGTERM and SIGHUP sent while each writing command writes its last output (its
+/// temporary file seen in the folder): the command either ends with exit 130, one line, and
+/// none of its outputs, or (a bake, which finishes the write it began) with exit 0 and every
+/// output whole; no temporary, lock or checkpoint file is left. "Whole" is the bytes of the
+/// same command run to its end without a signal (the outputs are reproducible).
+#[cfg(target_os = "linux")]
+#[test]
+fn a_signal_during_the_write_leaves_every_output_whole_or_none() {
+    let base = fresh_dir("hostile", "signals");
+    let twill = fabric("twill");
+    // The shards that merge reads.
+    for (k, name) in ["a.shard", "b.shard"].iter().enumerate() {
+        let shard = format!("{k}/2");
+        let out = run_in(
+            &base,
+            &[
+                "bake",
+                "-q",
+                "--weave",
+                &twill,
+                "--res",
+                "16,32,32,64",
+                "--shard",
+                &shard,
+                "-o",
+                name,
+            ],
+        );
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    }
+    let setup = |d: &Path| {
+        for s in ["a.shard", "b.shard"] {
+            std::fs::copy(base.join(s), d.join(s)).unwrap();
+        }
+    };
+    let mut failures = Vec::new();
+    for w in WRITERS {
+        let args = case_args(w.line, &twill);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        // The reference: the same command run to its end.
+        let reference = fresh_dir("hostile", &format!("signals-ref-{}", w.at));
+        setup(&reference);
+        let out = run_in(&reference, &args);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}: {}",
+            w.name,
+            text(&out.stderr)
+        );
+        let whole: Vec<Vec<u8>> = w
+            .outputs
+            .iter()
+            .map(|o| std::fs::read(reference.join(o)).unwrap())
+            .collect();
+        for (sig, sig_name) in [
+            (libc::SIGINT, "SIGINT"),
+            (libc::SIGTERM, "SIGTERM"),
+            (libc::SIGHUP, "SIGHUP"),
+        ] {
+            let case = format!("{} ({sig_name})", w.name);
+            let prefix = format!(".{}.tmp-", w.at);
+            // The write can be missed (the command may finish between two looks): try again.
+            let mut caught = None;
+            for attempt in 0..5 {
+                let d = fresh_dir("hostile", &format!("signals-{}-{sig}-{attempt}", w.at));
+                setup(&d);
+                let mut child = common::cmd(&d, &args).spawn().unwrap();
+                let mut seen = false;
+                while child.try_wait().unwrap().is_none() {
+                    if listing(&d).iter().any(|n| n.starts_with(&prefix)) {
+                        // SAFETY: kill sends a signal to our own child process.
+                        assert_eq!(unsafe { libc::kill(child.id() as i32, sig) }, 0);
+                        seen = true;
+                        break;
+                    }
+                }
+                let out = child.wait_with_output().unwrap();
+                if seen {
+                    caught = Some((d, out));
+                    break;
+                }
+            }
+            let Some((d, out)) = caught else {
+                failures.push(format!("{case}: the write was never caught in 5 runs"));
+                continue;
+            };
+            let names = listing(&d);
+            let left: Vec<&String> = names.iter().filter(|n| leftover(n)).collect();
+            let present: Vec<bool> = w.outputs.iter().map(|o| d.join(o).exists()).collect();
+            let err = text(&out.stderr);
+            let verdict = match out.status.code() {
+                Some(130) if present.iter().all(|p| !p) => (err.lines().count() == 1
+                    && err.starts_with("clothbake: interrupted"))
+                .then_some(())
+                .ok_or("exit 130 without one line `clothbake: interrupted...`"),
+                Some(130) => Err("exit 130 with some outputs written"),
+                Some(0) => w
+                    .outputs
+                    .iter()
+                    .zip(&whole)
+                    .all(|(o, b)| std::fs::read(d.join(o)).ok().as_ref() == Some(b))
+                    .then_some(())
+                    .ok_or("exit 0 with an output missing or not whole"),
+                _ => Err("neither exit 130 nor 0"),
+            };
+            if let Err(why) = verdict {
+                failures.push(format!(
+                    "{case}: {why}: status {:?}, outputs present {present:?}, stderr {err:?}",
+                    out.status
+                ));
+            }
+            if !left.is_empty() {
+                failures.push(format!("{case}: left {left:?}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
