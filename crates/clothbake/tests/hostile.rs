@@ -239,6 +239,52 @@ const CASES: &[(&str, &str)] = &[
     ("info of a FIFO", "info fifo.exr"),
     ("diff of binary data", "diff noise.bin noise.exr"),
     ("merge -o one of its inputs", "merge noise.bin -o noise.bin"),
+    // Render numbers whose arithmetic would overflow.
+    (
+        "render --eye 1e154 away",
+        "render --weave TWILL -o r.png --eye 1e154,0,1",
+    ),
+    (
+        "render --look-at 1e308",
+        "render --weave TWILL -o r.png --look-at 0,1e308,0",
+    ),
+    (
+        "render --light 1e308",
+        "render --weave TWILL -o r.png --light 1e308,0,1",
+    ),
+    (
+        "render --irradiance 1e308",
+        "render --weave TWILL -o r.png --irradiance 1e308",
+    ),
+    (
+        "render --exposure 1e308",
+        "render --weave TWILL -o r.png --exposure 1e308",
+    ),
+    // Sample counts and seeds past their ranges.
+    (
+        "--samples 2^64 - 1",
+        "eval --weave TWILL --method raytrace --samples 18446744073709551615",
+    ),
+    (
+        "--samples 2^32",
+        "eval --weave TWILL --method raytrace --samples 4294967296",
+    ),
+    (
+        "--samples 1e9 with --bounces all",
+        "eval --weave TWILL --bounces all --samples 1000000000",
+    ),
+    (
+        "bake --samples 2^32",
+        "bake --weave TWILL --method raytrace --samples 4294967296 --res 2,4,2,4 -o s.exr",
+    ),
+    (
+        "--seed past u64",
+        "eval --weave TWILL --method raytrace --seed 18446744073709551616",
+    ),
+    (
+        "--res 100000 on every axis",
+        "bake --weave TWILL --res 100000,100000,100000,100000 -o w.exr",
+    ),
     // Names a bake owns: its lock and checkpoint, and temporary files, even with --force.
     (
         "bake -o a lock, --force",
@@ -345,6 +391,45 @@ fn every_hostile_input_gets_one_line_and_exit_2_with_nothing_written() {
             "a case grew to {} MB",
             ru.ru_maxrss >> 10
         );
+    }
+}
+
+/// Messages of numbers out of range: the one line names the number, the range and the fix. The
+/// expected numbers are written out here (1e20 cells for 100000^4, not a wrapped count).
+#[test]
+fn numbers_out_of_range_name_their_range() {
+    let d = fresh_dir("hostile", "ranges");
+    let twill = fabric("twill");
+    let cases: &[(&str, &[&str])] = &[
+        (
+            "bake --weave TWILL --res 100000,100000,100000,100000 -o w.exr",
+            &["100000000000000000000 cells", "2^31"],
+        ),
+        (
+            "eval --weave TWILL --method raytrace --seed 18446744073709551616",
+            &[
+                "--seed 18446744073709551616",
+                "at most 18446744073709551615",
+                "--seed 1",
+            ],
+        ),
+        (
+            "eval --weave TWILL --method raytrace --samples 18446744073709551615",
+            &["at most 16777216", "--samples 100000"],
+        ),
+        (
+            "render --weave TWILL -o r.png --irradiance 1e308",
+            &["irradiance", "1000000", "e.g. 3.14159"],
+        ),
+        (
+            "render --weave TWILL -o r.png --eye 1e154,0,1",
+            &["[-1000000, 1000000]", "--eye"],
+        ),
+    ];
+    for (line, needles) in cases {
+        let args = case_args(line, &twill);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        common::fails_with(&run_in(&d, &args), 2, needles);
     }
 }
 
