@@ -599,3 +599,69 @@ fn a_signal_during_the_write_leaves_every_output_whole_or_none() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Runs `args` in `dir` and returns its exit status and its largest resident set in bytes
+/// (`wait4`'s rusage of that child alone).
+#[cfg(target_os = "linux")]
+fn peak_rss(dir: &Path, args: &[&str]) -> (i32, u64) {
+    // Reaped by wait4 below, not by Child::wait.
+    #[allow(clippy::zombie_processes)]
+    let child = common::cmd(dir, args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut status = 0;
+    // SAFETY: wait4 writes the status and the zeroed rusage of our own child.
+    let mut ru: libc::rusage = unsafe { std::mem::zeroed() };
+    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut ru) };
+    assert_eq!(pid, child.id() as i32);
+    (libc::WEXITSTATUS(status), ru.ru_maxrss as u64 * 1024)
+}
+
+/// An export stays within the memory bound docs/limits-output.md states, written out here:
+/// 64 MiB for the program, 16 bytes a texel of the slices held (and 64 a slice), 192 bytes a
+/// texel of each worker's slice, 1 MiB + 64 KiB of buffers; MERL 80 bytes a cell of its
+/// 90 x 90 x 180 and 144 bytes a rotation per worker. The spectral file alone (26 f32 a texel)
+/// is more than the bound's slices: it must be streamed, not held.
+#[cfg(target_os = "linux")]
+#[test]
+fn an_export_keeps_its_memory_bound() {
+    let d = fresh_dir("hostile", "export-memory");
+    let twill = fabric("twill");
+    let (nt, np, n, threads) = (16u64, 16u64, 128u64, 2u64);
+    let res = format!("{nt},{np},{n}");
+    let texels = n * n;
+    let slices = nt * np;
+    let rgl = slices * (16 * texels + 64) + threads * 192 * texels + (1 << 20) + (1 << 16);
+    let merl = 80 * 90 * 90 * 180 + 12 + threads * 144 * 4;
+    let bound = (64 << 20) + rgl + merl;
+    let (code, rss) = peak_rss(
+        &d,
+        &[
+            "export",
+            "--weave",
+            &twill,
+            "--rgl",
+            "e.bsdf",
+            "--rgl-spectral",
+            "s.bsdf",
+            "--merl",
+            "m.binary",
+            "--rgl-res",
+            &res,
+            "--threads",
+            "2",
+        ],
+    );
+    assert_eq!(code, 0);
+    let spectral = std::fs::metadata(d.join("s.bsdf")).unwrap().len();
+    assert!(spectral > slices * 16 * texels * 6, "{spectral}");
+    println!(
+        "export --rgl-res {res} with MERL: peak {:.1} MB, bound {:.1} MB, spectral file {:.1} MB",
+        rss as f64 / 1e6,
+        bound as f64 / 1e6,
+        spectral as f64 / 1e6
+    );
+    assert!(rss <= bound, "peak {rss} bytes above the bound {bound}");
+}
