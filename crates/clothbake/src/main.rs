@@ -45,7 +45,7 @@ fn main() -> ExitCode {
     match std::panic::catch_unwind(run) {
         Ok(Ok(code)) => ExitCode::from(code),
         Ok(Err(e)) => {
-            eprintln!("clothbake: {e}");
+            eprintln!("clothbake: {}", printable(&e.to_string()));
             ExitCode::from(e.code())
         }
         Err(_) => ExitCode::from(2), // the panic hook has printed the message
@@ -83,6 +83,7 @@ fn run() -> Result<u8, CliError> {
             None => return Err(help_cmd::no_command()),
         },
     };
+    let out = printable(&out);
     let mut stdout = std::io::stdout().lock();
     match stdout
         .write_all(out.as_bytes())
@@ -94,6 +95,28 @@ fn run() -> Result<u8, CliError> {
             .map(|()| code)
             .map_err(|e| CliError::new(format!("cannot write the output: {e}"), "check stdout")),
     }
+}
+
+/// `text` with every control character but the line feed and the tab escaped (`\u{1b}`): what
+/// a table or fabric made before control characters were refused carries (a name, a note)
+/// cannot reach the terminal raw.
+fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text
+        .chars()
+        .any(|c| c.is_control() && c != '\n' && c != '\t')
+    {
+        return text.into();
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() && c != '\n' && c != '\t' {
+                c.escape_unicode().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect::<String>()
+        .into()
 }
 
 /// Runs a command that writes files other than a bake: a signal ends it at once, leaving no

@@ -665,3 +665,175 @@ fn an_export_keeps_its_memory_bound() {
     );
     assert!(rss <= bound, "peak {rss} bytes above the bound {bound}");
 }
+
+/// A container file (binary table, shard, checkpoint) with its kind set to `kind`, its header
+/// JSON changed by `edit` and its values by `values`, its lengths and CRC made right again
+/// (layout: docs/table-format.md).
+fn rewrite_container(
+    bytes: &[u8],
+    kind: &str,
+    edit: impl FnOnce(&mut serde_json::Value),
+    values: impl FnOnce(&mut [u8]),
+) -> Vec<u8> {
+    let header_len = u64::from_le_bytes(bytes[28..36].try_into().unwrap()) as usize;
+    let mut header: serde_json::Value =
+        serde_json::from_slice(&bytes[44..44 + header_len]).unwrap();
+    edit(&mut header);
+    let header = serde_json::to_vec(&header).unwrap();
+    let mut out = bytes[..12].to_vec();
+    let mut tag = [0u8; 16];
+    tag[..kind.len()].copy_from_slice(kind.as_bytes());
+    out.extend(tag);
+    out.extend((header.len() as u64).to_le_bytes());
+    out.extend(&bytes[36..44]);
+    out.extend(&header);
+    let mut vals = bytes[44 + header_len..bytes.len() - 4].to_vec();
+    values(&mut vals);
+    out.extend(vals);
+    let crc = crc32fast::hash(&out);
+    out.extend(crc.to_le_bytes());
+    out
+}
+
+/// The messages the issue found misleading now name the right cause: a negative value in a
+/// checkpoint is the checkpoint's fault (not the model's), a damaged CRC attribute is not
+/// "stored 0x00000000", control characters in a JSON fabric's name are refused, and a fabric
+/// whose header would overflow is refused before the bake.
+#[test]
+fn misleading_messages_name_the_right_cause() {
+    let d = fresh_dir("hostile", "messages");
+    let twill = fabric("twill");
+    let ok = |args: &[&str]| {
+        let out = run_in(&d, args);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    };
+    // A checkpoint of shard 0/1 holding -1 in its first value.
+    ok(&[
+        "bake", "-q", "--weave", &twill, "--res", "2,4,2,4", "--shard", "0/1", "-o", "s.shard",
+    ]);
+    let shard = std::fs::read(d.join("s.shard")).unwrap();
+    let bad = rewrite_container(
+        &shard,
+        "checkpoint",
+        |_| {},
+        |v| v[..4].copy_from_slice(&(-1.0f32).to_le_bytes()),
+    );
+    std::fs::write(d.join("t.shard.checkpoint"), bad).unwrap();
+    let out = run_in(
+        &d,
+        &[
+            "bake", "--weave", &twill, "--res", "2,4,2,4", "--shard", "0/1", "-o", "t.shard",
+            "--resume",
+        ],
+    );
+    let line = common::fails_with(&out, 2, &["t.shard.checkpoint", "-1", "delete"]);
+    assert!(!line.contains("fabric's sizes"), "{line}");
+    assert!(!d.join("t.shard").exists());
+    // An OpenEXR table whose CRC attribute is not hexadecimal.
+    ok(&[
+        "bake", "-q", "--weave", &twill, "--res", "2,4,2,4", "-o", "c.exr",
+    ]);
+    let mut exr = std::fs::read(d.join("c.exr")).unwrap();
+    let name = b"clothbake.crc32\0string\0";
+    let at = exr.windows(name.len()).position(|w| w == name).unwrap() + name.len() + 4;
+    exr[at..at + 8].copy_from_slice(b"zzzzzzzz");
+    std::fs::write(d.join("c.exr"), exr).unwrap();
+    let line = common::fails_with(
+        &run_in(&d, &["info", "c.exr"]),
+        2,
+        &[
+            "c.exr",
+            "clothbake.crc32",
+            "zzzzzzzz",
+            "8 hexadecimal digits",
+        ],
+    );
+    assert!(!line.contains("0x00000000"), "{line}");
+    // A JSON fabric named with an escape sequence.
+    let twill_json = std::fs::read_to_string(&twill).unwrap();
+    let named = twill_json.replacen("\"twill\"", "\"tw\\u001b[31mill\"", 1);
+    assert_ne!(named, twill_json);
+    std::fs::write(d.join("esc.json"), named).unwrap();
+    let line = common::fails_with(
+        &run_in(
+            &d,
+            &[
+                "eval", "--weave", "esc.json", "--wi", "30,0", "--wo", "45,180",
+            ],
+        ),
+        2,
+        &["esc.json", "name", "U+001B"],
+    );
+    assert!(!line.contains('\u{1b}'));
+    // A table made before: its fabric's name carries the escape; info shows it escaped.
+    ok(&[
+        "bake", "-q", "--weave", &twill, "--res", "2,4,2,4", "-o", "n.bin",
+    ]);
+    let table = std::fs::read(d.join("n.bin")).unwrap();
+    let renamed = rewrite_container(
+        &table,
+        "table",
+        |h| {
+            let f = h["fabric_json"].as_str().unwrap().replacen(
+                "\"name\":\"twill\"",
+                "\"name\":\"tw\\u001b[31mill\",\"notes\":[\"a\\u001b[2Jb\"]",
+                1,
+            );
+            h["fabric_json"] = f.into();
+        },
+        |_| {},
+    );
+    std::fs::write(d.join("n.bin"), renamed).unwrap();
+    let out = run_in(&d, &["info", "n.bin"]);
+    let shown = common::succeeds(&out);
+    assert!(!shown.contains('\u{1b}'), "{shown:?}");
+    assert!(shown.contains("tw\\u{1b}[31mill"), "{shown}");
+    assert!(shown.contains("a\\u{1b}[2Jb"), "{shown}");
+    // A fabric of 15 MB whose notes (quotes, 2 bytes in the file) take 4 bytes each in a
+    // header: refused before the bake (a bake of this grid takes seconds), nothing written.
+    let quotes = "\\\"".repeat(7_500_000);
+    let big = twill_json.replacen('{', &format!("{{\"notes\": [\"{quotes}\"],"), 1);
+    assert!(big.len() > 15_000_000 && big.len() < 16 << 20);
+    std::fs::write(d.join("notes.json"), big).unwrap();
+    let before = listing(&d);
+    let t0 = Instant::now();
+    common::fails_with(
+        &run_in(
+            &d,
+            &[
+                "bake",
+                "--weave",
+                "notes.json",
+                "--res",
+                "32,64,32,64",
+                "-o",
+                "big.exr",
+            ],
+        ),
+        2,
+        &["notes.json", "header", "notes", "nothing was baked"],
+    );
+    assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());
+    assert_eq!(listing(&d), before);
+}
+
+/// A WIF draft with CR-only line endings (old Macintosh files) reads as the same draft with LF
+/// endings: the same answer.
+#[test]
+fn a_draft_with_cr_line_endings_reads_like_lf() {
+    let d = fresh_dir("hostile", "cr-draft");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/denim.wif");
+    let lf = std::fs::read_to_string(path).unwrap().replace("\r\n", "\n");
+    std::fs::write(d.join("lf.wif"), &lf).unwrap();
+    std::fs::write(d.join("cr.wif"), lf.replace('\n', "\r")).unwrap();
+    let eval = |f: &str| {
+        common::succeeds(&run_in(
+            &d,
+            &[
+                "eval", "--weave", f, "--wi", "30,0", "--wo", "45,180", "--json",
+            ],
+        ))
+    };
+    let (a, b) = (eval("lf.wif"), eval("cr.wif"));
+    assert_eq!(a.replace("lf.wif", "cr.wif"), b);
+}
