@@ -302,10 +302,10 @@ impl Settings {
                 n.number("bounces", "1")
             ));
         }
-        if let Some(n) = self.samples.filter(|&n| n == 0 || n > MAX_SAMPLES) {
+        if let Some(k) = self.samples.filter(|&k| k == 0 || k > MAX_SAMPLES) {
             return Err(format!(
-                "{} {n} is out of range; give a whole number from 1 to {MAX_SAMPLES} (2^24)",
-                f("samples")
+                "{} is out of range; give a whole number from 1 to {MAX_SAMPLES} (2^24)",
+                n.number("samples", &k.to_string())
             ));
         }
         let method = if self.raytrace {

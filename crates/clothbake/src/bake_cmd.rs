@@ -361,16 +361,34 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     Ok(summary)
 }
 
-/// The line after a baked table's summary: what to try with it next.
+/// The line after a baked table's summary: what to try with it next, spelled as this program
+/// can be run ([`invocation`]).
 pub fn next_steps(weave: &Path, table: &Path) -> String {
     format!(
-        "next: `clothbake info {t}` (what it holds), `clothbake render --table {t} -o {png}` \
-         (a picture), `clothbake eval --weave {w} --wi 30,0 --wo 45,180` (one pair of \
-         directions)\n",
+        "next: `{c} info {t}` (what it holds), `{c} render --table {t} -o {png}` (a picture), \
+         `{c} eval --weave {w} --wi 30,0 --wo 45,180` (one pair of directions)\n",
+        c = invocation(),
         t = table.display(),
         png = table.with_extension("png").display(),
         w = weave.display(),
     )
+}
+
+/// How a hint runs this program: `clothbake` when a `clothbake` is on PATH; else, when cargo
+/// runs it (`cargo run`, which sets `CARGO`), `cargo run --release -p clothbake --`; else the
+/// path of this executable.
+pub fn invocation() -> String {
+    let on_path = std::env::var_os("PATH").is_some_and(|p| {
+        std::env::split_paths(&p)
+            .any(|d| std::fs::metadata(d.join("clothbake")).is_ok_and(|m| m.is_file()))
+    });
+    if on_path {
+        "clothbake".into()
+    } else if std::env::var_os("CARGO").is_some() {
+        "cargo run --release -p clothbake --".into()
+    } else {
+        std::env::current_exe().map_or_else(|_| "clothbake".into(), |e| e.display().to_string())
+    }
 }
 
 #[cfg(test)]
