@@ -33,18 +33,23 @@ fn forget_temporary(list: &mut Vec<PathBuf>, path: &Path) {
     }
 }
 
+/// Batches committed by this process (see [`abandon_temporaries`]).
+static COMMITTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
 /// Removes every temporary file this process is writing and keeps any other from being made
 /// or moved into place: for a front end about to end the process on a signal (a second
 /// Ctrl-C). Waits for a [`Batch::commit`] in progress to finish, so that a set of outputs is
-/// left whole or absent. Call it only just before the process exits: writes of other threads
-/// block from then on.
-pub fn abandon_temporaries() {
+/// left whole or absent, and returns whether a batch was committed (its outputs are in place,
+/// whole). Call it only just before the process exits: writes of other threads block from
+/// then on.
+pub fn abandon_temporaries() -> bool {
     let mut list = temporaries();
     for p in list.drain(..) {
         let _ = fs::remove_file(p);
     }
     // Held until the process exits: no write registers or renames a file after this.
     std::mem::forget(list);
+    COMMITTED.load(Ordering::SeqCst) > 0
 }
 
 /// Removes the temporary file when dropped, unless disarmed.
@@ -117,7 +122,7 @@ impl Batch {
     pub fn commit(mut self) -> Result<(), TableError> {
         self.open = false;
         let staged = BATCH.with(|b| b.borrow_mut().take()).unwrap_or_default();
-        commit(staged)
+        commit(staged, true)
     }
 }
 
@@ -132,7 +137,7 @@ impl Drop for Batch {
 
 /// Moves staged files into place while holding the list of temporaries (so that
 /// [`abandon_temporaries`] waits for the whole set).
-fn commit(mut staged: Vec<Staged>) -> Result<(), TableError> {
+fn commit(mut staged: Vec<Staged>, batch: bool) -> Result<(), TableError> {
     let mut result = Ok(());
     {
         let _list = temporaries();
@@ -141,6 +146,9 @@ fn commit(mut staged: Vec<Staged>) -> Result<(), TableError> {
             if result.is_err() {
                 break;
             }
+        }
+        if batch && result.is_ok() {
+            COMMITTED.fetch_add(1, Ordering::SeqCst);
         }
     }
     // The guards (which take the list) are dropped once it is released: they remove the
@@ -312,7 +320,7 @@ fn write_atomic_impl(
         None => Some(staged),
     });
     match staged {
-        Some(s) => commit(vec![s]),
+        Some(s) => commit(vec![s], false),
         None => Ok(()),
     }
 }

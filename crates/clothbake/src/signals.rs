@@ -28,8 +28,12 @@ pub enum OnSignal {
 /// Ends the process after removing every temporary file in flight (nothing half-written is
 /// left; a set of outputs being moved into place is finished first).
 fn exit_now() -> ! {
-    clothbake_loader::abandon_temporaries();
-    eprintln!("clothbake: interrupted; nothing was written");
+    if clothbake_loader::abandon_temporaries() {
+        // The signal came as the outputs were moved into place: they are whole.
+        eprintln!("clothbake: interrupted; the outputs were written whole before it");
+    } else {
+        eprintln!("clothbake: interrupted; nothing was written");
+    }
     std::process::exit(i32::from(INTERRUPTED));
 }
 

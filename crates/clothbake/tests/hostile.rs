@@ -576,6 +576,14 @@ fn a_signal_during_the_write_leaves_every_output_whole_or_none() {
                     && err.starts_with("clothbake: interrupted"))
                 .then_some(())
                 .ok_or("exit 130 without one line `clothbake: interrupted...`"),
+                // The signal came as the set was moved into place: all whole, and said so.
+                Some(130) if err.contains("written whole") => w
+                    .outputs
+                    .iter()
+                    .zip(&whole)
+                    .all(|(o, b)| std::fs::read(d.join(o)).ok().as_ref() == Some(b))
+                    .then_some(())
+                    .ok_or("exit 130 saying the outputs are whole, and they are not"),
                 Some(130) => Err("exit 130 with some outputs written"),
                 Some(0) => w
                     .outputs
