@@ -76,7 +76,8 @@ pub const MITSUBA_LLVM: Dependency = Dependency {
     needs: "the mitsuba and numpy Python packages and a libLLVM of version 17 or later for \
             Mitsuba's llvm_ad_rgb variant",
     install: "python3 -m pip install mitsuba numpy and apt-get install libllvm19 (or set \
-              DRJIT_LIBLLVM_PATH to a libLLVM >= 17), or run `cargo xtask test`",
+              DRJIT_LIBLLVM_PATH to a libLLVM >= 17; `cargo xtask test` installs the Python \
+              packages, not libLLVM)",
     uses_path: true,
     check: mitsuba_llvm_ready,
 };

@@ -92,7 +92,7 @@ fn python_mitsuba_plugin() {
 #[test]
 #[cfg_attr(
     any(missing_python, missing_mitsuba_llvm, not(target_os = "linux")),
-    ignore = "needs Linux, python3 with numpy, pytest and mitsuba, and a libLLVM >= 17 for Mitsuba's llvm_ad_rgb variant: python3 -m pip install numpy pytest mitsuba; apt-get install libllvm19 (or set DRJIT_LIBLLVM_PATH); or run `cargo xtask test`"
+    ignore = "needs Linux, python3 with numpy, pytest and mitsuba, and a libLLVM >= 17 for Mitsuba's llvm_ad_rgb variant: python3 -m pip install numpy pytest mitsuba; apt-get install libllvm19 (or set DRJIT_LIBLLVM_PATH; `cargo xtask test` installs the Python packages, not libLLVM)"
 )]
 fn python_mitsuba_plugin_llvm() {
     PYTHON.require();
@@ -107,7 +107,7 @@ fn python_mitsuba_plugin_llvm() {
 #[test]
 #[cfg_attr(
     any(missing_python, missing_mitsuba_llvm, not(target_os = "linux")),
-    ignore = "needs Linux, python3 with numpy and mitsuba, and a libLLVM >= 17 for Mitsuba's llvm_ad_rgb variant: python3 -m pip install numpy pytest mitsuba; apt-get install libllvm19 (or set DRJIT_LIBLLVM_PATH); or run `cargo xtask test`"
+    ignore = "needs Linux, python3 with numpy and mitsuba, and a libLLVM >= 17 for Mitsuba's llvm_ad_rgb variant: python3 -m pip install numpy pytest mitsuba; apt-get install libllvm19 (or set DRJIT_LIBLLVM_PATH; `cargo xtask test` installs the Python packages, not libLLVM)"
 )]
 fn gallery_quick() {
     PYTHON.require();

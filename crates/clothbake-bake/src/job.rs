@@ -298,6 +298,9 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
         Some(Err(e)) => return Err(JobError::Invalid(e.to_string())),
     };
     let baker = Baker::new(job.fabric, &job.options).map_err(bake_error)?;
+    if output.is_some() {
+        check_header(job, baker.metadata())?;
+    }
     let orbits = baker.orbits();
     let rows = match shard {
         Some(id) => shard_rows(orbits, id),
@@ -454,6 +457,35 @@ pub fn run(job: &Job<'_>, hooks: &Hooks<'_>) -> Result<Done, JobError> {
         cells,
         symmetry: (!baker.symmetries().is_empty()).then(|| baker.metadata().symmetry.clone()),
     })
+}
+
+/// Room kept in a checkpoint's or shard's header for what it holds besides the metadata (the
+/// row ranges done, the shard): 1 MiB.
+pub const HEADER_ROOM: u64 = 1 << 20;
+
+/// Refuses, before any work, a bake whose metadata (the fabric's description as JSON,
+/// escaped again inside the header's JSON) would not fit the header of its checkpoints, shard
+/// or binary table ([`clothbake_loader::container::MAX_HEADER_LEN`], less [`HEADER_ROOM`]): a
+/// fabric file within the input limit whose names or notes grow when escaped.
+pub fn check_header(job: &Job<'_>, meta: &Metadata) -> Result<(), JobError> {
+    let len = serde_json::to_vec(meta).map_or(u64::MAX, |v| v.len() as u64);
+    let most = clothbake_loader::container::MAX_HEADER_LEN - HEADER_ROOM;
+    if len <= most {
+        return Ok(());
+    }
+    let source = job
+        .inputs
+        .first()
+        .map_or("the fabric".to_string(), |p| p.display().to_string());
+    Err(invalid(
+        format!(
+            "{source}: the fabric's description takes {len} bytes in a table's header (its \
+             JSON escaped once more), more than the {most} bytes (16 MiB less 1 MiB for the \
+             rows) a header of its checkpoints, shards and binary tables holds"
+        ),
+        "shorten its name and notes (characters such as quotes, backslashes and control \
+         characters take two to six bytes each once escaped); nothing was baked",
+    ))
 }
 
 /// Refuses a job whose estimated peak memory ([`memory::peak_bytes`]) exceeds `available`

@@ -374,8 +374,15 @@ pub fn read_part(
                         c.values.len()
                     ))
                 })?;
-                if !v.iter().all(|x| x.is_finite()) {
-                    return Err(corrupt(format!("row {r} holds a non-finite value")));
+                if let Some(x) = v
+                    .iter()
+                    .find(|x| !(x.is_finite() && **x >= 0.0 && **x <= clothbake_loader::MAX_VALUE))
+                {
+                    return Err(corrupt(format!(
+                        "row {r} holds the value {x}, not a reflectance (finite, from 0 to {:e} \
+                         1/sr)",
+                        clothbake_loader::MAX_VALUE
+                    )));
                 }
                 row.push([v[0], v[1], v[2]]);
             }

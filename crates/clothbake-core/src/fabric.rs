@@ -362,6 +362,23 @@ impl Fabric {
         let weave = Weave::new(rows).expect("checked rectangular and non-empty");
         let warp = group(cx, "warp", &raw.warp, weave.n_warp())?;
         let weft = group(cx, "weft", &raw.weft, weave.n_weft())?;
+        // Names and notes are shown on terminals (eval, info): no control characters (an
+        // escape sequence such as \u001b would reach the terminal raw), as in WIF drafts.
+        let texts = raw.name.iter().map(|n| ("name".to_string(), n)).chain(
+            raw.notes
+                .iter()
+                .enumerate()
+                .map(|(k, n)| (format!("notes[{k}]"), n)),
+        );
+        for (field, text) in texts {
+            if let Some(c) = text.chars().find(|c| c.is_control()) {
+                return Err(cx.err(
+                    field,
+                    format!("holds the control character U+{:04X}", u32::from(c)),
+                    "remove it: names and notes are one line of printable text",
+                ));
+            }
+        }
         let naming = JsonNaming {
             file: cx.file,
             warp: &raw.warp,

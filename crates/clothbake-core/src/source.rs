@@ -83,7 +83,7 @@ fn read_text_file(path: &Path, file: &str, wif: bool) -> Result<Vec<u8>, FabricE
     let cannot = |e: std::io::Error| {
         err(
             format!("cannot read the fabric file: {e}"),
-            "check the path (e.g. tables/twill.json)",
+            "check the path",
         )
     };
     // Checked before opening, then again on what was opened: the path may be replaced in

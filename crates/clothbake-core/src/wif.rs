@@ -162,7 +162,9 @@ fn split_ini(text: &str, file: &str) -> Result<Vec<Section>, WifError> {
         fix: fix.into(),
     };
     let mut sections: Vec<Section> = Vec::new();
-    for (n, raw) in text.lines().enumerate() {
+    // Lines end in LF, CR LF or a lone CR (old Macintosh drafts).
+    let text = text.replace("\r\n", "\n");
+    for (n, raw) in text.split(['\n', '\r']).enumerate() {
         let line = n + 1;
         let s = raw.trim_start_matches('\u{feff}').trim();
         if s.is_empty() || s.starts_with(';') {

@@ -120,6 +120,16 @@ pub struct Anisotropy {
     pub max: f64,
 }
 
+/// An upper bound on the memory a MERL export takes besides the program, in bytes, with
+/// `threads` workers averaging `phi_samples` rotations: the cells' values and spreads as the
+/// rows are collected (32 bytes a cell), the table (24 bytes a cell), the file's bytes (24 bytes
+/// a cell) and each worker's pairs of one cell (72 bytes a pair, two pairs a rotation).
+pub fn peak_bytes(phi_samples: usize, threads: usize) -> u64 {
+    let cells = N_CELLS as u64;
+    let workers = (threads.max(1) as u64).min(N_THETA_H as u64);
+    80 * cells + 12 + workers * 2 * 72 * phi_samples as u64
+}
+
 /// A MERL table: f_r per cell and channel (index `c * N_CELLS + cell`) and the anisotropy lost.
 #[derive(Clone, Debug)]
 pub struct MerlTable {

@@ -25,6 +25,7 @@ use super::{luminance, reflect, spectrum, Bsdf};
 use clothbake_core::UnitVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
+use std::io::{self, Write};
 
 /// The file's magic: "tensor_file" and a NUL.
 pub const MAGIC: &[u8; 12] = b"tensor_file\0";
@@ -87,45 +88,170 @@ impl Field {
     }
 }
 
+/// A field of a tensor file whose data is made as the file is written
+/// ([`write_tensor_file`]), so that no copy of a large field is held: element type, shape and a
+/// function writing the little-endian elements.
+pub struct LazyField<'a> {
+    /// Field name, e.g. "rgb".
+    pub name: String,
+    /// Element type.
+    pub dtype: Dtype,
+    /// Shape, outermost dimension first (row-major data).
+    pub shape: Vec<u64>,
+    data: WriteData<'a>,
+}
+
+/// What writes a [`LazyField`]'s data.
+type WriteData<'a> = Box<dyn Fn(&mut dyn Write) -> io::Result<()> + Sync + 'a>;
+
+impl<'a> LazyField<'a> {
+    /// A field of `shape` whose f32 elements `data` writes, in order (through [`put_f32s`]).
+    pub fn f32_with(
+        name: &str,
+        shape: &[u64],
+        data: impl Fn(&mut dyn Write) -> io::Result<()> + Sync + 'a,
+    ) -> LazyField<'a> {
+        LazyField {
+            name: name.into(),
+            dtype: Dtype::F32,
+            shape: shape.to_vec(),
+            data: Box::new(data),
+        }
+    }
+
+    /// A field written from its bytes.
+    pub fn of(f: &'a Field) -> LazyField<'a> {
+        LazyField {
+            name: f.name.clone(),
+            dtype: f.dtype,
+            shape: f.shape.clone(),
+            data: Box::new(move |w| w.write_all(&f.data)),
+        }
+    }
+
+    /// The size of the field's data in bytes.
+    pub fn byte_len(&self) -> u64 {
+        let size = match self.dtype {
+            Dtype::U8 => 1,
+            Dtype::F32 => 4,
+        };
+        self.shape.iter().product::<u64>() * size
+    }
+
+    /// The field with its data made (what [`tensor_file`] takes).
+    pub fn to_field(&self) -> Field {
+        let mut data = Vec::with_capacity(self.byte_len() as usize);
+        (self.data)(&mut data).expect("writing to memory cannot fail");
+        Field {
+            name: self.name.clone(),
+            dtype: self.dtype,
+            shape: self.shape.clone(),
+            data,
+        }
+    }
+}
+
+/// Writes `values` as little-endian f32 through a small buffer.
+pub fn put_f32s(w: &mut dyn Write, values: impl IntoIterator<Item = f32>) -> io::Result<()> {
+    let mut buf = Vec::with_capacity(1 << 16);
+    for v in values {
+        buf.extend_from_slice(&v.to_le_bytes());
+        if buf.len() >= 1 << 16 {
+            w.write_all(&buf)?;
+            buf.clear();
+        }
+    }
+    w.write_all(&buf)
+}
+
 /// Serialises fields into a tensor file: magic, version (u8 major, minor), u32 field count, then
 /// per field u16 name length, name, u16 rank, u8 type code, u64 data offset, rank x u64 shape;
 /// then each field's data, starting at a multiple of 8 bytes. All integers little-endian.
 pub fn tensor_file(fields: &[Field]) -> Vec<u8> {
-    let header: usize = 12
+    let lazy: Vec<LazyField<'_>> = fields.iter().map(LazyField::of).collect();
+    let mut out = Vec::new();
+    write_tensor_file(&mut out, &lazy).expect("writing to memory cannot fail");
+    out
+}
+
+/// Writes the tensor file of `fields` (the layout of [`tensor_file`]) to `out`, each field's
+/// data made as it is written; returns the file's size in bytes. An error when a field writes
+/// another number of bytes than its shape holds (a bug in the caller).
+pub fn write_tensor_file(out: &mut dyn Write, fields: &[LazyField<'_>]) -> io::Result<u64> {
+    let header: u64 = 12
         + 2
         + 4
         + fields
             .iter()
-            .map(|f| 2 + f.name.len() + 2 + 1 + 8 + 8 * f.shape.len())
-            .sum::<usize>();
-    let align = |x: usize| x.div_ceil(8) * 8;
+            .map(|f| 2 + f.name.len() as u64 + 2 + 1 + 8 + 8 * f.shape.len() as u64)
+            .sum::<u64>();
+    let align = |x: u64| x.div_ceil(8) * 8;
     let mut offsets = Vec::with_capacity(fields.len());
     let mut at = align(header);
     for f in fields {
         offsets.push(at);
-        at = align(at + f.data.len());
+        at = align(at + f.byte_len());
     }
-    let mut out = Vec::with_capacity(at);
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&VERSION);
-    out.extend_from_slice(&(fields.len() as u32).to_le_bytes());
+    let mut head = Vec::with_capacity(header as usize);
+    head.extend_from_slice(MAGIC);
+    head.extend_from_slice(&VERSION);
+    head.extend_from_slice(&(fields.len() as u32).to_le_bytes());
     for (f, &off) in fields.iter().zip(&offsets) {
-        out.extend_from_slice(&(f.name.len() as u16).to_le_bytes());
-        out.extend_from_slice(f.name.as_bytes());
-        out.extend_from_slice(&(f.shape.len() as u16).to_le_bytes());
-        out.push(f.dtype.code());
-        out.extend_from_slice(&(off as u64).to_le_bytes());
+        head.extend_from_slice(&(f.name.len() as u16).to_le_bytes());
+        head.extend_from_slice(f.name.as_bytes());
+        head.extend_from_slice(&(f.shape.len() as u16).to_le_bytes());
+        head.push(f.dtype.code());
+        head.extend_from_slice(&off.to_le_bytes());
         for &s in &f.shape {
-            out.extend_from_slice(&s.to_le_bytes());
+            head.extend_from_slice(&s.to_le_bytes());
         }
     }
-    debug_assert_eq!(out.len(), header);
+    debug_assert_eq!(head.len() as u64, header);
+    let mut w = Counted { inner: out, n: 0 };
+    w.write_all(&head)?;
     for (f, &off) in fields.iter().zip(&offsets) {
-        out.resize(off, 0);
-        out.extend_from_slice(&f.data);
+        w.pad_to(off)?;
+        let before = w.n;
+        (f.data)(&mut w)?;
+        if w.n - before != f.byte_len() {
+            return Err(io::Error::other(format!(
+                "field {} wrote {} bytes for a shape of {} (a bug)",
+                f.name,
+                w.n - before,
+                f.byte_len()
+            )));
+        }
     }
-    out.resize(at, 0);
-    out
+    w.pad_to(at)?;
+    Ok(at)
+}
+
+/// A writer counting the bytes written.
+struct Counted<'w> {
+    inner: &'w mut dyn Write,
+    n: u64,
+}
+
+impl Counted<'_> {
+    fn pad_to(&mut self, at: u64) -> io::Result<()> {
+        let zeros = [0u8; 8];
+        while self.n < at {
+            let k = (at - self.n).min(8) as usize;
+            self.write_all(&zeros[..k])?;
+        }
+        Ok(())
+    }
+}
+
+impl Write for Counted<'_> {
+    fn write(&mut self, b: &[u8]) -> io::Result<usize> {
+        let k = self.inner.write(b)?;
+        self.n += k as u64;
+        Ok(k)
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
 }
 
 /// Resolution of an RGL export.
@@ -148,6 +274,25 @@ pub const DEFAULT_GRID: RglGrid = RglGrid {
 };
 
 impl RglGrid {
+    /// Slices evaluated and held: one per view-direction node, the repeated phi = pi
+    /// excluded.
+    pub fn slices(&self) -> u64 {
+        self.n_phi as u64 * self.n_theta as u64
+    }
+
+    /// An upper bound on the memory an RGL export of this grid takes besides the program,
+    /// in bytes, with `threads` workers (the RGB and the spectral file alike, one or both):
+    /// the slices held (16 bytes a texel: rgb and luminance f32, and 64 bytes a slice), each
+    /// worker's slice in evaluation (at most 192 bytes a texel: the direction pairs, their
+    /// values, the texels and the luminance in f64, counted with room), and the writer's
+    /// buffers (1 MiB and 64 KiB). The files are streamed from the slices
+    /// ([`lazy_fields_of`], [`write_tensor_file`]): nothing the size of a file is held.
+    pub fn peak_bytes(&self, threads: usize) -> u64 {
+        let texels = (self.n_slice as u64).pow(2);
+        let workers = (threads.max(1) as u64).min(self.slices());
+        self.slices() * (16 * texels + 64) + workers * 192 * texels + (1 << 20) + (1 << 16)
+    }
+
     /// An error message naming the bad count, or `Ok`.
     pub fn validate(&self) -> Result<(), String> {
         for (name, v, max) in [
@@ -285,67 +430,85 @@ pub fn rgl_fields(
 
 /// The fields of a `.bsdf` file from evaluated slices, in the order written: description,
 /// jacobian, theta_i, phi_i, ndf, sigma, vndf, luminance, then `rgb` or `wavelengths` and
-/// `spectra` (see [`Colour`]; the readers find fields by name).
+/// `spectra` (see [`Colour`]; the readers find fields by name). Made in memory: for a file,
+/// [`lazy_fields_of`] and [`write_tensor_file`] hold nothing but the slices.
 pub fn fields_of(slices: &Slices, description: &str, colour: Colour) -> Vec<Field> {
+    lazy_fields_of(slices, description, colour)
+        .iter()
+        .map(LazyField::to_field)
+        .collect()
+}
+
+/// [`fields_of`] with the large fields (luminance, rgb, spectra) made from the slices as the
+/// file is written.
+pub fn lazy_fields_of<'a>(
+    slices: &'a Slices,
+    description: &str,
+    colour: Colour,
+) -> Vec<LazyField<'a>> {
     let grid = &slices.grid;
     let (nt, np, n) = (grid.n_theta, grid.n_phi + 1, grid.n_slice);
     let thetas = grid.theta_nodes();
     let phis = grid.phi_nodes();
-    let slices = &slices.slices;
-    let slice_at = |j: usize, k: usize| &slices[(j % (np - 1)) * nt + k];
+    // Slice (j, k); the node phi = pi (j = n_phi) repeats phi = -pi.
+    let slice_at = move |j: usize, k: usize| &slices.slices[(j % (np - 1)) * nt + k];
+    let every = move || (0..np).flat_map(move |j| (0..nt).map(move |k| slice_at(j, k)));
     let (npu, ntu, nu) = (np as u64, nt as u64, n as u64);
-    let mut lum = Vec::with_capacity(np * nt * n * n);
-    for j in 0..np {
-        for k in 0..nt {
-            lum.extend_from_slice(&slice_at(j, k).1);
-        }
-    }
     let f32s = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+    let eager = |f: Field| LazyField {
+        name: f.name,
+        dtype: f.dtype,
+        shape: f.shape,
+        data: Box::new(move |w: &mut dyn Write| w.write_all(&f.data)),
+    };
     let mut fields = vec![
-        Field::bytes("description", description.as_bytes()),
-        Field::bytes("jacobian", &[1]),
-        Field::f32("theta_i", &[ntu], &f32s(&thetas)),
-        Field::f32("phi_i", &[npu], &f32s(&phis)),
-        Field::f32("ndf", &[2, 2], &[1.0; 4]),
-        Field::f32("sigma", &[2, 2], &[0.25; 4]),
-        Field::f32("vndf", &[npu, ntu, 2, 2], &vec![1.0; np * nt * 4]),
-        Field::f32("luminance", &[npu, ntu, nu, nu], &lum),
+        eager(Field::bytes("description", description.as_bytes())),
+        eager(Field::bytes("jacobian", &[1])),
+        eager(Field::f32("theta_i", &[ntu], &f32s(&thetas))),
+        eager(Field::f32("phi_i", &[npu], &f32s(&phis))),
+        eager(Field::f32("ndf", &[2, 2], &[1.0; 4])),
+        eager(Field::f32("sigma", &[2, 2], &[0.25; 4])),
+        eager(Field::f32(
+            "vndf",
+            &[npu, ntu, 2, 2],
+            &vec![1.0; np * nt * 4],
+        )),
+        LazyField::f32_with("luminance", &[npu, ntu, nu, nu], move |w| {
+            every().try_for_each(|s| put_f32s(w, s.1.iter().copied()))
+        }),
     ];
     match colour {
-        Colour::Rgb => {
-            let mut rgb = Vec::with_capacity(np * nt * 3 * n * n);
-            for j in 0..np {
-                for k in 0..nt {
-                    rgb.extend_from_slice(&slice_at(j, k).0);
-                }
-            }
-            fields.push(Field::f32("rgb", &[npu, ntu, 3, nu, nu], &rgb));
-        }
+        Colour::Rgb => fields.push(LazyField::f32_with(
+            "rgb",
+            &[npu, ntu, 3, nu, nu],
+            move |w| every().try_for_each(|s| put_f32s(w, s.0.iter().copied())),
+        )),
         Colour::Spectral => {
-            let basis = spectrum::Upsampling::new();
             let nw = spectrum::WAVELENGTHS.len();
-            let mut spectra = Vec::with_capacity(np * nt * nw * n * n);
-            for j in 0..np {
-                for k in 0..nt {
-                    let rgb = &slice_at(j, k).0;
-                    for b in basis.basis() {
-                        spectra.extend((0..n * n).map(|i| {
-                            (0..3)
-                                .map(|c| b[c] * f64::from(rgb[c * n * n + i]))
-                                .sum::<f64>() as f32
-                        }));
-                    }
-                }
-            }
-            fields.push(Field::f32(
+            fields.push(eager(Field::f32(
                 "wavelengths",
                 &[nw as u64],
                 &f32s(&spectrum::WAVELENGTHS),
-            ));
-            fields.push(Field::f32(
+            )));
+            let basis = spectrum::Upsampling::new();
+            fields.push(LazyField::f32_with(
                 "spectra",
                 &[npu, ntu, nw as u64, nu, nu],
-                &spectra,
+                move |w| {
+                    every().try_for_each(|s| {
+                        let rgb = &s.0;
+                        basis.basis().iter().try_for_each(|b| {
+                            put_f32s(
+                                w,
+                                (0..n * n).map(|i| {
+                                    (0..3)
+                                        .map(|c| b[c] * f64::from(rgb[c * n * n + i]))
+                                        .sum::<f64>() as f32
+                                }),
+                            )
+                        })
+                    })
+                },
             ));
         }
     }

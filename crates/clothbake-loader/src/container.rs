@@ -18,7 +18,7 @@ use std::fmt;
 use std::io::{BufReader, Write};
 use std::path::Path;
 
-use crate::atomic::write_atomic_as;
+use crate::atomic::{write_atomic_as, write_owned_as};
 use crate::bytes::{hex, open_sized, read_f32s, read_hashed, read_up_to, CrcWriter, Source};
 use crate::error::TableError;
 
@@ -164,7 +164,22 @@ where
     }
     let mut tag = [0u8; KIND_LEN];
     tag[..kind.tag().len()].copy_from_slice(kind.tag().as_bytes());
-    write_atomic_as(path, kind.tag(), overwrite, |out| {
+    // A checkpoint is the one file written under a name a bake owns (`<output>.checkpoint`).
+    let owned = kind == ContainerKind::Checkpoint;
+    let write_file =
+        |path: &Path,
+         what: &str,
+         overwrite: bool,
+         f: &mut dyn FnMut(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>| {
+            if owned {
+                write_owned_as(path, what, overwrite, |w| f(w))
+            } else {
+                write_atomic_as(path, what, overwrite, |w| f(w))
+            }
+        };
+    let mut chunks = Some(chunks);
+    write_file(path, kind.tag(), overwrite, &mut |out| {
+        let chunks = chunks.take().expect("written once");
         let mut w = CrcWriter::new(out);
         w.write_all(&BINARY_MAGIC)?;
         w.write_all(&CONTAINER_VERSION.to_le_bytes())?;

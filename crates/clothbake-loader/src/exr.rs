@@ -641,15 +641,39 @@ mod exr_io {
                     expected.join(", ")
                 )));
             };
-            if let Some(stored) = attrs.get(&Text::from(ATTR_CRC32)).and_then(attribute_text) {
+            if let Some(attr) = attrs.get(&Text::from(ATTR_CRC32)) {
+                // Eight hexadecimal digits as written; anything else is a damaged attribute,
+                // not a checksum of 0.
+                let text = attribute_text(attr);
+                let stored = text
+                    .as_deref()
+                    .map(str::trim)
+                    .filter(|t| t.len() == 8 && t.bytes().all(|b| b.is_ascii_hexdigit()))
+                    .and_then(|t| u32::from_str_radix(t, 16).ok());
+                let Some(stored) = stored else {
+                    let shown = match &text {
+                        Some(t) => format!(
+                            "`{}`",
+                            t.chars().take(40).collect::<String>().escape_debug()
+                        ),
+                        None => "not text".to_string(),
+                    };
+                    return Err(TableError::Corrupted {
+                        path: path.to_path_buf(),
+                        reason: format!(
+                            "its {ATTR_CRC32} attribute is {shown}, not a checksum of 8 \
+                             hexadecimal digits"
+                        ),
+                    });
+                };
                 let computed =
                     values_crc(&meta_json_bytes, planes[0].len(), planes.len(), |ch, i| {
                         planes[ch].get(i)
                     });
-                if u32::from_str_radix(stored.trim(), 16).ok() != Some(computed) {
+                if stored != computed {
                     return Err(TableError::Checksum {
                         path: path.to_path_buf(),
-                        stored: u32::from_str_radix(stored.trim(), 16).unwrap_or(0),
+                        stored,
                         computed,
                     });
                 }

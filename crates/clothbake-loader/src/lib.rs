@@ -27,7 +27,7 @@ pub mod spatial;
 pub mod stored;
 mod table;
 
-pub use atomic::{check_target, write_atomic_as};
+pub use atomic::{abandon_temporaries, bake_owned, check_target, write_atomic_as, Batch};
 pub use binary::{read_binary, write_binary};
 pub use clothbake_bsdf::{Bsdf, BsdfSample, UnitVec3};
 pub use container::{

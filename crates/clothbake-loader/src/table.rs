@@ -151,7 +151,11 @@ impl Grid {
             return Err(TableError::InvalidTable {
                 reason: format!(
                     "grid {self}: {} cells is more than the limit of {MAX_CELLS} (2^31); use a coarser grid",
-                    self.cells()
+                    // The exact count (a u128 holds any product of four u32).
+                    [self.n_theta_i, self.n_phi_i, self.n_theta_o, self.n_phi_o]
+                        .iter()
+                        .map(|&n| u128::from(n))
+                        .product::<u128>()
                 ),
             });
         }

@@ -88,7 +88,8 @@ fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) ->
 /// bounces: 1 (default), or 2 to add the secondary reflection (thesis ch. 5; minutes at full
 /// res), or N from 3 to 64 or "all": every bounce, path-traced from the second on over the
 /// analytic second bounce on a coarse grid (docs/transport.md; about 5 minutes at full res).
-/// facet: "huo" (default) or "lewis". progress: True prints the percentage done to stderr; a
+/// facet: "huo" (default) or "lewis". progress: True prints the percentage done to stderr (on
+/// a terminal one line redrawn in place, else a line every 10%); a
 /// callable is called as progress(done, total) (cells evaluated) and stops the bake by
 /// returning False (the rows done are kept in the checkpoint; KeyboardInterrupt is raised).
 /// output: write the table (or the shard) to this file, atomically (overwrite: replace an
@@ -265,6 +266,7 @@ pub fn bake(
     let callback_error: Mutex<Option<PyErr>> = Mutex::new(None);
     let shown = AtomicU64::new(0);
     let name = fabric.fabric.name().to_string();
+    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let on_progress = |done: u64, total: u64| {
         if let Some(cb) = &callback {
             Python::attach(|py| match cb.call1(py, (done, total)) {
@@ -283,12 +285,19 @@ pub fn bake(
             });
         }
         if print {
+            // On a terminal one line redrawn in place; into a log or a pipe a line every 10%
+            // (no carriage returns).
             let pct = done * 100 / total.max(1);
-            if shown.fetch_max(pct + 1, Ordering::Relaxed) < pct + 1 {
+            let step = if tty { pct } else { pct / 10 * 10 };
+            if shown.fetch_max(step + 1, Ordering::Relaxed) < step + 1 {
                 let mut err = std::io::stderr().lock();
-                let _ = write!(err, "\rbaking {name}: {pct:3}%");
-                if done >= total {
-                    let _ = writeln!(err);
+                if tty {
+                    let _ = write!(err, "\rbaking {name}: {pct:3}%");
+                    if done >= total {
+                        let _ = writeln!(err);
+                    }
+                } else {
+                    let _ = writeln!(err, "baking {name}: {step:3}%");
                 }
             }
         }

@@ -189,6 +189,12 @@ impl PyFabric {
         level: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let facet = facet_model(facet)?;
+        let most = clothbake_bake::settings::MAX_SAMPLES;
+        if samples == 0 || samples > most {
+            return Err(PyValueError::new_err(format!(
+                "samples: {samples}; give a whole number of rays from 1 to {most} (2^24)"
+            )));
+        }
         let point_level = match level {
             "auto" => true,
             "cells" => false,

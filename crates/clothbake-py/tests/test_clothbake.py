@@ -416,6 +416,7 @@ def test_bake_options_reach_the_table(twill_path):
         (dict(precision="f32", output="t.bin"), "precision: applies only to EXR"),
         (dict(format="bin", output="t.exr"), "format: \"bin\" but the output t.exr"),
         (dict(checkpoint_every=0.0, output="t.exr"), "checkpoint_every: 0"),
+        (dict(method="raytrace", samples=2**25), "samples=33554432 is out of range; give a whole number from 1 to 16777216"),
     ],
 )
 def test_bad_bake_options_name_the_option(twill_path, kwargs, words):
@@ -479,3 +480,21 @@ def test_table_eval_reads_any_layout_alike(twill_path):
     # float32 input: the same directions rounded, as the lookup takes them anyway.
     np.testing.assert_array_equal(t.eval(wi.astype(np.float32), wo.astype(np.float32)), f)
     assert t.eval(wi[0], wo[0]).shape == (3,)
+
+
+def test_progress_into_a_log_has_no_carriage_returns(twill_path, capfd):
+    """progress=True with stderr not a terminal (captured into a file here): plain lines,
+    one per 10% at most, ending at 100%."""
+    clothbake.bake(clothbake.Fabric(twill_path), res=(4, 8, 4, 8), progress=True)
+    err = capfd.readouterr().err
+    assert "\r" not in err
+    lines = [l for l in err.splitlines() if l.startswith("baking ")]
+    assert 1 <= len(lines) <= 11, err
+    assert lines[-1].endswith("100%"), err
+
+
+def test_eval_samples_are_bounded(twill_path):
+    fab = clothbake.Fabric(twill_path)
+    wi, wo = dirs([30], [0]), dirs([45], [180])
+    with pytest.raises(ValueError, match="from 1 to 16777216"):
+        fab.eval(wi, wo, method="raytrace", samples=2**25)

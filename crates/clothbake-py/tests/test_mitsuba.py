@@ -255,3 +255,21 @@ def test_plugin_shows_the_yarns_up_close(twill_path, tmp_path, figures_dir):
           f"(vs the averaged picture {e_flat:.4f})")
     assert e < 0.02
     assert e_flat > 5 * e
+
+
+def test_the_readme_snippet_renders_the_twill(tmp_path, monkeypatch):
+    """The README's Python block, run as written in a folder beside tables/: it bakes the
+    twill and writes a PNG in which the ball (the image's centre) is lit above the sky."""
+    import pathlib
+
+    root = pathlib.Path(__file__).resolve().parents[3]
+    readme = (root / "README.md").read_text()
+    code = readme.split("```python\n", 1)[1].split("```", 1)[0]
+    (tmp_path / "tables").symlink_to(root / "tables")
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "README.md", "exec"), {})
+    img = np.asarray(mi.Bitmap(str(tmp_path / "twill-py.png")), dtype=np.float64)
+    h, w = img.shape[:2]
+    ball = img[h // 2 - 8:h // 2 + 8, w // 2 - 8:w // 2 + 8, :3].mean()
+    sky = img[:8, :8, :3].mean()
+    assert ball > sky + 20, (ball, sky)

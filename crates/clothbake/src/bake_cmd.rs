@@ -4,11 +4,12 @@
 //! output (an existing file without --force, a missing or unwritable folder: refused before any
 //! time is spent), bake on a pool of `--threads` workers with a progress bar on a terminal,
 //! then write the table atomically through the loader. Ctrl-C raises the cancel flag: the bake
-//! stops and nothing is written (exit 130; a second Ctrl-C exits at once).
+//! stops and nothing is written (exit 130; a second Ctrl-C exits at once; `signals`).
 
 use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg, ShardArg};
 use crate::error::{table_error, CliError};
 use crate::eval_cmd::load_fabric;
+use crate::signals;
 use clothbake_bake::checkpoint::DEFAULT_INTERVAL;
 use clothbake_bake::job::{self, Hooks, Job, JobError, Target};
 use clothbake_bake::output::Format;
@@ -20,14 +21,7 @@ use clothbake_loader::Precision;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
-
-/// Raised by Ctrl-C.
-static CANCEL: AtomicBool = AtomicBool::new(false);
-
-/// The exit status of an interrupted bake (128 + SIGINT, as shells report it).
-pub const INTERRUPTED: u8 = 130;
 
 /// A bake request, checked and resolved.
 #[derive(Debug)]
@@ -192,17 +186,6 @@ pub fn preflight(outputs: &[(&Path, &str)], force: bool, inputs: &[&Path]) -> Re
     clothbake_bake::output::preflight(outputs, force, inputs).map_err(|e| table_error(&e))
 }
 
-fn install_ctrlc() {
-    // A second Ctrl-C exits at once. If a handler cannot be installed, Ctrl-C keeps its
-    // default action (the process ends; the atomic write still leaves no partial table).
-    let _ = ctrlc::set_handler(|| {
-        if CANCEL.swap(true, Ordering::SeqCst) {
-            eprintln!("clothbake: interrupted twice; nothing was written");
-            std::process::exit(i32::from(INTERRUPTED));
-        }
-    });
-}
-
 /// The bake's progress line: cells evaluated, with their rate.
 const BAKE_BAR: &str = "{elapsed_precise} [{wide_bar}] {percent:>3}% {human_pos}/{human_len} \
                         cells evaluated, {rate}, ETA {eta}";
@@ -275,7 +258,7 @@ fn job_error(e: JobError) -> CliError {
                 ),
                 None => i.to_string(),
             };
-            CliError::line(msg).with_code(INTERRUPTED)
+            CliError::line(msg).with_code(signals::INTERRUPTED)
         }
     }
 }
@@ -318,7 +301,7 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
         naming: Naming::Cli,
         inputs: vec![plan.weave.clone()],
     };
-    install_ctrlc();
+    signals::install(signals::OnSignal::Cancel);
     let start = Instant::now();
     let pool = thread_pool(plan.threads)?;
     let bar = progress_bar(0, BAKE_BAR, o.run.quiet);
@@ -338,7 +321,7 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
         progress: &progress,
         note: &note,
         warn: &warn,
-        cancel: &CANCEL,
+        cancel: &signals::CANCEL,
     };
     let result = pool.install(|| job::run(&job, &hooks));
     if let Some(b) = &bar {
@@ -378,16 +361,34 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     Ok(summary)
 }
 
-/// The line after a baked table's summary: what to try with it next.
+/// The line after a baked table's summary: what to try with it next, spelled as this program
+/// can be run ([`invocation`]).
 pub fn next_steps(weave: &Path, table: &Path) -> String {
     format!(
-        "next: `clothbake info {t}` (what it holds), `clothbake render --table {t} -o {png}` \
-         (a picture), `clothbake eval --weave {w} --wi 30,0 --wo 45,180` (one pair of \
-         directions)\n",
+        "next: `{c} info {t}` (what it holds), `{c} render --table {t} -o {png}` (a picture), \
+         `{c} eval --weave {w} --wi 30,0 --wo 45,180` (one pair of directions)\n",
+        c = invocation(),
         t = table.display(),
         png = table.with_extension("png").display(),
         w = weave.display(),
     )
+}
+
+/// How a hint runs this program: `clothbake` when a `clothbake` is on PATH; else, when cargo
+/// runs it (`cargo run`, which sets `CARGO`), `cargo run --release -p clothbake --`; else the
+/// path of this executable.
+pub fn invocation() -> String {
+    let on_path = std::env::var_os("PATH").is_some_and(|p| {
+        std::env::split_paths(&p)
+            .any(|d| std::fs::metadata(d.join("clothbake")).is_ok_and(|m| m.is_file()))
+    });
+    if on_path {
+        "clothbake".into()
+    } else if std::env::var_os("CARGO").is_some() {
+        "cargo run --release -p clothbake --".into()
+    } else {
+        std::env::current_exe().map_or_else(|_| "clothbake".into(), |e| e.display().to_string())
+    }
 }
 
 #[cfg(test)]

@@ -172,7 +172,7 @@ pub struct BakeOpts {
     pub samples: Option<usize>,
 
     /// Random seed for --method raytrace (cell c uses seed + c) [default: 1].
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", value_parser = parse_seed)]
     pub seed: Option<u64>,
 
     /// End caps for --method raytrace: excluded from the average (default) or shaded.
@@ -508,7 +508,7 @@ pub struct EvalArgs {
     pub samples: Option<usize>,
 
     /// Random seed for --method raytrace [default: 1].
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", value_parser = parse_seed)]
     pub seed: Option<u64>,
 
     /// --facet, --variant.
@@ -877,14 +877,24 @@ pub fn parse_period_point(s: &str) -> Result<clothbake_core::PeriodPoint, String
     clothbake_core::PeriodPoint::new(u, v).ok_or_else(|| format!("U and V must be finite; {FIX}"))
 }
 
-/// Parses a positive sample count.
+/// Parses a sample count, 1 to [`clothbake_bake::settings::MAX_SAMPLES`].
 pub fn parse_samples(s: &str) -> Result<usize, String> {
-    match s.trim().parse::<usize>() {
-        Ok(0) => Err("the sample count must be at least 1; give e.g. --samples 100000".into()),
+    clothbake_bake::settings::parse_samples(s, "--samples")
+}
+
+/// Parses a random seed, a whole number from 0 to 2^64 - 1.
+pub fn parse_seed(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    match t.parse::<u64>() {
         Ok(n) => Ok(n),
+        Err(_) if clothbake_bake::settings::is_whole(t) => Err(format!(
+            "--seed {t} is too large (at most {}, 2^64 - 1); give a smaller whole number, e.g. \
+             --seed 1",
+            u64::MAX
+        )),
         Err(_) => Err(format!(
-            "`{}` is not a whole number of samples; give e.g. --samples 100000",
-            s.trim()
+            "`{t}` is not a whole number from 0 to {}; give e.g. --seed 1",
+            u64::MAX
         )),
     }
 }
@@ -977,8 +987,9 @@ pub fn parse_res(s: &str) -> Result<Grid, String> {
         };
     }
     let g = Grid::new(n[0], n[1], n[2], n[3]);
-    let cells: u64 = n.iter().map(|&x| u64::from(x)).product();
-    if cells > clothbake_loader::MAX_CELLS {
+    // Exact: a u128 holds any product of four u32 (a u64 product could wrap).
+    let cells: u128 = n.iter().map(|&x| u128::from(x)).product();
+    if cells > u128::from(clothbake_loader::MAX_CELLS) {
         return Err(format!(
             "{cells} cells is more than the limit of 2^31; use a coarser grid, e.g. 32,64,32,64"
         ));
@@ -1250,7 +1261,8 @@ pub struct PlotArgs {
 
 /// Parses `X,Y,Z`: three finite numbers.
 pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
-    const FIX: &str = "write X,Y,Z, three numbers separated by commas, e.g. 0,-55,45";
+    const FIX: &str = "write X,Y,Z, three numbers separated by commas, each from -1000000 to \
+                       1000000 (the scenes span about 100 units), e.g. 0,-55,45";
     let parts: Vec<&str> = s.split(',').collect();
     let [x, y, z] = parts.as_slice() else {
         return Err(format!(
@@ -1258,12 +1270,28 @@ pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
             parts.len()
         ));
     };
+    let coordinate = |p: &str, name: &str| {
+        let v = number(p, name).map_err(|e| format!("{e}; {FIX}"))?;
+        if v.abs() > MAX_COORDINATE {
+            return Err(format!("{name} {v} is outside [-1000000, 1000000]; {FIX}"));
+        }
+        Ok(v)
+    };
     Ok([
-        number(x, "X").map_err(|e| format!("{e}; {FIX}"))?,
-        number(y, "Y").map_err(|e| format!("{e}; {FIX}"))?,
-        number(z, "Z").map_err(|e| format!("{e}; {FIX}"))?,
+        coordinate(x, "X")?,
+        coordinate(y, "Y")?,
+        coordinate(z, "Z")?,
     ])
 }
+
+/// The largest magnitude of a render's coordinates and light components (`--eye`,
+/// `--look-at`, `--light`): far beyond the scenes (about 100 units across), and small enough
+/// that every product and sum of the camera's and the light's arithmetic stays finite.
+pub const MAX_COORDINATE: f64 = 1e6;
+
+/// The largest `--irradiance` and `--exposure`: a pixel value (at most 1e30 1/sr, a table's
+/// limit, times the irradiance) and its exposed value stay finite in f32.
+pub const MAX_LIGHT: f64 = 1e6;
 
 /// Parses a field of view in (0, 180) degrees.
 pub fn parse_fov(s: &str) -> Result<f64, String> {
@@ -1341,24 +1369,28 @@ pub fn parse_ambient(s: &str) -> Result<f64, String> {
     )
 }
 
-/// Parses a non-negative finite irradiance.
+/// Parses an irradiance from 0 to [`MAX_LIGHT`].
 pub fn parse_irradiance(s: &str) -> Result<f64, String> {
-    non_negative(
-        s,
-        "irradiance",
-        "give a non-negative irradiance, e.g. 3.14159 (pi, the default)",
-    )
+    const FIX: &str = "give an irradiance from 0 to 1000000, e.g. 3.14159 (pi, the default)";
+    let x = non_negative(s, "irradiance", FIX)?;
+    if x > MAX_LIGHT {
+        return Err(format!("irradiance {x} is more than 1000000; {FIX}"));
+    }
+    Ok(x)
 }
 
 /// Parses `--exposure X|auto`, X > 0.
 pub fn parse_exposure(s: &str) -> Result<Exposure, String> {
-    const FIX: &str = "give a positive factor, e.g. 1.5, or auto";
+    const FIX: &str = "give a positive factor up to 1000000, e.g. 1.5, or auto";
     if s.trim().eq_ignore_ascii_case("auto") {
         return Ok(Exposure::Auto);
     }
     let x = number(s, "exposure").map_err(|e| format!("{e}; {FIX}"))?;
     if x <= 0.0 {
         return Err(format!("exposure {x} is not positive; {FIX}"));
+    }
+    if x > MAX_LIGHT {
+        return Err(format!("exposure {x} is more than 1000000; {FIX}"));
     }
     Ok(Exposure::Factor(x))
 }

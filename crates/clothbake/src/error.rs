@@ -67,7 +67,10 @@ pub fn table_error(e: &clothbake_loader::TableError) -> CliError {
             action,
             source,
         } => {
-            let reading = action.contains("read") || action.starts_with("open the table");
+            // Files are opened only to be read (writes create a temporary file); a folder is
+            // opened to be written into.
+            let reading = action.contains("read")
+                || (action.starts_with("open the ") && !action.ends_with("folder"));
             CliError::new(
                 format!("{}: cannot {action}: {}", path.display(), os_cause(source)),
                 io_fix(source, reading, written(action)),
@@ -185,6 +188,26 @@ mod tests {
         let full = std::io::Error::from_raw_os_error(28);
         let fix = io_fix(&full, false, written("write the PNG image"));
         assert!(fix.contains("write the PNG image elsewhere"), "{fix}");
+    }
+
+    #[test]
+    fn a_file_that_cannot_be_opened_is_a_reading_error() {
+        let denied = || std::io::Error::from(std::io::ErrorKind::PermissionDenied);
+        let e = table_error(&clothbake_loader::TableError::Io {
+            path: "t.exr.checkpoint".into(),
+            action: "open the checkpoint".into(),
+            source: denied(),
+        });
+        assert!(
+            e.to_string().contains("check the file's permissions"),
+            "{e}"
+        );
+        let e = table_error(&clothbake_loader::TableError::Io {
+            path: "out".into(),
+            action: "open the folder".into(),
+            source: denied(),
+        });
+        assert!(e.to_string().contains("you may not write there"), "{e}");
     }
 
     #[test]

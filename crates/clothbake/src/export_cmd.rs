@@ -8,6 +8,7 @@ use crate::bake_cmd::preflight;
 use crate::cli::ExportArgs;
 use crate::error::CliError;
 use crate::eval_cmd::apply_material;
+use clothbake_bake::memory;
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel};
 use clothbake_export::fitted::material::{Cells, Source};
@@ -100,7 +101,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             );
             // A fabric unchanged by a half turn has a BRDF unchanged by it: half the rotations.
             let half_turn = symmetries(&fabric).contains(&Symmetry::Rotate180);
-            write_all(args, brdf, cells, fabric.name(), &source, half_turn)
+            write_all(args, brdf, cells, fabric.name(), &source, half_turn, 0)
         }
         (None, Some(table)) => {
             refuse_model_options(args)?;
@@ -139,7 +140,8 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             });
             // No half-turn shortcut for a table: lookups are cheap, and the interpolated table
             // need not be exactly symmetric.
-            write_all(args, &lookup, cells, &name, &source, false)
+            let held = lookup.memory_bytes() as u64;
+            write_all(args, &lookup, cells, &name, &source, false, held)
         }
     }
 }
@@ -185,7 +187,8 @@ fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
     preflight(&outputs, args.run.force, &inputs)
 }
 
-/// Writes every requested file from `brdf`; `source` opens the RGL description.
+/// Writes every requested file from `brdf`, which holds `held` bytes (a loaded table's);
+/// `source` opens the RGL description.
 fn write_all(
     args: &ExportArgs,
     brdf: &dyn Bsdf,
@@ -193,16 +196,23 @@ fn write_all(
     name: &str,
     source: &str,
     half_turn: bool,
+    held: u64,
 ) -> Result<String, CliError> {
     let threads = crate::bake_cmd::thread_count(args.run.threads);
+    let g = args.rgl_res.0;
+    let n_cells = cells
+        .as_ref()
+        .map_or(1, |c| (c.u_edges.len() - 1) * (c.v_edges.len() - 1));
+    check_memory(args, threads, held, n_cells)?;
     let pool = crate::bake_cmd::thread_pool(threads)?;
     let mut summary = String::new();
     let src = Source {
         average: brdf,
         cells,
     };
-    summary += &pool.install(|| crate::fitted_cmd::write(args, &src, name))?;
-    let g = args.rgl_res.0;
+    // Fitted on the pool; written from this thread, where the command's outputs are batched
+    // (moved into place together).
+    summary += &crate::fitted_cmd::write(args, &src, name, &pool)?;
     // One evaluation of the slices serves both RGL files.
     let mut slices = None;
     for (out, colour) in [
@@ -232,9 +242,13 @@ fn write_all(
             g.n_slice
         );
         let slices = slices.get_or_insert_with(|| pool.install(|| rgl::rgl_slices(brdf, &g)));
-        let fields = rgl::fields_of(slices, &description, colour);
-        let bytes = rgl::tensor_file(&fields);
-        export::write_file(out, &bytes, args.run.force)?;
+        // Streamed from the slices: nothing the size of the file is held.
+        let fields = rgl::lazy_fields_of(slices, &description, colour);
+        let mut size = 0;
+        clothbake_loader::write_atomic_as(out, "exported file", args.run.force, |w| {
+            size = rgl::write_tensor_file(w, &fields)?;
+            Ok(())
+        })?;
         let _ = writeln!(
             summary,
             "wrote {}: RGL tensor file ({}), view grid {} x {} (+1), slices {} x {}, {:.1} MB, \
@@ -248,7 +262,7 @@ fn write_all(
             g.n_phi,
             g.n_slice,
             g.n_slice,
-            bytes.len() as f64 / 1e6,
+            size as f64 / 1e6,
             start.elapsed().as_secs_f64()
         );
     }
@@ -274,6 +288,43 @@ fn write_all(
     } else {
         summary
     })
+}
+
+/// The most memory the export takes (the program's [`memory::BASE_BYTES`], `held` bytes of a
+/// loaded table, the RGL slices held and in evaluation, the MERL table; `RglGrid::peak_bytes`,
+/// `merl::peak_bytes`), refused before any work when the machine has less available.
+fn check_memory(
+    args: &ExportArgs,
+    threads: usize,
+    held: u64,
+    cells: usize,
+) -> Result<(), CliError> {
+    let rgl = if args.rgl.is_some() || args.rgl_spectral.is_some() {
+        args.rgl_res.0.peak_bytes(threads)
+    } else {
+        0
+    };
+    let merl = args
+        .merl
+        .as_ref()
+        .map_or(0, |_| merl::peak_bytes(args.phi_samples, threads));
+    let fitted = if crate::fitted_cmd::wanted(args) {
+        clothbake_export::fitted::material::Fitted::peak_bytes(cells)
+    } else {
+        0
+    };
+    let need = memory::BASE_BYTES + held + rgl + merl + fitted;
+    match memory::available_bytes() {
+        Some(have) if need > have => Err(CliError::new(
+            format!(
+                "this export needs up to {} of memory, but {} is available",
+                memory::describe(need),
+                memory::describe(have)
+            ),
+            "give a smaller --rgl-res (the slices hold 16 bytes a texel) or fewer --threads",
+        )),
+        _ => Ok(()),
+    }
 }
 
 fn facet_name(f: FacetModel) -> &'static str {

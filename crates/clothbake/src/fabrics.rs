@@ -117,7 +117,28 @@ pub fn is_draft(weave: &Path) -> bool {
 pub fn read(weave: &Path, wif: &WifOptions) -> Result<Fabric, FabricError> {
     match shipped_for(weave) {
         Some(s) => s.fabric(wif),
-        None => Fabric::from_path_with(weave, wif),
+        None => Fabric::from_path_with(weave, wif).map_err(|mut e| {
+            if std::fs::symlink_metadata(weave).is_err() {
+                e.fix = missing_fix(weave);
+            }
+            e
+        }),
+    }
+}
+
+/// The fix for a fabric file that does not exist: the shipped fabric of that file name, built
+/// in (`tables/basket.json` outside the source: `--weave basket`), or the way to name one.
+fn missing_fix(weave: &Path) -> String {
+    let name = weave.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    match find(name) {
+        Some(s) => format!(
+            "check the path, or give the shipped fabric of that name, built in: --weave {} \
+             (`clothbake fabrics` lists them)",
+            s.name()
+        ),
+        None => "check the path, or give a shipped fabric by name, e.g. --weave twill \
+                 (`clothbake fabrics` lists them)"
+            .into(),
     }
 }
 

@@ -66,8 +66,13 @@ fn percent(r: &clothbake_export::fitted::fit::Residual) -> String {
     )
 }
 
-/// Fits and writes every fitted target asked for; returns the summary lines.
-pub fn write(args: &ExportArgs, src: &Source<'_>, name: &str) -> Result<String, CliError> {
+/// Fits (on `pool`) and writes every fitted target asked for; returns the summary lines.
+pub fn write(
+    args: &ExportArgs,
+    src: &Source<'_>,
+    name: &str,
+    pool: &rayon::ThreadPool,
+) -> Result<String, CliError> {
     let mut summary = String::new();
     if !wanted(args) {
         return Ok(summary);
@@ -77,7 +82,18 @@ pub fn write(args: &ExportArgs, src: &Source<'_>, name: &str) -> Result<String, 
     let p = args.periods_per_uv;
     let force = args.run.force;
     let want_openpbr = args.mtlx.is_some() || args.usd.is_some() || args.blender.is_some();
-    let fits = Fits::new(src, &tables, args.gltf.is_some(), want_openpbr);
+    let fits = pool.install(|| Fits::new(src, &tables, args.gltf.is_some(), want_openpbr));
+    if let Some(c) = &src.cells {
+        let n = (c.u_edges.len() - 1) * (c.v_edges.len() - 1);
+        if !Fitted::fits_per_cell(n) {
+            let _ = writeln!(
+                summary,
+                "note: the period has {n} crossing cells, more than the {} fitted one by one; \
+                 one material is fitted to the whole cloth (no textures)",
+                clothbake_export::fitted::material::MAX_CELLS
+            );
+        }
+    }
     if let Some(out) = &args.gltf {
         let file = gltf::glb(&fits.gltf, name, p);
         export::write_file(out, &file.bytes, force)?;

@@ -1,7 +1,7 @@
 //! `clothbake`: the command-line front end of clothbake-core.
 //!
 //! Every failure is one line `clothbake: <cause>; <fix>` on stderr with exit status 2 (130 for
-//! an interrupted bake). `clothbake diff` exits 1 when the tables differ beyond its tolerance.
+//! an interrupted command). `clothbake diff` exits 1 when the tables differ beyond its tolerance.
 
 mod bake_cmd;
 mod cli;
@@ -16,6 +16,7 @@ mod info_cmd;
 mod merge_cmd;
 mod render_cmd;
 mod report;
+mod signals;
 
 use clap::error::{ContextKind, ErrorKind};
 use clap::FromArgMatches;
@@ -45,7 +46,7 @@ fn main() -> ExitCode {
     match std::panic::catch_unwind(run) {
         Ok(Ok(code)) => ExitCode::from(code),
         Ok(Err(e)) => {
-            eprintln!("clothbake: {e}");
+            eprintln!("clothbake: {}", printable(&e.to_string()));
             ExitCode::from(e.code())
         }
         Err(_) => ExitCode::from(2), // the panic hook has printed the message
@@ -71,10 +72,10 @@ fn run() -> Result<u8, CliError> {
         Some(Command::Bake(args)) => (bake_cmd::run(&args.weave, &args.opts)?, 0),
         Some(Command::Info(args)) => (info_cmd::run(&args)?, 0),
         Some(Command::Diff(args)) => diff_cmd::run(&args)?,
-        Some(Command::Export(args)) => (export_cmd::run(&args)?, 0),
-        Some(Command::Merge(args)) => (merge_cmd::run(&args)?, 0),
-        Some(Command::Render(args)) => (render_cmd::run_render(&args)?, 0),
-        Some(Command::Plot(args)) => (render_cmd::run_plot(&args)?, 0),
+        Some(Command::Export(args)) => (writes(|| export_cmd::run(&args))?, 0),
+        Some(Command::Merge(args)) => (writes(|| merge_cmd::run(&args))?, 0),
+        Some(Command::Render(args)) => (writes(|| render_cmd::run_render(&args))?, 0),
+        Some(Command::Plot(args)) => (writes(|| render_cmd::run_plot(&args))?, 0),
         Some(Command::Fabrics) => (fabrics::list(), 0),
         Some(Command::Completions(args)) => (help_cmd::completions(args.shell), 0),
         Some(Command::Man(args)) => (help_cmd::man(args.command.as_deref())?, 0),
@@ -83,6 +84,7 @@ fn run() -> Result<u8, CliError> {
             None => return Err(help_cmd::no_command()),
         },
     };
+    let out = printable(&out);
     let mut stdout = std::io::stdout().lock();
     match stdout
         .write_all(out.as_bytes())
@@ -94,6 +96,39 @@ fn run() -> Result<u8, CliError> {
             .map(|()| code)
             .map_err(|e| CliError::new(format!("cannot write the output: {e}"), "check stdout")),
     }
+}
+
+/// `text` with every control character but the line feed and the tab escaped (`\u{1b}`): what
+/// a table or fabric made before control characters were refused carries (a name, a note)
+/// cannot reach the terminal raw.
+fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text
+        .chars()
+        .any(|c| c.is_control() && c != '\n' && c != '\t')
+    {
+        return text.into();
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() && c != '\n' && c != '\t' {
+                c.escape_unicode().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect::<String>()
+        .into()
+}
+
+/// Runs a command that writes files other than a bake: a signal ends it at once, leaving no
+/// temporary file and no partial set of outputs (`signals`); its outputs appear together when
+/// it succeeds (`clothbake_loader::Batch`).
+fn writes(command: impl FnOnce() -> Result<String, CliError>) -> Result<String, CliError> {
+    signals::install(signals::OnSignal::Exit);
+    let batch = clothbake_loader::Batch::begin();
+    let out = command()?;
+    batch.commit().map_err(|e| error::table_error(&e))?;
+    Ok(out)
 }
 
 /// A command line clap rejected, as one line that points to the help of the command meant: a

@@ -28,13 +28,39 @@ fn small_twill(dir: &Path, extra: &[&str]) -> Output {
 fn default_mode_writes_a_table_that_info_reads() {
     let d = fresh_dir("default");
     let twill = fabric("twill");
-    let out = succeeds(&run_in(&d, &["--weave", &twill, "--res", SMALL]));
+    // The binary's folder on PATH: the hints call it by name.
+    let exe = Path::new(env!("CARGO_BIN_EXE_clothbake"));
+    let mut c = common::cmd(&d, &["--weave", &twill, "--res", SMALL]);
+    c.env("PATH", exe.parent().unwrap());
+    let out = succeeds(&c.output().unwrap());
     assert_eq!(out.lines().count(), 2, "{out}");
     assert!(out
         .lines()
         .nth(1)
         .unwrap()
         .starts_with("next: `clothbake info twill.exr`"));
+    // Not on PATH, run by cargo (CARGO set): the hints say how cargo runs it; run by neither,
+    // its path.
+    for (cargo, want) in [
+        (
+            true,
+            "next: `cargo run --release -p clothbake -- info t2.exr`".to_string(),
+        ),
+        (false, format!("next: `{} info t3.exr`", exe.display())),
+    ] {
+        let out_name = if cargo { "t2.exr" } else { "t3.exr" };
+        let mut c = common::cmd(&d, &["--weave", &twill, "--res", SMALL, "-o", out_name]);
+        c.env("PATH", "/nonexistent");
+        if cargo {
+            c.env("CARGO", "cargo");
+        } else {
+            c.env_remove("CARGO");
+        }
+        let out = succeeds(&c.output().unwrap());
+        assert!(out.lines().nth(1).unwrap().starts_with(&want), "{out}");
+    }
+    std::fs::remove_file(d.join("t2.exr")).unwrap();
+    std::fs::remove_file(d.join("t3.exr")).unwrap();
     for w in [
         "wrote twill.exr",
         "4x8x4x8",

@@ -158,3 +158,30 @@ fn fitted_exports_refuse_bad_requests_before_work() {
     assert_eq!(listing(&dir), vec!["m.base.png".to_string()]);
     assert_eq!(std::fs::read(dir.join("m.base.png")).unwrap(), b"keep");
 }
+
+#[test]
+fn a_period_of_more_than_1024_cells_gets_one_material() {
+    // A 33 x 33 plain weave has 1089 crossing cells: fitted as one material (the bound on the
+    // per-cell fits' time and memory), said on stdout, no maps written.
+    let dir = fresh_dir("fitted", "many-cells");
+    let n = 33;
+    let pattern: Vec<Vec<u8>> = (0..n)
+        .map(|j| (0..n).map(|i| ((i + j) % 2) as u8).collect())
+        .collect();
+    let group = serde_json::json!({
+        "height": vec![0.0; n], "radius": vec![1.5; n], "spacing": vec![3.1; n],
+        "material": {"albedo": [0.5, 0.4, 0.3], "exponent": 10.0, "specular": 0.3}});
+    let fabric =
+        serde_json::json!({"name": "big", "pattern": pattern, "warp": group, "weft": group});
+    std::fs::write(dir.join("big.json"), fabric.to_string()).unwrap();
+    let out = run_in(
+        &dir,
+        &[
+            "export", "--weave", "big.json", "--gltf", "b.glb", "--mtlx", "b.mtlx",
+        ],
+    );
+    let text = succeeds(&out);
+    assert!(text.contains("1089 crossing cells"), "{text}");
+    assert!(text.contains("one set of parameters"), "{text}");
+    assert!(!listing(&dir).contains(&"b.base.png".to_string()));
+}

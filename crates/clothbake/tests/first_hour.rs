@@ -338,3 +338,41 @@ fn eval_names_its_settings() {
         "I_2 by  path tracer, radiometric kernel"
     );
 }
+
+/// Outside the clone, `--weave tables/basket.json` names no file: the hint gives the shipped
+/// fabric of that name, and the command it gives works there; a name shipped under no file
+/// gets the way to name one, and `clothbake fabrics` (which the hints point to) lists `twill`.
+#[test]
+fn a_missing_fabric_file_points_to_what_exists() {
+    let d = fresh_dir("first-hour", "outside");
+    let line = fails_with(
+        &run_in(&d, &["--weave", "tables/basket.json", "--res", "2,4,2,4"]),
+        2,
+        &["tables/basket.json", "--weave basket"],
+    );
+    assert!(!line.contains("tables/twill.json"), "{line}");
+    succeeds(&run_in(
+        &d,
+        &["--weave", "basket", "--res", "2,4,2,4", "-q"],
+    ));
+    assert!(d.join("basket.exr").exists());
+    fails_with(
+        &run_in(
+            &d,
+            &[
+                "eval",
+                "--weave",
+                "tables/nope.json",
+                "--wi",
+                "30,0",
+                "--wo",
+                "45,180",
+            ],
+        ),
+        2,
+        &["tables/nope.json", "--weave twill", "clothbake fabrics"],
+    );
+    assert!(succeeds(&run_in(&d, &["fabrics"]))
+        .lines()
+        .any(|l| l.starts_with("twill ")));
+}

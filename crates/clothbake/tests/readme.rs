@@ -180,6 +180,7 @@ macro_rules! doc_test {
 
 doc_test! {
     docs_baking: "docs/baking.md", 5;
+    docs_cli: "docs/cli.md", 20;
     docs_cluster: "docs/cluster.md", 4;
     docs_export: "docs/export.md", 6;
     docs_fabric_format: "docs/fabric-format.md", 1;
@@ -196,6 +197,7 @@ const NOTHING_TO_RUN: [&str; 2] = ["docs/loader.md", "docs/python.md"];
 fn every_document_with_shell_blocks_is_run_or_listed() {
     let tested = [
         "docs/baking.md",
+        "docs/cli.md",
         "docs/cluster.md",
         "docs/export.md",
         "docs/fabric-format.md",

@@ -9,6 +9,11 @@ use clothbake_core::{Bsdf, Footprint};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
+/// The most crossing cells a material is fitted per cell (a 32 x 32 period): each distinct
+/// cell costs a fit (about a second), and the cells' samples are held at once
+/// ([`Fitted::peak_bytes`]). A weave with more cells gets one material for the whole cloth.
+pub const MAX_CELLS: usize = 1024;
+
 /// The reflectance a material is fitted to.
 pub struct Source<'a> {
     /// The averaged reflectance (the period's mean).
@@ -50,7 +55,12 @@ impl Fitted {
     /// texture's mean is the averaged f_r.
     pub fn new(family: Family, src: &Source<'_>, tables: &Albedos) -> Fitted {
         let conv = family.convention();
-        let (u_edges, v_edges, cells) = match &src.cells {
+        let too_many = src
+            .cells
+            .as_ref()
+            .is_some_and(|c| (c.u_edges.len() - 1) * (c.v_edges.len() - 1) > MAX_CELLS);
+        let cells_src = if too_many { None } else { src.cells.as_ref() };
+        let (u_edges, v_edges, cells) = match cells_src {
             None => {
                 let r = Samples::of(src.average, Directions::fitting());
                 (vec![0.0, 1.0], vec![0.0, 1.0], vec![fit(conv, tables, &r)])
@@ -127,6 +137,21 @@ impl Fitted {
         };
         m.residual = m.residual_against(src.average, conv, tables);
         m
+    }
+
+    /// An upper bound on the memory a fit of `cells` crossing cells holds at its peak: each
+    /// cell's samples (24 bytes a pair of the fitting directions), the albedo tables and the
+    /// residual's samples.
+    pub fn peak_bytes(cells: usize) -> u64 {
+        let pairs = (Directions::fitting().dirs().len() as u64).pow(2);
+        let report = (Directions::reporting().dirs().len() as u64).pow(2);
+        let per_cell = 24 * pairs + 64;
+        (cells.min(MAX_CELLS) as u64 + 2) * per_cell + 8 * 24 * report + (1 << 20)
+    }
+
+    /// Whether `cells` crossing cells are fitted one by one ([`MAX_CELLS`]).
+    pub fn fits_per_cell(cells: usize) -> bool {
+        cells <= MAX_CELLS
     }
 
     /// The residual of this material's period mean, evaluated under `conv`, against `average`.
