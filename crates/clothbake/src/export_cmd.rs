@@ -170,6 +170,7 @@ fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
 
 /// Checks every output before any work is done ([`preflight`]).
 fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
+    crate::fitted_cmd::check_stems(args)?;
     let fitted = crate::fitted_cmd::outputs(args);
     let mut outputs: Vec<(&std::path::Path, &str)> = [
         (&args.rgl, "RGL file"),

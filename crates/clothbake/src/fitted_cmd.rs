@@ -52,6 +52,33 @@ fn map_stems(args: &ExportArgs) -> Vec<(PathBuf, String)> {
     v
 }
 
+/// Refuses MaterialX and USD outputs whose file stem cannot name their maps inside those files
+/// (a USD asset path ends at `@`; quotes, backslashes and control characters would break the
+/// XML or USDA text): the maps are named after the stem.
+pub fn check_stems(args: &ExportArgs) -> Result<(), CliError> {
+    for p in [&args.mtlx, &args.usd].into_iter().flatten() {
+        let stem = p
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let bad = stem
+            .chars()
+            .find(|c| c.is_control() || matches!(c, '@' | '"' | '\\' | '<' | '>' | '&'));
+        if let Some(c) = bad {
+            return Err(CliError::new(
+                format!(
+                    "{}: the file name holds {c:?}, which cannot stand in the names of its \
+                     texture maps inside the file",
+                    p.display()
+                ),
+                "name the --mtlx/--usd output without @, quotes, backslashes, <, >, & or \
+                 control characters",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Whether any fitted target was asked for.
 pub fn wanted(args: &ExportArgs) -> bool {
     args.gltf.is_some() || args.mtlx.is_some() || args.usd.is_some() || args.blender.is_some()

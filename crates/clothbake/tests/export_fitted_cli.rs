@@ -157,6 +157,21 @@ fn fitted_exports_refuse_bad_requests_before_work() {
     );
     assert_eq!(listing(&dir), vec!["m.base.png".to_string()]);
     assert_eq!(std::fs::read(dir.join("m.base.png")).unwrap(), b"keep");
+    // A stem that cannot name the maps inside a USD or MaterialX file (an asset path ends at
+    // `@`; a quote ends an XML attribute), refused before any work, nothing written.
+    for name in ["a@b.usda", "q\"x.mtlx"] {
+        let flag = if name.ends_with(".usda") {
+            "--usd"
+        } else {
+            "--mtlx"
+        };
+        fails_with(
+            &run_in(&dir, &["export", "--weave", w, flag, name]),
+            2,
+            &["file name holds", "texture maps"],
+        );
+    }
+    assert_eq!(listing(&dir), vec!["m.base.png".to_string()]);
 }
 
 #[test]
