@@ -26,18 +26,15 @@ pub struct Glb {
 /// 8-bit codes of its maps ([`Maps::quantised`]).
 pub fn held(m: &Fitted) -> Fitted {
     if m.is_uniform() {
-        let f = |x: f64| x as f32 as f64;
         let p = m.cells[0];
         let (s, c) = p.tangent_deg.to_radians().sin_cos();
-        let rotation = f(s.atan2(c));
+        // The direction as the file's `anisotropyRotation` (f32 radians) holds it; glTF has no
+        // diffuse roughness.
+        let rotation = s.atan2(c) as f32 as f64;
         m.map(|_| Params {
-            base: p.base.map(f),
-            roughness: f(p.roughness),
-            anisotropy: f(p.anisotropy),
             tangent_deg: rotation.to_degrees(),
-            sheen: f(p.sheen),
-            sheen_roughness: f(p.sheen_roughness),
             diffuse_roughness: 0.0,
+            ..p.to_f32()
         })
     } else {
         Maps::new(m).quantised(m)

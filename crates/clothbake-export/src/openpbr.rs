@@ -17,7 +17,7 @@
 //! mesh bound to the material.
 
 use crate::fitted::material::Fitted;
-use crate::fitted::texture::{snorm8, srgb8, srgb_decode, unorm8, Map};
+use crate::fitted::texture::{centre_texel, raster, snorm8, srgb8, srgb_decode, unorm8, Map};
 use crate::fitted::{cycles_params, Params};
 use std::fmt::Write as _;
 
@@ -34,14 +34,7 @@ pub struct OpenPbrMaps {
 impl OpenPbrMaps {
     /// The maps of `m`.
     pub fn new(m: &Fitted) -> OpenPbrMaps {
-        let (w, h) = m.texture_size();
-        let cells = m.texel_cells(w, h);
-        let map = |channels: usize, f: &dyn Fn(&Params) -> Vec<u8>| Map {
-            w,
-            h,
-            channels,
-            data: cells.iter().flat_map(|&k| f(&m.cells[k])).collect(),
-        };
+        let map = |channels: usize, f: &dyn Fn(&Params) -> Vec<u8>| raster(m, channels, f);
         OpenPbrMaps {
             base: map(3, &|p| p.base.iter().map(|&c| srgb8(c)).collect()),
             scalars: map(4, &|p| {
@@ -62,14 +55,10 @@ impl OpenPbrMaps {
     /// `m` with each cell's parameters as the maps hold them.
     pub fn held(&self, m: &Fitted) -> Fitted {
         let (w, h) = (self.base.w, self.base.h);
-        let (nu, _) = m.dims();
         let mut cells = m.cells.clone();
         let dir = |x: u8| x as f64 / 255.0 * 2.0 - 1.0;
         for (k, p) in cells.iter_mut().enumerate() {
-            let (i, j) = (k % nu, k / nu);
-            let u = (0.5 * (m.u_edges[i] + m.u_edges[i + 1])).rem_euclid(1.0);
-            let v = (0.5 * (m.v_edges[j] + m.v_edges[j + 1])).rem_euclid(1.0);
-            let t = ((v * h as f64) as usize).min(h - 1) * w + ((u * w as f64) as usize).min(w - 1);
+            let t = centre_texel(m, k, w, h);
             let b = &self.base.data[3 * t..3 * t + 3];
             let s = &self.scalars.data[4 * t..4 * t + 4];
             let d = &self.tangent.data[3 * t..3 * t + 3];
@@ -592,19 +581,20 @@ pub fn usda(m: &Fitted, name: &str, maps: Option<&[String; 3]>, periods_per_uv: 
 /// The Principled BSDF's parameters of the OpenPBR fit `m` ([`cycles_params`]), as the
 /// Blender module holds them (f32).
 pub fn blender_held(m: &Fitted) -> Fitted {
-    let f = |x: f64| x as f32 as f64;
-    m.map(|p| {
-        let c = cycles_params(p);
-        Params {
-            base: c.base.map(f),
-            roughness: f(c.roughness),
-            anisotropy: f(c.anisotropy),
-            tangent_deg: f(c.tangent_deg),
-            sheen: f(c.sheen),
-            sheen_roughness: f(c.sheen_roughness),
-            diffuse_roughness: f(c.diffuse_roughness),
-        }
-    })
+    m.map(|p| cycles_params(p).to_f32())
+}
+
+/// The material as the MaterialX and USD files (and their maps) hold it: a uniform one as
+/// f32 constants, a textured one as the 8-bit codes of its maps ([`OpenPbrMaps::held`]).
+pub fn held(m: &Fitted) -> Fitted {
+    if m.is_uniform() {
+        m.map(|p| Params {
+            tangent_deg: p.tangent_deg,
+            ..p.to_f32()
+        })
+    } else {
+        OpenPbrMaps::new(m).held(m)
+    }
 }
 
 /// The Blender module of `m` (fitted for OpenPBR, converted to the Principled BSDF's

@@ -36,15 +36,18 @@ pub fn outputs(args: &ExportArgs) -> Vec<(PathBuf, &'static str)> {
     out
 }
 
+/// The stem of an output's file name, which its maps are named after ("cloth" without one).
+fn stem(p: &Path) -> String {
+    p.file_stem()
+        .map_or_else(|| "cloth".into(), |s| s.to_string_lossy().into_owned())
+}
+
 /// The folders and stems of the MaterialX and USD outputs (their maps' names).
 fn map_stems(args: &ExportArgs) -> Vec<(PathBuf, String)> {
     let mut v: Vec<(PathBuf, String)> = Vec::new();
     for p in [&args.mtlx, &args.usd].into_iter().flatten() {
         let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
-        let stem = p
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "cloth".into());
+        let stem = stem(p);
         if !v.contains(&(dir.clone(), stem.clone())) {
             v.push((dir, stem));
         }
@@ -57,11 +60,7 @@ fn map_stems(args: &ExportArgs) -> Vec<(PathBuf, String)> {
 /// XML or USDA text): the maps are named after the stem.
 pub fn check_stems(args: &ExportArgs) -> Result<(), CliError> {
     for p in [&args.mtlx, &args.usd].into_iter().flatten() {
-        let stem = p
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let bad = stem
+        let bad = stem(p)
             .chars()
             .find(|c| c.is_control() || matches!(c, '@' | '"' | '\\' | '<' | '>' | '&'));
         if let Some(c) = bad {
@@ -146,13 +145,7 @@ pub fn write(
                 }
             }
         }
-        let names_for = |path: &Path| {
-            let stem = path
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "cloth".into());
-            maps.as_ref().map(|_| openpbr::map_names(&stem))
-        };
+        let names_for = |path: &Path| maps.as_ref().map(|_| openpbr::map_names(&stem(path)));
         if let Some(out) = &args.mtlx {
             let doc = openpbr::mtlx(m, name, names_for(out).as_ref(), p);
             export::write_file(out, doc.as_bytes(), force)?;

@@ -337,22 +337,7 @@ impl Fits {
         } else {
             zero
         };
-        let openpbr_held = if openpbr.is_uniform() {
-            openpbr.map(|p| {
-                let f = |x: f64| x as f32 as f64;
-                Params {
-                    base: p.base.map(f),
-                    roughness: f(p.roughness),
-                    anisotropy: f(p.anisotropy),
-                    tangent_deg: p.tangent_deg,
-                    sheen: f(p.sheen),
-                    sheen_roughness: f(p.sheen_roughness),
-                    diffuse_roughness: f(p.diffuse_roughness),
-                }
-            })
-        } else {
-            crate::openpbr::OpenPbrMaps::new(&openpbr).held(&openpbr)
-        };
+        let openpbr_held = crate::openpbr::held(&openpbr);
         let blender_held = crate::openpbr::blender_held(&openpbr);
         let (openpbr_residual, blender_residual) = if want_openpbr {
             (

@@ -62,6 +62,22 @@ pub struct Params {
     pub diffuse_roughness: f64,
 }
 
+impl Params {
+    /// Every parameter rounded to f32, as a file writes factors and float images.
+    pub fn to_f32(&self) -> Params {
+        let f = |x: f64| x as f32 as f64;
+        Params {
+            base: self.base.map(f),
+            roughness: f(self.roughness),
+            anisotropy: f(self.anisotropy),
+            tangent_deg: f(self.tangent_deg),
+            sheen: f(self.sheen),
+            sheen_roughness: f(self.sheen_roughness),
+            diffuse_roughness: f(self.diffuse_roughness),
+        }
+    }
+}
+
 /// A family of targets whose files share one parameterisation (and so one fit).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Family {

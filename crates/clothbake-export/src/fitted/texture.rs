@@ -55,6 +55,32 @@ impl Map {
     }
 }
 
+/// The map of `m` at its [`Fitted::texture_size`] whose texel holds `f` of its cell's
+/// parameters (`channels` bytes).
+pub fn raster(m: &Fitted, channels: usize, f: &dyn Fn(&Params) -> Vec<u8>) -> Map {
+    let (w, h) = m.texture_size();
+    Map {
+        w,
+        h,
+        channels,
+        data: m
+            .texel_cells(w, h)
+            .iter()
+            .flat_map(|&k| f(&m.cells[k]))
+            .collect(),
+    }
+}
+
+/// The index of the texel of a `w` x `h` map (row 0 at v = 0) under the centre of cell `k`
+/// of `m`: where a file's parameters for that cell are read back.
+pub fn centre_texel(m: &Fitted, k: usize, w: usize, h: usize) -> usize {
+    let (nu, _) = m.dims();
+    let (i, j) = (k % nu, k / nu);
+    let u = (0.5 * (m.u_edges[i] + m.u_edges[i + 1])).rem_euclid(1.0);
+    let v = (0.5 * (m.v_edges[j] + m.v_edges[j + 1])).rem_euclid(1.0);
+    ((v * h as f64) as usize).min(h - 1) * w + ((u * w as f64) as usize).min(w - 1)
+}
+
 /// The sRGB encoding of a linear value in [0, 1], to 8 bits.
 pub fn srgb8(x: f64) -> u8 {
     let x = x.clamp(0.0, 1.0);
@@ -104,14 +130,7 @@ pub struct Maps {
 impl Maps {
     /// The maps of `m` at its [`Fitted::texture_size`].
     pub fn new(m: &Fitted) -> Maps {
-        let (w, h) = m.texture_size();
-        let cells = m.texel_cells(w, h);
-        let map = |channels: usize, f: &dyn Fn(&Params) -> Vec<u8>| Map {
-            w,
-            h,
-            channels,
-            data: cells.iter().flat_map(|&k| f(&m.cells[k])).collect(),
-        };
+        let map = |channels: usize, f: &dyn Fn(&Params) -> Vec<u8>| raster(m, channels, f);
         Maps {
             base: map(3, &|p| p.base.iter().map(|&c| srgb8(c)).collect()),
             roughness: map(3, &|p| vec![0, unorm8(p.roughness), 0]),
@@ -147,16 +166,9 @@ impl Maps {
     /// `m` with each cell's parameters as the maps hold them (the texel at the cell's centre).
     pub fn quantised(&self, m: &Fitted) -> Fitted {
         let (w, h) = (self.base.w, self.base.h);
-        let (nu, _) = m.dims();
-        let mut cells = m.cells.clone();
-        for (k, p) in cells.iter_mut().enumerate() {
-            let (i, j) = (k % nu, k / nu);
-            let u = 0.5 * (m.u_edges[i] + m.u_edges[i + 1]);
-            let v = 0.5 * (m.v_edges[j] + m.v_edges[j + 1]);
-            let c = (u.rem_euclid(1.0) * w as f64) as usize;
-            let r = (v.rem_euclid(1.0) * h as f64) as usize;
-            *p = self.decoded(r.min(h - 1) * w + c.min(w - 1));
-        }
+        let cells = (0..m.cells.len())
+            .map(|k| self.decoded(centre_texel(m, k, w, h)))
+            .collect();
         Fitted { cells, ..m.clone() }
     }
 }
