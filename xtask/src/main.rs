@@ -19,6 +19,8 @@
 //!   `docs/export.md` (see `fitted.rs`).
 //! * `lod`: the level-of-detail pictures (point, cells, period) against the ground-truth
 //!   pictures at six distances, into `docs/validation.md` (see `lod.rs`).
+//! * `error-sources`: the model's error split into masking, shadowing and shading, into
+//!   docs/validation.md.
 //! * `validate-spatial`: the model per crossing cell against the truth sorted into the same
 //!   cells, written to `docs/validation-spatial.md`.
 //! * `validate`: holds the analytic model against the ray-traced ground truth for every shipped
@@ -37,6 +39,7 @@
 use clothbake_bake::golden::{bake_golden, golden_path, shipped_fabrics};
 use clothbake_bake::{bake, BakeOptions};
 mod ch5;
+mod error_sources;
 mod figures;
 mod fitted;
 mod gallery;
@@ -85,6 +88,7 @@ fn main() {
         "install-capi" => install_capi::run(&root(), &std::env::args().skip(2).collect::<Vec<_>>()),
         "validate" => validate(),
         "validate-spatial" => spatial::run(&root()),
+        "error-sources" => error_sources::run(&root()),
         "lod" => lod::run(&root()),
         "fitted" => fitted::run(&root()),
         "ch5" => ch5::run(&root()),
@@ -100,7 +104,7 @@ fn main() {
         "ir-accuracy" => ir_accuracy::run(&root()),
         _ => {
             eprintln!(
-                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | lod | fitted | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots|yarns [--thunderloom DIR]] | gallery [--quick] [--envmap FILE.exr] [--only NAME,...] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
+                "usage: cargo xtask test [CARGO TEST ARGS] | install-capi PREFIX | validate | validate-spatial | error-sources | lod | fitted | golden | ch5 | figures [fig4-5|disks|fig5-17|up-close|plots|yarns [--thunderloom DIR]] | gallery [--quick] [--envmap FILE.exr] [--only NAME,...] | bench-bake [--bounces-2] | loader-accuracy | ir-accuracy [--scan]"
             );
             std::process::exit(2);
         }
@@ -230,6 +234,7 @@ fn validate() {
         "transport-validation",
         "spatial-validation",
         "lod-validation",
+        "error-sources",
     ] {
         let (begin, end) = (
             format!("<!-- {marker}:begin -->"),

@@ -284,6 +284,35 @@ impl RayTracer {
         Vec3::new(u.rem_euclid(1.0) * px, v.rem_euclid(1.0) * py, z_ref) + wo.get() * back
     }
 
+    /// The masking and shadowing shares of the period seen from `wo` (docs/model.md, "Where
+    /// the error comes from"): the fraction of its projected area where the eye meets counted
+    /// yarn (the coverage), and where that yarn also faces the light `wi` and is lit. From
+    /// `samples` stratified rays, deterministic for a given `seed`; zeros when a direction is
+    /// at or below the horizon.
+    pub fn visible_and_lit(
+        &self,
+        wi: UnitVec3,
+        wo: UnitVec3,
+        samples: usize,
+        seed: u64,
+    ) -> (f64, f64) {
+        if !(wi.above_horizon() && wo.above_horizon()) || samples == 0 {
+            return (0.0, 0.0);
+        }
+        let mut rng = Rng::stream(seed, 0);
+        let (mut seen, mut lit) = (0usize, 0usize);
+        for o in self.origins(samples, &mut rng) {
+            if let Some(c) = self.first_contact(o, -wo.get()) {
+                seen += 1;
+                if c.normal.dot(wi.get()) > 0.0 && self.lit(&c, wi) {
+                    lit += 1;
+                }
+            }
+        }
+        let n = samples as f64;
+        (seen as f64 / n, lit as f64 / n)
+    }
+
     /// Traces `m` stratified primary rays over one period into `sums`.
     fn batch(&self, wi: UnitVec3, wo: UnitVec3, m: usize, rng: &mut Rng, sums: &mut BatchSums) {
         for o in self.origins(m, rng) {
