@@ -138,8 +138,8 @@ fn validate() {
          (`validate::direction_set`), {samples} primary rays each. Error measure: relative error of the \
          channel-mean total intensity I = I_d + I_s, |analytic - traced| / traced; bias is the mean signed \
          relative difference; noise is the ground truth's own mean relative standard error.\n\n\
-         Facets: rho_d 0.4, rho_s 0.3, n 10 (sec. 4.3). `refined` and `thesis` are the analytic variants \
-         (docs/model.md); `caps excluded` is the ground-truth convention the model is held to, `caps shaded` \
+         Facets: rho_d 0.4, rho_s 0.3, n 10 (sec. 4.3). `refined`, `thesis` and `sliced` are the analytic \
+         variants (docs/model.md); `caps excluded` is the ground-truth convention the model is held to, `caps shaded` \
          shows what flat yarn ends would add if they were averaged as yarn surface. The same model resolved \
          per crossing cell of the period: docs/validation-spatial.md (`cargo xtask validate-spatial`).\n"
     )
@@ -170,6 +170,12 @@ fn validate() {
                         Caps::Excluded,
                     ),
                     (
+                        "huo, sliced, caps excluded",
+                        FacetModel::Huo,
+                        Variant::Sliced,
+                        Caps::Excluded,
+                    ),
+                    (
                         "lewis, refined, caps excluded",
                         FacetModel::Lewis,
                         Variant::Refined,
@@ -183,12 +189,20 @@ fn validate() {
                     ),
                 ]
             } else {
-                &[(
-                    "huo, refined, caps excluded",
-                    FacetModel::Huo,
-                    Variant::Refined,
-                    Caps::Excluded,
-                )]
+                &[
+                    (
+                        "huo, refined, caps excluded",
+                        FacetModel::Huo,
+                        Variant::Refined,
+                        Caps::Excluded,
+                    ),
+                    (
+                        "huo, sliced, caps excluded",
+                        FacetModel::Huo,
+                        Variant::Sliced,
+                        Caps::Excluded,
+                    ),
+                ]
             };
             for &(what, facet, variant, caps) in configs {
                 let r = compare_with(&f, facet, variant, caps, &pairs, samples, seed);

@@ -11,7 +11,7 @@ use clothbake_core::rng::Rng;
 use clothbake_core::validate::secondary_direction_set;
 use clothbake_core::{
     AnalyticModel, Fabric, FacetModel, Kernel, RayTracer, SecondaryMethod, SecondaryOptions,
-    UnitVec3,
+    UnitVec3, Variant,
 };
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -68,6 +68,21 @@ fn analytic(c: &mut Criterion) {
                 black_box(&out);
             })
         });
+    }
+    // The variants side by side, one pair at a time (docs/model.md, "The sliced variant").
+    for variant in [Variant::Refined, Variant::Sliced] {
+        let m = AnalyticModel::with_variant(&fabric, FacetModel::Huo, variant);
+        c.bench_function(
+            &format!("analytic_variant/twill/{}/random", variant.name()),
+            |b| {
+                let mut k = 0;
+                b.iter(|| {
+                    k = (k + 1) & (dirs.len() - 1);
+                    let (wi, wo) = dirs[k];
+                    black_box(m.intensity(black_box(wi), black_box(wo)))
+                })
+            },
+        );
     }
     c.bench_function("analytic_preprocess/twill", |b| {
         b.iter(|| black_box(AnalyticModel::new(black_box(&fabric), FacetModel::Huo)))

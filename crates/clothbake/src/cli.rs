@@ -657,6 +657,9 @@ pub enum VariantArg {
     Thesis,
     /// Eq. 3.6 averaged over the arc (default).
     Refined,
+    /// Refined, with the side profiles taken slice by slice along each piece: closer to the
+    /// ground truth (docs/model.md), about 3x the cost.
+    Sliced,
 }
 
 impl From<VariantArg> for Variant {
@@ -664,6 +667,7 @@ impl From<VariantArg> for Variant {
         match v {
             VariantArg::Thesis => Variant::Thesis,
             VariantArg::Refined => Variant::Refined,
+            VariantArg::Sliced => Variant::Sliced,
         }
     }
 }

@@ -10,8 +10,9 @@
 //! evaluated pair by pair, with the same results.
 //!
 //! Covered: Huo facets whose exponents are whole numbers up to 4096 (the closed-form specular
-//! integral, eq. 4.10), both end-length variants, one bounce. Anything else (Lewis facets, an
-//! exponent the closed form does not take) is evaluated pair by pair by
+//! integral, eq. 4.10), the `thesis` and `refined` variants, one bounce. Anything else (Lewis
+//! facets, an exponent the closed form does not take, the `sliced` variant) is evaluated pair by
+//! pair by
 //! [`AnalyticModel::intensity`].
 
 use super::AnalyticModel;
@@ -28,7 +29,8 @@ mod avx2;
 /// does not.
 #[cfg(target_arch = "x86_64")]
 fn whole_exponents(m: &AnalyticModel) -> Option<Vec<u32>> {
-    if m.facet != FacetModel::Huo {
+    // The sliced variant's units are evaluated slice by slice, pair by pair.
+    if m.facet != FacetModel::Huo || m.variant == super::Variant::Sliced {
         return None;
     }
     m.units

@@ -219,7 +219,9 @@ fn end_interval(
     let seg = &u.seg;
     let hidden = table.active(psi).map_or(0.0, |o| match variant {
         Variant::Thesis => occluded_length(seg.top, o, psi),
-        Variant::Refined => mean_occluded_length(seg.radius, seg.height, o, psi, arc, e, y1 - y0),
+        Variant::Refined | Variant::Sliced => {
+            mean_occluded_length(seg.radius, seg.height, o, psi, arc, e, y1 - y0)
+        }
     });
     if va > 0.0 {
         (y0, y1 - hidden)

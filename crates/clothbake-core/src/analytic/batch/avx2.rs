@@ -509,7 +509,7 @@ fn end_interval(m: &AnalyticModel, u: &Unit, v: &View, arc: &Arc, e: (F, F)) -> 
     }
     let hidden = match m.variant {
         Variant::Thesis => occluded_length(seg.top, &o, psi),
-        Variant::Refined => mean_occluded_length(seg, &o, psi, arc, e, max_len),
+        Variant::Refined | Variant::Sliced => mean_occluded_length(seg, &o, psi, arc, e, max_len),
     };
     let hidden = some.select(hidden, F::splat(0.0));
     (plus.select(y0, y0 + hidden), plus.select(y1 - hidden, y1))
