@@ -1,8 +1,8 @@
 //! The presets of real cloth (docs/fabric-format.md, "Presets of real cloth"): each file
 //! against the documented table (ends and picks per cm, yarn diameters, rho_s, n), the model
 //! finite and positive on them, and what their inputs imply about their look: the denim's
-//! reflection is blue (an indigo warp over most of the surface, a white weft adding the same to
-//! every channel), a filament satin's highlight stands out from its diffuse reflection more
+//! reflection is blue (an indigo warp over most of the surface, a beige weft adding nearly the
+//! same to every channel) and as light as measured indigo denim, a filament satin's highlight stands out from its diffuse reflection more
 //! than any plain weave's, and the woollen twill's least.
 
 use clothbake_core::validate::direction_set;
@@ -118,7 +118,7 @@ fn the_model_is_finite_and_positive_on_every_preset() {
 #[test]
 fn denim_reflects_blue() {
     // Off the mirror direction (mostly diffuse): the indigo warp covers most of what is seen and
-    // the off-white weft adds nearly the same to every channel, so blue leads; the white
+    // the beige weft adds nearly the same to every channel, so blue leads; the white
     // highlight cannot reverse that either.
     let f = load("denim.wif");
     for (wi, wo) in [((40.0, 0.0), (30.0, 120.0)), ((30.0, 90.0), (50.0, 200.0))] {
@@ -130,6 +130,54 @@ fn denim_reflects_blue() {
             .total();
         assert!(i[2] > i[0] && i[2] > i[1], "{wi:?} {wo:?}: {i:?}");
     }
+}
+
+/// CIE L* of a preset as a colour instrument sees it: diffuse light, the eye 8 degrees off the
+/// normal (d/8), specular included; the reflectance factor R = (1 / pi) of the integral of I
+/// over the incident hemisphere (midpoint rule in cos(theta_i) and phi_i, 48 x 96), per linear
+/// sRGB channel; Y = 0.2126 R + 0.7152 G + 0.0722 B (D65); L* = 116 f(Y) - 16 (CIE 15).
+fn lightness_d8(f: &Fabric) -> f64 {
+    let m = AnalyticModel::new(f, FacetModel::Huo);
+    let wo = UnitVec3::from_degrees(8.0, 45.0);
+    let (nu, nphi) = (48, 96);
+    let mut r = [0.0; 3];
+    for a in 0..nu {
+        let mu = (a as f64 + 0.5) / nu as f64;
+        for b in 0..nphi {
+            let phi = 360.0 * (b as f64 + 0.5) / nphi as f64;
+            let wi = UnitVec3::from_degrees(mu.acos().to_degrees(), phi);
+            let i = m.intensity(wi, wo).total();
+            for k in 0..3 {
+                // d omega = d mu d phi; (1 / pi) * (1 / nu) * (2 pi / nphi).
+                r[k] += i[k] * 2.0 / (nu * nphi) as f64;
+            }
+        }
+    }
+    let y = 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2];
+    let fy = if y > (6.0f64 / 29.0).powi(3) {
+        y.cbrt()
+    } else {
+        y / (3.0 * (6.0f64 / 29.0).powi(2)) + 4.0 / 29.0
+    };
+    116.0 * fy - 16.0
+}
+
+/// The denim's lightness lies in the range a colour instrument measures on indigo denim: L*
+/// about 30 for a dark shade to 60 for a light one (H. Mercer, "Shade control in indigo
+/// dyeing", part 2, denimsandjeans.com; docs/fabric-format.md).
+#[test]
+fn denim_lightness_is_that_of_measured_indigo_shades() {
+    let l = lightness_d8(&load("denim.wif"));
+    eprintln!("denim: L* (d/8) {l:.1}");
+    assert!((30.0..=60.0).contains(&l), "L* {l}");
+    // The measure sees lightness: the same cloth in white yarn (albedo 0.95) is near 100.
+    let white = load("denim.wif")
+        .with_groups(
+            |_, g| g.material.albedo = [0.95; 3],
+            &clothbake_core::PlainNaming("white"),
+        )
+        .unwrap();
+    assert!(lightness_d8(&white) > 85.0, "{}", lightness_d8(&white));
 }
 
 #[test]

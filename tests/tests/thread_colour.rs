@@ -108,7 +108,7 @@ fn denim_is_bluest_where_only_warp_is_seen() {
         share_b < 0.6,
         "along the warp the weft should show: {share_b}"
     );
-    // So blue over red (indigo warp: B >> R; off-white weft: B ~ R) orders the same way, in the
+    // So blue over red (indigo warp: B >> R; beige weft: B < R) orders the same way, in the
     // model and in the ray-traced ground truth.
     let m = AnalyticModel::new(&f, FacetModel::Huo);
     let rt = RayTracer::new(&f, FacetModel::Huo);

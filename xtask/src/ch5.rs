@@ -5,10 +5,11 @@
 //! * sphere: radius 1 at the origin, 48 x 48 pixels of a pinhole camera at the eye looking at the
 //!   origin; the cylinders follow the sphere's longitudes (local warp axis = the tangent toward
 //!   the north pole +z); surface points where L or E is below the local horizon are skipped;
-//! * disk: radius 5 on z = 0, sampled on a 41 x 41 grid, light 75 degrees above the plane with
-//!   the sphere test's azimuth: L = (0, -cos 75, sin 75); the cylinders along +y (reading A,
-//!   parallel to the light's azimuth) and, in tables of their own, along +x (reading B: light
-//!   and eye in the cylinders' cross-section plane);
+//! * disk: on z = 0, sampled on a 41 x 41 grid over its bounding square, light 75 degrees above
+//!   the plane, either with the sphere test's azimuth, L = (0, -cos 75, sin 75), on a disk of
+//!   radius 5, or beyond the disk from the eye, L = (0, cos 75, sin 75), on disks of radius 5
+//!   and 10; the cylinders along +y (reading A, parallel to the light's azimuth) and, in tables
+//!   of their own, along +x (reading B: light and eye in the cylinders' cross-section plane);
 //! * eye at (0, -10, 10) for both, so E varies over the surface (perspective);
 //! * "ray-traced solution" = the two-level sampling with the thesis's steps (first level 32,
 //!   d_alpha = d_l = 0.2, l0 = 1.5); "analytical" = the thesis's ranges (C_max 0.3, l0 1.5)
@@ -117,7 +118,7 @@ fn sphere(out: &mut String) {
             }
         }
     }
-    writeln!(out, "## Sphere test (Figs 5.8-5.9)\n\n{} lit and visible pixels; rho_d 0.4, rho_s 0.7, n 1, d 2, r 1, h 0.\n", pts.len()).unwrap();
+    writeln!(out, "## Sphere test (Figs 5.8-5.9)\n\nLight toward (0, -0.5, 0.87) normalised (azimuth -y), eye at (0, -10, 10) (azimuth -y), cylinder axes along the meridians (toward the north pole +z); unit sphere at the origin. {} lit and visible pixels; rho_d 0.4, rho_s 0.7, n 1, d 2, r 1, h 0.\n", pts.len()).unwrap();
     writeln!(out, "| kernel | analytical | ray-traced (two-level) | correlation of I_ss | mean rel. diff of I_ss | mean I_ss/I_s (analytical) |\n|---|---|---|---|---|---|").unwrap();
     for kernel in [Kernel::Thesis, Kernel::Radiometric] {
         for (aname, am, sname, sm) in [
@@ -176,25 +177,51 @@ enum Reading {
     AlongX,
 }
 
-fn disk(out: &mut String) {
-    writeln!(out, "\n## Disk test: the two readings\n\nThe thesis does not say how the cylinders lie on the disk. Reading A (the tables titled \"cylinders along y\"): axes along +y, in the vertical plane of the light and the eye (both at azimuth -y). Reading B (\"cylinders along x\"): axes along +x, so that the light and the eye lie in the cylinders' cross-section plane; given for the thesis kernel with the thesis's ranges and with full ranges.").unwrap();
-    disk_reading(out, Reading::AlongY);
-    disk_reading(out, Reading::AlongX);
+/// Where the light is, seen from the disk's centre: on the eye's side (azimuth -y, as the
+/// sphere test) or on the far side of the disk from the eye (azimuth +y); 75 degrees high.
+#[derive(Clone, Copy, PartialEq)]
+enum Light {
+    EyeSide,
+    Beyond,
 }
 
-fn disk_reading(out: &mut String, reading: Reading) {
+fn disk(out: &mut String) {
+    writeln!(out, "\n## Disk test: the readings\n\nThe thesis states neither how the cylinders lie on the disk, nor the light's azimuth, nor the disk's radius. In every table the disk lies on z = 0 centred at the origin, the eye is at (0, -10, 10) (azimuth -y, so the eye direction varies over the disk) and the light is a direction 75 degrees above the disk; each title names the rest:\n\n* **light on the eye's side**: toward (0, -cos 75, sin 75), azimuth -y like the eye (the sphere test's azimuth); disk radius 5;\n* **light beyond the disk**: toward (0, +cos 75, sin 75), azimuth +y, on the far side of the disk from the eye; disk radius 5 and 10;\n* **cylinders along y** (reading A): axes along +y, in the vertical plane of the light and the eye; **cylinders along x** (reading B): axes along +x, so that the light and the eye lie in the cylinders' cross-section plane.\n\nEach disk is sampled on a 41 x 41 grid over its bounding square (steps of radius / 20), the points inside the disk where the light and the eye are above the plane.").unwrap();
+    for (light, radius, reading) in [
+        (Light::EyeSide, 5.0, Reading::AlongY),
+        (Light::EyeSide, 5.0, Reading::AlongX),
+        (Light::Beyond, 5.0, Reading::AlongY),
+        (Light::Beyond, 5.0, Reading::AlongX),
+        (Light::Beyond, 10.0, Reading::AlongY),
+        (Light::Beyond, 10.0, Reading::AlongX),
+    ] {
+        disk_reading(out, light, radius, reading);
+    }
+}
+
+fn disk_reading(out: &mut String, light: Light, radius: f64, reading: Reading) {
     let (axis, which) = match reading {
         Reading::AlongY => (Vec3::new(0.0, 1.0, 0.0), "cylinders along y"),
         Reading::AlongX => (Vec3::new(1.0, 0.0, 0.0), "cylinders along x"),
     };
     let eye = Vec3::new(0.0, -10.0, 10.0);
     let t = 75f64.to_radians();
-    let l = Vec3::new(0.0, -t.cos(), t.sin());
+    let (l, where_light) = match light {
+        Light::EyeSide => (
+            Vec3::new(0.0, -t.cos(), t.sin()),
+            "light on the eye's side (azimuth -y)",
+        ),
+        Light::Beyond => (
+            Vec3::new(0.0, t.cos(), t.sin()),
+            "light beyond the disk (azimuth +y)",
+        ),
+    };
+    let step = radius / 20.0;
     let mut pts = Vec::new();
     for j in 0..41 {
         for i in 0..41 {
-            let p = Vec3::new(-5.0 + 0.25 * i as f64, -5.0 + 0.25 * j as f64, 0.0);
-            if p.length() <= 5.0 {
+            let p = Vec3::new(-radius + step * i as f64, -radius + step * j as f64, 0.0);
+            if p.length() <= radius {
                 if let Some(d) = local(l, eye, p, Vec3::new(0.0, 0.0, 1.0), axis) {
                     pts.push(d);
                 }
@@ -213,7 +240,7 @@ fn disk_reading(out: &mut String, reading: Reading) {
             full_analytic(),
         ),
     ];
-    if let Reading::AlongY = reading {
+    if let (Light::EyeSide, Reading::AlongY) = (light, reading) {
         settings.push((
             "radiometric kernel, full ranges (physically right)",
             Kernel::Radiometric,
@@ -221,7 +248,7 @@ fn disk_reading(out: &mut String, reading: Reading) {
         ));
     }
     for (title, kernel, method) in settings {
-        writeln!(out, "\n## Disk test (Table 5.2, Fig. 5.14), {which}: {title}\n\n{} disk points; rho_d 0.4, rho_s 0.7, d 2, r 1, h 0.\n", pts.len()).unwrap();
+        writeln!(out, "\n## Disk test (Table 5.2, Fig. 5.14), {where_light}, {which}, radius {radius}: {title}\n\nLight toward ({:.3}, {:.3}, {:.3}), eye at (0, -10, 10), cylinder axes along {}; disk radius {radius}, {} disk points; rho_d 0.4, rho_s 0.7, d 2, r 1, h 0.\n", l.x, l.y, l.z, if let Reading::AlongY = reading { "+y" } else { "+x" }, pts.len()).unwrap();
         writeln!(out, "| n | max I_ss | max I_ss/I_s | max I_2 | max I_2/I_1 | share I_ss | share I_sd | share I_ds | share I_dd |\n|---|---|---|---|---|---|---|---|---|").unwrap();
         for n in [
             1.0, 2.0, 4.0, 8.0, 12.0, 16.0, 20.0, 24.0, 32.0, 40.0, 55.0, 70.0, 90.0,
@@ -251,7 +278,7 @@ fn disk_reading(out: &mut String, reading: Reading) {
                 100.0 * share[3] / tot
             )
             .unwrap();
-            eprintln!("disk {which} n {n}: max I_2 {m2:.4}");
+            eprintln!("disk {where_light} {which} radius {radius} n {n}: max I_2 {m2:.4}");
         }
     }
 }

@@ -192,7 +192,7 @@ fn up_close(root: &Path, dir: &Path, width: u32, height: u32) {
             .expect("bake")
             .table;
         let brdf = clothbake_loader::Brdf::from_table(table, Default::default()).unwrap();
-        let s = Shader::new(Box::new(brdf), clothbake_render::shade::fabric_tint(&f));
+        let s = Shader::new(Box::new(brdf));
         for periods in [None, Some(16.0)] {
             let never = AtomicBool::new(false);
             let img = render_weave(&scene, &cam, &lighting, &s, 2, periods, &|_| {}, &never);

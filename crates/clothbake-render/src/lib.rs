@@ -2,7 +2,7 @@
 //!
 //! A render is a pure function of its inputs: each pixel averages `aa x aa` stratified samples
 //! (sub-pixel offsets `((a + 0.5) / aa, (b + 0.5) / aa)`), each a ray of the [`camera`] into
-//! the [`scene`], shaded by [`shade::radiance`] in the hit point's tangent frame; background
+//! the [`scene`], shaded by [`shade::radiance`] (a sun and a sky) in the hit point's tangent frame; background
 //! samples count 0. Rows are computed in parallel (rayon) and collected in order, so the image
 //! is bit-identical for any number of threads. [`tonemap`] turns it into PNG bytes.
 
@@ -135,7 +135,8 @@ fn pixel(
                     let t = (hit.point - ray.origin).length();
                     w.footprint(&hit, t, wo.z)
                 });
-                let (v, c) = shade_at(shader, lighting, wi, wo, at);
+                let up = hit.to_local(clothbake_core::Vec3::new(0.0, 0.0, 1.0));
+                let (v, c) = shade_at(shader, lighting, wi, wo, up, at);
                 surface += 1;
                 if shader.shows_gaps() {
                     for k in 0..3 {

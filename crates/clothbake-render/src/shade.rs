@@ -1,32 +1,41 @@
 //! Shading: a [`Shader`] (any [`Bsdf`]: the analytic model or a baked table) and the pixel
-//! value of a lit surface point.
+//! value of a lit surface point under a sun and a sky.
 //!
 //! Pixel value (linear, per RGB channel), for a surface point seen from the eye:
 //!
-//! `V = rho_a * tint + f_r(wi, wo) * cos(theta_i) * E`
+//! `V = E f_r(w_s, wo) C(e) + rho_a s(N) pi f_r(w_k, wo)`
 //!
-//! * `wi` (toward the light) and `wo` (toward the eye) are expressed in the point's tangent
-//!   frame (local +X weft, +Y warp, +Z normal) before f_r is looked up;
-//! * `f_r` is the BRDF in 1/sr (thesis: f_r = I / (pi cos theta_i));
-//! * `E` is the irradiance of the directional light on a surface facing it (default pi, so that
-//!   the directional term equals the thesis's intensity I for unit light, and a white Lambertian
-//!   surface facing the light shows 1);
-//! * `rho_a * tint` is the thesis's ambient term rho_a I_a with unit ambient light I_a = 1,
-//!   coloured by the cloth's tint (its diffuse colour divided by its largest channel: (1, 1, 1)
-//!   for grey cloth);
-//! * where `wo` is at or below the local horizon (the back of the surface) V = 0; where `wi`
-//!   is, only the ambient term remains. There are no cast shadows between parts of the scene.
+//! * all directions in the point's tangent frame (local +X weft, +Y warp, +Z normal) before f_r
+//!   is looked up; `wo` toward the eye; f_r in 1/sr (thesis: f_r = I / (pi cos theta_i));
+//! * **the sun**: a disk of angular radius [`SUN_RADIUS`] toward `wi`, of irradiance `E` on a
+//!   surface facing it (default pi: a white Lambertian surface facing it shows 1). With its
+//!   centre at elevation e above the local horizon, C(e) is the mean of the cosine over the part
+//!   of the disk above the horizon, times its share of the disk (exactly cos(theta_i) = sin e
+//!   for e >= [`SUN_RADIUS`], 0 for e <= -[`SUN_RADIUS`], and in between a closed form that joins
+//!   both with a continuous slope: the sun sets over a penumbra instead of at a line), and `w_s`
+//!   is `wi` itself where the whole disk is up, else the direction of the same azimuth at
+//!   elevation (e + [`SUN_RADIUS`]) / 2, the middle of the part that is up;
+//! * **the sky**: a uniform sky over the world's upper hemisphere (+Z up) above a ground of
+//!   [`GROUND`] times its radiance, scaled so that a white Lambertian surface facing up shows
+//!   `rho_a` (the thesis's ambient coefficient); s(N) = (1 + N_z) / 2 + [`GROUND`] (1 - N_z) / 2
+//!   is the share of that irradiance a surface of normal N receives (exact for a horizon plane),
+//!   and the light it receives is looked up in one direction, `w_k` = the normal tilted toward
+//!   the brighter sky, normalize(N + k up) with k = (1 - [`GROUND`]) / (1 + [`GROUND`]), always
+//!   above the horizon. So the sky is coloured by the cloth's own reflectance, varies smoothly
+//!   over a curved surface, and lights what the sun does not reach;
+//! * where `wo` is at or below the local horizon (the back of the surface) V = 0. There are no
+//!   cast shadows between parts of the scene.
 //! * with `render --periods N`, f_r is looked up through the pixel's footprint of the weave
-//!   period (`Bsdf::f_at`, docs/spatial.md): a spatial table or the model shows the weave where
-//!   a pixel covers less than a period, and the average beyond. The cloth is drawn opaque (the
-//!   coverage of the gaps is not applied), so a distant render equals the averaged one; with
-//!   `--gaps` every value is scaled by the coverage c of its footprint (the cloth over black:
-//!   `V c`), the directional coverage C(wo) without `--periods` (1 for an averaged table).
-//!   Where a footprint is under a crossing cell, the model with one bounce answers the point
-//!   level (docs/spatial.md): a sample whose eye ray meets a gap has c = 0; without `--gaps`
-//!   a pixel averages the samples that meet yarn (times the share of its samples that meet
-//!   the surface), so the gaps close up within a pixel and show black only where a pixel
-//!   sees nothing but gap.
+//!   period (`Bsdf::local`, docs/spatial.md), for the sun and the sky alike: a spatial table or
+//!   the model shows the weave where a pixel covers less than a period, and the average beyond.
+//!   The cloth is drawn opaque (the coverage of the gaps is not applied), so a distant render
+//!   equals the averaged one; with `--gaps` every value is scaled by the coverage c of its
+//!   footprint (the cloth over black: `V c`), the directional coverage C(wo) without `--periods`
+//!   (1 for an averaged table). Where a footprint is under a crossing cell, the model with one
+//!   bounce answers the point level (docs/spatial.md): a sample whose eye ray meets a gap has
+//!   c = 0; without `--gaps` a pixel averages the samples that meet yarn (times the share of its
+//!   samples that meet the surface), so the gaps close up within a pixel and show black only
+//!   where a pixel sees nothing but gap.
 
 pub use clothbake_core::Component;
 use clothbake_core::{
@@ -35,22 +44,17 @@ use clothbake_core::{
 };
 
 /// What a picture shades with: a [`Bsdf`] (the analytic model or a baked table, through the
-/// one interface) and the cloth's tint for the ambient term.
+/// one interface).
 pub struct Shader {
     bsdf: Box<dyn Bsdf>,
-    tint: [f32; 3],
     /// Whether the gaps between the yarns show: the value is scaled by the coverage.
     gaps: bool,
 }
 
 impl Shader {
-    /// Any BSDF with the tint of its ambient term.
-    pub fn new(bsdf: Box<dyn Bsdf>, tint: [f32; 3]) -> Shader {
-        Shader {
-            bsdf,
-            tint,
-            gaps: false,
-        }
+    /// Any BSDF.
+    pub fn new(bsdf: Box<dyn Bsdf>) -> Shader {
+        Shader { bsdf, gaps: false }
     }
 
     /// The same shader showing the gaps between the yarns (`render --gaps`): each value is
@@ -84,7 +88,7 @@ impl Shader {
                 bsdf = bsdf.with_yarns(y);
             }
         }
-        Ok(Shader::new(Box::new(bsdf), fabric_tint(fabric)))
+        Ok(Shader::new(Box::new(bsdf)))
     }
 
     /// The ground truth of `fabric` (`render --truth`): the ray tracer's looks
@@ -102,29 +106,22 @@ impl Shader {
         seed: u64,
         paths: Option<clothbake_core::PathOptions>,
     ) -> Shader {
-        Shader::new(
-            Box::new(Truth {
-                rt: RayTracer::new(fabric, facet),
-                seed,
-                paths,
-                cell: 1.0 / fabric.weave().n_warp().max(fabric.weave().n_weft()) as f64,
-            }),
-            fabric_tint(fabric),
-        )
+        Shader::new(Box::new(Truth {
+            rt: RayTracer::new(fabric, facet),
+            seed,
+            paths,
+            cell: 1.0 / fabric.weave().n_warp().max(fabric.weave().n_weft()) as f64,
+        }))
     }
 
     /// The baked table at `path` (either format), looked up with the loader's interpolation.
-    /// The tint comes from the fabric file stored in the table's metadata ((1, 1, 1) if it
-    /// cannot be read).
     pub fn table(path: &std::path::Path) -> Result<Shader, clothbake_loader::TableError> {
         let options = clothbake_loader::Options {
             sampling: false,
             ..Default::default()
         };
         let brdf = clothbake_loader::Brdf::open(path, options)?;
-        let tint = Fabric::from_json_str(&brdf.meta().fabric_json, "table metadata")
-            .map_or([1.0; 3], |f| fabric_tint(&f));
-        Ok(Shader::new(Box::new(brdf), tint))
+        Ok(Shader::new(Box::new(brdf)))
     }
 
     /// f_r(wi, wo) in 1/sr, RGB, in the render's f32; zero when either direction is at or
@@ -141,11 +138,6 @@ impl Shader {
     /// Whether each value is scaled by its footprint's coverage (`render --gaps`).
     pub fn shows_gaps(&self) -> bool {
         self.gaps
-    }
-
-    /// The cloth's colour for the ambient term: the diffuse colour over its largest channel.
-    pub fn tint(&self) -> [f32; 3] {
-        self.tint
     }
 }
 
@@ -232,43 +224,101 @@ impl Bsdf for Truth {
     }
 }
 
-/// A fabric's tint: the mean of its two groups' diffuse colours over its largest channel.
-pub fn fabric_tint(fabric: &Fabric) -> [f32; 3] {
-    tint_of(std::array::from_fn(|k| {
-        0.5 * (fabric.warp().material.albedo[k] + fabric.weft().material.albedo[k])
-    }))
-}
+/// The sun's angular radius, radians: 6 degrees, wider than the real sun's 0.27 on purpose (a
+/// hazy sun with its aureole), so that the penumbra where it sets spans several pixels of a
+/// picture's curved surfaces and the terminator is soft instead of a crease (docs/render.md).
+pub const SUN_RADIUS: f64 = 6.0 * std::f64::consts::PI / 180.0;
 
-/// A colour divided by its largest channel ((1, 1, 1) for black or grey).
-pub fn tint_of(c: [f64; 3]) -> [f32; 3] {
-    let m = c[0].max(c[1]).max(c[2]);
-    if m.is_finite() && m > 0.0 {
-        std::array::from_fn(|k| (c[k] / m) as f32)
-    } else {
-        [1.0; 3]
-    }
-}
+/// The ground's radiance as a share of the sky's (a ground of albedo about 0.2).
+pub const GROUND: f64 = 0.2;
 
-/// Lighting of a render: the directional light and the ambient term.
+/// Lighting of a render: the sun and the sky (module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lighting {
-    /// Unit direction toward the light (world frame).
+    /// Unit direction toward the sun's centre (world frame).
     pub light: clothbake_core::Vec3,
-    /// Irradiance E of the light on a surface facing it.
+    /// Irradiance E of the sun on a surface facing it.
     pub irradiance: f64,
-    /// Ambient coefficient rho_a.
+    /// The sky's strength rho_a: what a white Lambertian surface facing up shows in the sky's
+    /// light alone.
     pub ambient: f64,
 }
 
-/// The pixel value of a surface point with local light and eye directions `wi`, `wo` (not
-/// necessarily above the horizon): see the module documentation.
+/// The share C(e) of the sun's irradiance (on a surface facing it) that reaches a surface over
+/// whose horizon its centre stands at elevation `e` (radians): sin e while the whole disk is up,
+/// 0 once it has set, and between the two the mean over the disk of max(elevation, 0) (the
+/// cosine taken as linear across the small disk), scaled by sin(r) / r so that both ends join.
+pub fn sun_share(e: f64) -> f64 {
+    let r = SUN_RADIUS;
+    if e >= r {
+        return e.sin();
+    }
+    if e <= -r {
+        return 0.0;
+    }
+    // The chord at height -e cuts the disk; the part above it is up.
+    let c = -e;
+    let h = (r * r - c * c).max(0.0);
+    let segment = r * r * (c / r).clamp(-1.0, 1.0).acos() - c * h.sqrt();
+    let mean = (e * segment + 2.0 / 3.0 * h * h.sqrt()) / (std::f64::consts::PI * r * r);
+    mean * r.sin() / r
+}
+
+/// The direction the sun's light is looked up in for local `wi` at elevation `e`
+/// (`wi` itself while the whole disk is up), and its share [`sun_share`]; `None` once it has set.
+fn sun(wi: clothbake_core::Vec3) -> Option<(UnitVec3, f64)> {
+    let w = UnitVec3::new(wi)?;
+    let e = w.z.clamp(-1.0, 1.0).asin();
+    if e >= SUN_RADIUS {
+        return Some((w, w.cos_theta()));
+    }
+    if e <= -SUN_RADIUS {
+        return None;
+    }
+    let mid = 0.5 * (e + SUN_RADIUS);
+    let flat = (w.x * w.x + w.y * w.y).sqrt();
+    let (x, y) = if flat > 0.0 {
+        (w.x / flat, w.y / flat)
+    } else {
+        (1.0, 0.0)
+    };
+    let dir = UnitVec3::new(clothbake_core::Vec3::new(
+        x * mid.cos(),
+        y * mid.cos(),
+        mid.sin(),
+    ))?;
+    Some((dir, sun_share(e)))
+}
+
+/// The sky's lookup direction w_k and weight rho_a s(N) pi for a surface whose local frame sees
+/// the world's up as `up` (module documentation).
+fn sky(ambient: f64, up: clothbake_core::Vec3) -> Option<(UnitVec3, f64)> {
+    if ambient <= 0.0 {
+        return None;
+    }
+    let k = (1.0 - GROUND) / (1.0 + GROUND);
+    // |Z + k up| >= 1 - k > 0, and its z is at least 1 - k: above the horizon.
+    let dir = UnitVec3::new(clothbake_core::Vec3::new(
+        k * up.x,
+        k * up.y,
+        1.0 + k * up.z,
+    ))?;
+    let nz = up.z.clamp(-1.0, 1.0);
+    let share = 0.5 * (1.0 + nz) + GROUND * 0.5 * (1.0 - nz);
+    Some((dir, ambient * share * std::f64::consts::PI))
+}
+
+/// The pixel value of a surface point with local sun and eye directions `wi`, `wo` (not
+/// necessarily above the horizon) and the world's up `up` in the same local frame: see the
+/// module documentation.
 pub fn radiance(
     shader: &Shader,
     lighting: &Lighting,
     wi: clothbake_core::Vec3,
     wo: clothbake_core::Vec3,
+    up: clothbake_core::Vec3,
 ) -> [f64; 3] {
-    radiance_at(shader, lighting, wi, wo, None)
+    radiance_at(shader, lighting, wi, wo, up, None)
 }
 
 /// As [`radiance`], with f_r seen through footprint `at` of the weave period where one is
@@ -278,9 +328,10 @@ pub fn radiance_at(
     lighting: &Lighting,
     wi: clothbake_core::Vec3,
     wo: clothbake_core::Vec3,
+    up: clothbake_core::Vec3,
     at: Option<Footprint>,
 ) -> [f64; 3] {
-    let (v, c) = shade_at(shader, lighting, wi, wo, at);
+    let (v, c) = shade_at(shader, lighting, wi, wo, up, at);
     if shader.gaps {
         v.map(|x| x * c)
     } else {
@@ -288,56 +339,66 @@ pub fn radiance_at(
     }
 }
 
-/// The value of a surface point and the coverage of its footprint, from one lookup
-/// ([`Bsdf::local`]): the value unscaled, and the share of the footprint that is yarn (0 where
-/// a point shows a gap; without a footprint, the directional coverage C(wo)). [`radiance_at`]
-/// scales by it with `--gaps`; the picture's pixels leave gap points out of their yarns'
-/// mean without it (`render_weave`).
+/// The value of a surface point and the coverage of its footprint, from one lookup per light
+/// ([`Bsdf::local`]; the coverage depends on the eye's direction alone): the value unscaled,
+/// and the share of the footprint that is yarn (0 where a point shows a gap; without a
+/// footprint, the directional coverage C(wo)). [`radiance_at`] scales by it with `--gaps`; the
+/// picture's pixels leave gap points out of their yarns' mean without it (`render_weave`).
 pub fn shade_at(
     shader: &Shader,
     lighting: &Lighting,
     wi: clothbake_core::Vec3,
     wo: clothbake_core::Vec3,
+    up: clothbake_core::Vec3,
     at: Option<Footprint>,
 ) -> ([f64; 3], f64) {
     let Some(wo) = UnitVec3::new(wo).filter(|w| w.above_horizon()) else {
         return ([0.0; 3], 0.0);
     };
-    let tint = shader.tint();
-    let mut v: [f64; 3] = std::array::from_fn(|k| lighting.ambient * f64::from(tint[k]));
-    let wi = UnitVec3::new(wi).filter(|w| w.above_horizon());
-    let local = match (at, wi) {
-        (Some(at), Some(wi)) => shader.bsdf.local(at, wi, wo),
-        (Some(at), None) => Local {
-            f: [0.0; 3],
-            coverage: shader.bsdf.coverage_at(at, wo),
-        },
-        (None, wi) => {
-            // The whole period's coverage, asked only where it is used.
-            let c = if shader.gaps {
-                shader.bsdf.coverage_at(
-                    Footprint {
-                        u: 0.0,
-                        v: 0.0,
-                        width: f64::INFINITY,
-                    },
-                    wo,
-                )
-            } else {
-                1.0
-            };
-            Local {
-                f: wi.map_or([0.0; 3], |wi| shader.bsdf.f(wi, wo)),
-                coverage: c,
-            }
+    // The whole period's coverage, asked only where it is used.
+    let period_coverage = || {
+        if shader.gaps {
+            shader.bsdf.coverage_at(
+                Footprint {
+                    u: 0.0,
+                    v: 0.0,
+                    width: f64::INFINITY,
+                },
+                wo,
+            )
+        } else {
+            1.0
         }
     };
-    if let Some(wi) = wi {
+    let look = |dir: UnitVec3| -> Local {
+        match at {
+            Some(at) => shader.bsdf.local(at, dir, wo),
+            None => Local {
+                f: shader.bsdf.f(dir, wo),
+                coverage: 1.0,
+            },
+        }
+    };
+    let mut v = [0.0f64; 3];
+    let mut coverage = None;
+    for (dir, weight) in [
+        sun(wi).map(|(d, c)| (d, c * lighting.irradiance)),
+        sky(lighting.ambient, up),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        let local = look(dir);
+        coverage.get_or_insert(local.coverage);
         let f = local.f.map(|x| x as f32);
-        let ce = wi.cos_theta() * lighting.irradiance;
         for k in 0..3 {
-            v[k] += f64::from(f[k]) * ce;
+            v[k] += f64::from(f[k]) * weight;
         }
     }
-    (v, local.coverage)
+    let coverage = match (at, coverage) {
+        (None, _) => period_coverage(),
+        (Some(_), Some(c)) => c,
+        (Some(at), None) => shader.bsdf.coverage_at(at, wo),
+    };
+    (v, coverage)
 }

@@ -1108,12 +1108,14 @@ pub enum TonemapArg {
 /// `clothbake render`.
 #[derive(Args, Debug)]
 #[command(
-    after_help = "Pixel value (linear, per channel): V = rho_a * tint + f_r(wi, wo) * cos(theta_i) * E, \
-                  with wi (toward the light) and wo (toward the eye) in the surface's local frame \
-                  (+X weft, +Y warp, +Z normal), f_r in 1/sr, E the light's irradiance on a surface \
-                  facing it (default pi: the directional term is then the thesis's intensity for unit \
-                  light; a white Lambertian surface facing the light shows 1), tint the cloth's diffuse \
-                  colour over its largest channel. V = 0 where the eye sees the back of the surface. \
+    after_help = "Pixel value (linear, per channel): V = E f_r(wi, wo) C + rho_a s(N) pi f_r(w_k, wo): \
+                  a sun toward --light (a disk of 6 degrees' radius: C = cos(theta_i) while it is \
+                  up, falling to 0 over a penumbra as it sets, no seam at the terminator) and a sky \
+                  over a dim ground (w_k: the normal tilted toward the sky; s(N) from 1 facing up \
+                  to 0.2 facing down), directions in the surface's local frame (+X weft, +Y warp, \
+                  +Z normal), f_r in 1/sr, E the sun's irradiance on a surface facing it (default pi: \
+                  a white Lambertian surface facing it shows 1; facing up it shows rho_a in the sky's \
+                  light). V = 0 where the eye sees the back of the surface. \
                   PNG: x = exposure * V, clamped to [0, 1] (or x / (1 + x) with --tonemap reinhard), \
                   sRGB-encoded to 8 bits. EXR: V itself, f32. World: +Z up. See docs/render.md."
 )]
@@ -1170,7 +1172,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub truth: bool,
 
-    /// Ambient coefficient rho_a (thesis sec. 4.3 uses 0.3).
+    /// The sky's strength rho_a: a white Lambertian surface facing up shows rho_a in the sky's
+    /// light (the thesis's ambient coefficient; sec. 4.3 uses 0.3); 0: the sun alone.
     #[arg(long, value_name = "RHO_A", value_parser = parse_ambient, default_value = "0.3")]
     pub ambient: f64,
 
@@ -1369,7 +1372,7 @@ pub fn parse_ambient(s: &str) -> Result<f64, String> {
     unit_interval(
         s,
         "ambient",
-        "give the ambient coefficient rho_a between 0 and 1, e.g. 0.3",
+        "give the sky's strength rho_a between 0 and 1, e.g. 0.3",
     )
 }
 

@@ -51,10 +51,7 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
             b.model.variant.into(),
             b.bounces.bounces,
         );
-        return Ok(Shader::new(
-            Box::new(ft),
-            clothbake_render::shade::fabric_tint(&fabric),
-        ));
+        return Ok(Shader::new(Box::new(ft)));
     }
     Shader::model(
         &fabric,

@@ -268,6 +268,42 @@ fn read_rgb(path: &Path, width: usize) -> Vec<[f32; 3]> {
     img.layer_data.channel_data.pixels
 }
 
+/// The shipped denim reads as indigo in the preview renderer as run by hand
+/// (`clothbake render --weave tables/denim.wif`, every option at its default): the mean linear
+/// B/R over the pixels on the cloth is at least 2 (issue 37: photographs of indigo denim show
+/// about 3, mid-wash, to 6, raw; before it the render showed 1.30, lavender grey).
+#[test]
+fn the_denim_reads_as_indigo() {
+    let (png, exr) = (temp("denim.png"), temp("denim.exr"));
+    let draft = tables().join("denim.wif");
+    succeeds(&[
+        "render",
+        "--weave",
+        draft.to_str().unwrap(),
+        "--quiet",
+        "-o",
+        png.to_str().unwrap(),
+        "--exr",
+        exr.to_str().unwrap(),
+    ]);
+    let px = read_rgb(&exr, 512);
+    let cloth: Vec<&[f32; 3]> = px.iter().filter(|p| p.iter().any(|v| *v > 0.0)).collect();
+    assert!(
+        cloth.len() > px.len() / 5,
+        "{} pixels on the cloth",
+        cloth.len()
+    );
+    let mean = |k: usize| cloth.iter().map(|p| f64::from(p[k])).sum::<f64>() / cloth.len() as f64;
+    let ratio = mean(2) / mean(0);
+    eprintln!(
+        "denim: mean linear RGB ({:.4}, {:.4}, {:.4}), B/R {ratio:.2}",
+        mean(0),
+        mean(1),
+        mean(2)
+    );
+    assert!(ratio >= 2.0, "the denim's mean linear B/R is {ratio:.2}");
+}
+
 #[test]
 fn periods_show_the_weave_up_close_and_the_average_from_afar() {
     let table = temp("gingham-spatial.exr");
