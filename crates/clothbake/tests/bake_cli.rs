@@ -354,6 +354,7 @@ fn raytraced_and_two_bounce_tables() {
             ],
         ),
         ("b1.bin", &[]),
+        ("sliced.bin", &["--variant", "sliced"]),
     ] {
         succeeds(&run_in(
             &d,
@@ -370,6 +371,13 @@ fn raytraced_and_two_bounce_tables() {
     // The secondary reflection adds light: two bounces differ from one.
     assert_eq!(
         run_in(&d, &["diff", "b1.bin", "b2.bin"]).status.code(),
+        Some(1)
+    );
+    // The sliced variant is recorded and gives another table.
+    let info = succeeds(&run_in(&d, &["info", "sliced.bin"]));
+    assert!(info.contains("\"variant\":\"sliced\""), "{info}");
+    assert_eq!(
+        run_in(&d, &["diff", "b1.bin", "sliced.bin"]).status.code(),
         Some(1)
     );
 }
