@@ -494,11 +494,13 @@ mod exr_io {
             &self.meta_data.headers[0]
         }
 
-        /// Half samples in scan-line blocks, every channel at full resolution: what
-        /// clothbake writes, which [`read_half_lines`] and [`HalfLines`] decode.
+        /// Half samples in scan-line blocks, every channel at full resolution, the data window
+        /// at the origin: what clothbake writes, which [`read_half_lines`] and [`HalfLines`]
+        /// decode (anything else goes to the `exr` crate's generic decoder).
         pub(super) fn half_lines(&self) -> bool {
             let header = self.header();
             header.blocks == BlockDescription::ScanLines
+                && header.own_attributes.layer_position == exr::math::Vec2(0, 0)
                 && !header.deep
                 && header.channels.list.iter().all(|c| {
                     c.sample_type == SampleType::F16 && c.sampling == exr::math::Vec2(1, 1)
