@@ -233,6 +233,7 @@ mod exr_io {
     use exr::math::RoundingMode;
     use exr::meta::attribute::{LevelMode, SampleType};
     use exr::meta::header::Header;
+    use exr::meta::BlockDescription;
     use exr::prelude::{
         AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image, Layer,
         LayerAttributes, ReadChannels, ReadLayers, SmallVec, Text, WritableImage,
@@ -285,7 +286,7 @@ mod exr_io {
             })
             .collect();
         let meta_json = table.meta.to_ascii_json();
-        let crc = values_crc(
+        let crc = values_crc_with(
             meta_json.as_bytes(),
             width * height,
             names.len(),
@@ -478,7 +479,58 @@ mod exr_io {
         }
     }
 
+    /// A file whose header passed the checks of [`read_with`]: its bytes, its OpenEXR header
+    /// and the table's metadata (and its JSON text, which the checksum covers).
+    pub(super) struct Checked<'a> {
+        pub(super) path: &'a Path,
+        pub(super) bytes: &'a [u8],
+        pub(super) meta_data: &'a exr::meta::MetaData,
+        pub(super) meta: &'a Metadata,
+        pub(super) meta_json: &'a [u8],
+    }
+
+    impl Checked<'_> {
+        fn header(&self) -> &Header {
+            &self.meta_data.headers[0]
+        }
+
+        /// Half samples in scan-line blocks, every channel at full resolution, the data window
+        /// at the origin: what clothbake writes, which [`read_half_lines`] and [`HalfLines`]
+        /// decode (anything else goes to the `exr` crate's generic decoder).
+        pub(super) fn half_lines(&self) -> bool {
+            let header = self.header();
+            header.blocks == BlockDescription::ScanLines
+                && header.own_attributes.layer_position == exr::math::Vec2(0, 0)
+                && !header.deep
+                && header.channels.list.iter().all(|c| {
+                    c.sample_type == SampleType::F16 && c.sampling == exr::math::Vec2(1, 1)
+                })
+        }
+
+        /// An error unless the checksum attribute, if any, is `computed`.
+        pub(super) fn check_crc(&self, computed: u32) -> Result<(), TableError> {
+            match stored_crc(self.path, &self.header().own_attributes.other)? {
+                Some(stored) if stored != computed => Err(TableError::Checksum {
+                    path: self.path.to_path_buf(),
+                    stored,
+                    computed,
+                }),
+                _ => Ok(()),
+            }
+        }
+    }
+
     pub(super) fn read(path: &Path) -> Result<StoredTable, TableError> {
+        read_with(path, &decode_stored)
+    }
+
+    /// Reads the file and checks its header (one part, the metadata, the image size against
+    /// the grid, the channels), then gives it to `then`; the OpenEXR decoder's panics on
+    /// damaged files become errors.
+    pub(super) fn read_with<T>(
+        path: &Path,
+        then: &dyn Fn(&Checked<'_>) -> Result<T, TableError>,
+    ) -> Result<T, TableError> {
         let bytes = read_bounded(path)?;
         if bytes.is_empty() {
             return Err(TableError::Empty {
@@ -506,7 +558,7 @@ mod exr_io {
         };
 
         // The exr decoder is not trusted to never panic on damaged files.
-        let guarded = |f: &dyn Fn() -> Result<StoredTable, TableError>| {
+        let guarded = |f: &dyn Fn() -> Result<T, TableError>| {
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|_| {
                 Err(corrupted(
                     "the OpenEXR decoder failed on this file".to_string(),
@@ -597,6 +649,39 @@ mod exr_io {
                 }));
             }
 
+            then(&Checked {
+                path,
+                bytes: &bytes,
+                meta_data: &meta_data,
+                meta: &meta,
+                meta_json: &meta_json_bytes,
+            })
+        })
+    }
+
+    /// The samples of a checked file, at their stored precision.
+    fn decode_stored(c: &Checked<'_>) -> Result<StoredTable, TableError> {
+        let (path, bytes, meta) = (c.path, c.bytes, c.meta);
+        let grid = meta.grid;
+        let expected = meta.channel_names();
+        let corrupted = |reason: String| TableError::Corrupted {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let foreign = |reason: String| TableError::Foreign {
+            path: path.to_path_buf(),
+            what: "table".into(),
+            reason,
+        };
+        {
+            // Half samples in scan-line blocks (what clothbake writes): decoded block by block
+            // straight into the table's order, the checksum taken as the lines pass.
+            if c.half_lines() {
+                let (samples, computed) = read_half_lines(c)?;
+                c.check_crc(computed)?;
+                return StoredTable::new(meta.clone(), Samples::F16(samples))
+                    .map_err(|e| e.in_file(path));
+            }
             let image = exr::prelude::read()
                 .no_deep_data()
                 .largest_resolution_level()
@@ -641,81 +726,434 @@ mod exr_io {
                     expected.join(", ")
                 )));
             };
-            if let Some(attr) = attrs.get(&Text::from(ATTR_CRC32)) {
-                // Eight hexadecimal digits as written; anything else is a damaged attribute,
-                // not a checksum of 0.
-                let text = attribute_text(attr);
-                let stored = text
-                    .as_deref()
-                    .map(str::trim)
-                    .filter(|t| t.len() == 8 && t.bytes().all(|b| b.is_ascii_hexdigit()))
-                    .and_then(|t| u32::from_str_radix(t, 16).ok());
-                let Some(stored) = stored else {
-                    let shown = match &text {
-                        Some(t) => format!(
-                            "`{}`",
-                            t.chars().take(40).collect::<String>().escape_debug()
-                        ),
-                        None => "not text".to_string(),
-                    };
-                    return Err(TableError::Corrupted {
-                        path: path.to_path_buf(),
-                        reason: format!(
-                            "its {ATTR_CRC32} attribute is {shown}, not a checksum of 8 \
-                             hexadecimal digits"
-                        ),
-                    });
-                };
-                let computed =
-                    values_crc(&meta_json_bytes, planes[0].len(), planes.len(), |ch, i| {
-                        planes[ch].get(i)
-                    });
-                if stored != computed {
-                    return Err(TableError::Checksum {
-                        path: path.to_path_buf(),
-                        stored,
-                        computed,
-                    });
-                }
-            }
-            // Pixel of each cell, in cell order (see `docs/table-format.md`).
-            let pixels = || {
-                (0..grid.n_theta_i).flat_map(move |ti| {
-                    (0..grid.n_phi_i).flat_map(move |pi| {
-                        (0..grid.n_theta_o).flat_map(move |to| {
-                            (0..grid.n_phi_o).map(move |po| {
-                                let y = (ti * grid.n_theta_o + to) as usize;
-                                y * width + (pi * grid.n_phi_o + po) as usize
-                            })
-                        })
-                    })
-                })
-            };
+            c.check_crc(planes_crc(c.meta_json, &planes))?;
             // The averaged RGB, interleaved, then each class's values (diffuse, specular, ...)
-            // cell by cell.
+            // cell by cell (see `docs/table-format.md`).
             let lanes = meta.class_lanes();
-            let order = || {
-                let rgb = pixels().flat_map(|x| [(0, x), (1, x), (2, x)]);
-                let classes = (3..planes.len()).step_by(lanes).flat_map(move |ch| {
-                    pixels().flat_map(move |x| (ch..ch + lanes).map(move |c| (c, x)))
-                });
-                rgb.chain(classes)
-            };
-            let all_f16 = planes.iter().all(|p| matches!(p, Plane::F16(_)));
-            let samples = if all_f16 {
-                Samples::F16(
-                    order()
-                        .map(|(ch, x)| match planes[ch] {
-                            Plane::F16(v) => v[x],
-                            Plane::F32(_) => unreachable!("every plane is f16"),
-                        })
-                        .collect(),
-                )
-            } else {
-                Samples::F32(order().map(|(ch, x)| planes[ch].get(x)).collect())
+            let halves: Option<Vec<&[half::f16]>> = planes
+                .iter()
+                .map(|p| match p {
+                    Plane::F16(v) => Some(*v),
+                    Plane::F32(_) => None,
+                })
+                .collect();
+            let samples = match halves {
+                Some(h) => Samples::F16(gather(&grid, &h, lanes, |x| x)),
+                None => {
+                    let wide: Vec<Vec<f32>> = planes
+                        .iter()
+                        .map(|p| (0..p.len()).map(|i| p.get(i)).collect())
+                        .collect();
+                    let wide: Vec<&[f32]> = wide.iter().map(Vec::as_slice).collect();
+                    Samples::F32(gather(&grid, &wide, lanes, |x| x))
+                }
             };
             StoredTable::new(meta.clone(), samples).map_err(|e| e.in_file(path))
-        })
+        }
+    }
+
+    /// The [`ATTR_CRC32`] attribute's checksum, `None` without one; an attribute that is not 8
+    /// hexadecimal digits is a damaged file, not a checksum of 0.
+    fn stored_crc(
+        path: &Path,
+        attrs: &std::collections::HashMap<Text, AttributeValue>,
+    ) -> Result<Option<u32>, TableError> {
+        let Some(attr) = attrs.get(&Text::from(ATTR_CRC32)) else {
+            return Ok(None);
+        };
+        let text = attribute_text(attr);
+        let stored = text
+            .as_deref()
+            .map(str::trim)
+            .filter(|t| t.len() == 8 && t.bytes().all(|b| b.is_ascii_hexdigit()))
+            .and_then(|t| u32::from_str_radix(t, 16).ok());
+        match stored {
+            Some(v) => Ok(Some(v)),
+            None => {
+                let shown = match &text {
+                    Some(t) => format!(
+                        "`{}`",
+                        t.chars().take(40).collect::<String>().escape_debug()
+                    ),
+                    None => "not text".to_string(),
+                };
+                Err(TableError::Corrupted {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "its {ATTR_CRC32} attribute is {shown}, not a checksum of 8 \
+                         hexadecimal digits"
+                    ),
+                })
+            }
+        }
+    }
+
+    /// The samples of a table whose channels are all half floats in scan-line blocks
+    /// ([`Checked::half_lines`]), in the table's order (as `gather` orders them), and the
+    /// [`ATTR_CRC32`] checksum of the metadata and the samples as they pass, line by line
+    /// ([`HalfLines`]).
+    fn read_half_lines(c: &Checked<'_>) -> Result<(Vec<half::f16>, u32), TableError> {
+        let blocks = HalfBlocks::new(c)?;
+        let grid = c.meta.grid;
+        let channels = c.meta.channel_names().len();
+        let n = grid.len();
+        let (nto, npi, npo) = (
+            grid.n_theta_o as usize,
+            grid.n_phi_i as usize,
+            grid.n_phi_o as usize,
+        );
+        let lanes = c.meta.class_lanes().max(1);
+        let total = channels * n;
+        let mut samples: Vec<half::f16> = Vec::with_capacity(total);
+        crate::nodes::huge_pages(&samples);
+        let out = &mut samples.spare_capacity_mut()[..total];
+        let mut lines = blocks.lines(0);
+        let mut row = vec![0u16; blocks.width * channels];
+        for y in 0..blocks.height {
+            lines.next_line(&mut row)?;
+            let (ti, to) = (y / nto, y % nto);
+            for k in 0..channels {
+                // Where pixel x = pi npo + po of channel k lands: lane k of cell (ti, pi, to,
+                // po) for R, G, B; lane j of class group g after them.
+                let (first, stride) = if k < 3 {
+                    (k, 3)
+                } else {
+                    let (g, j) = ((k - 3) / lanes, (k - 3) % lanes);
+                    (3 * n + lanes * g * n + j, lanes)
+                };
+                // The row's pixels of one phi_i column are npo cells in a row.
+                for (pi, run) in row.chunks_exact(channels * npo).enumerate() {
+                    let at = first + stride * (((ti * npi + pi) * nto + to) * npo);
+                    let dst = &mut out[at..at + stride * (npo - 1) + 1];
+                    for (d, px) in dst
+                        .iter_mut()
+                        .step_by(stride)
+                        .zip(run.chunks_exact(channels))
+                    {
+                        d.write(half::f16::from_bits(px[k]));
+                    }
+                }
+            }
+        }
+        // SAFETY: every line 0..height was read ([`HalfLines::next_line`] fails otherwise), and
+        // a line writes lane k of each of its cells for every channel k: all `total` samples
+        // are initialised.
+        unsafe { samples.set_len(total) };
+        let mut hasher = crc32fast::Hasher::new();
+        hasher.update(c.meta_json);
+        hasher.combine(&lines.hasher);
+        Ok((samples, hasher.finalize()))
+    }
+
+    /// The blocks of a checked half-float scan-line file ([`Checked::half_lines`]), sorted
+    /// and checked to hold every line once: block `k` starts at line `k * per_block`.
+    pub(super) struct HalfBlocks<'a> {
+        checked: &'a Checked<'a>,
+        chunks: Vec<exr::block::chunk::Chunk>,
+        per_block: usize,
+        /// The table's channel of each of the file's channels.
+        slot: Vec<usize>,
+        width: usize,
+        height: usize,
+    }
+
+    impl<'a> HalfBlocks<'a> {
+        pub(super) fn new(c: &'a Checked<'a>) -> Result<HalfBlocks<'a>, TableError> {
+            use exr::block::chunk::CompressedBlock;
+            let corrupted = |reason: String| TableError::Corrupted {
+                path: c.path.to_path_buf(),
+                reason,
+            };
+            let header = c.header();
+            let names = c.meta.channel_names();
+            let slot: Vec<usize> = header
+                .channels
+                .list
+                .iter()
+                .map(|ch| {
+                    names
+                        .iter()
+                        .position(|n| n.as_bytes() == ch.name.bytes())
+                        .ok_or_else(|| corrupted("a channel of the EXR is not the table's".into()))
+                })
+                .collect::<Result<_, _>>()?;
+            let reader = exr::block::read(Cursor::new(c.bytes), false)
+                .map_err(|e| decode_error(c.path, "header", e))?;
+            let mut chunks: Vec<(i64, exr::block::chunk::Chunk)> = reader
+                .all_chunks(false)
+                .map_err(|e| decode_error(c.path, "pixel data", e))?
+                .map(|ch| {
+                    let ch = ch.map_err(|e| decode_error(c.path, "pixel data", e))?;
+                    match &ch.compressed_block {
+                        CompressedBlock::ScanLine(b) => Ok((i64::from(b.y_coordinate), ch)),
+                        _ => Err(corrupted(
+                            "the EXR's blocks are not scan lines, as its header says".into(),
+                        )),
+                    }
+                })
+                .collect::<Result<_, _>>()?;
+            chunks.sort_by_key(|ch| ch.0);
+            let per_block = header.compression.scan_lines_per_block();
+            let (width, height) = (
+                c.meta.grid.exr_width() as usize,
+                c.meta.grid.exr_height() as usize,
+            );
+            let whole = chunks.len() == height.div_ceil(per_block)
+                && chunks
+                    .iter()
+                    .enumerate()
+                    .all(|(k, ch)| ch.0 == (k * per_block) as i64);
+            if !whole {
+                return Err(corrupted(format!(
+                    "the OpenEXR pixel data does not cover each of its {height} lines once \
+                     ({} blocks of {per_block} lines)",
+                    chunks.len()
+                )));
+            }
+            Ok(HalfBlocks {
+                checked: c,
+                chunks: chunks.into_iter().map(|ch| ch.1).collect(),
+                per_block,
+                slot,
+                width,
+                height,
+            })
+        }
+
+        /// The lines from `first` on, in order.
+        pub(super) fn lines(&self, first: usize) -> HalfLines<'_> {
+            HalfLines {
+                blocks: self,
+                block: None,
+                next: first,
+                hasher: crc32fast::Hasher::new(),
+                bytes: Vec::new(),
+            }
+        }
+    }
+
+    /// Lines of a [`HalfBlocks`], decoded a block at a time as they are asked for, in order,
+    /// and the checksum of the lines passed (without the metadata before them).
+    pub(super) struct HalfLines<'a> {
+        blocks: &'a HalfBlocks<'a>,
+        block: Option<(usize, exr::block::UncompressedBlock)>,
+        next: usize,
+        /// The [`ATTR_CRC32`] checksum of the lines passed, samples widened to f32.
+        pub(super) hasher: crc32fast::Hasher,
+        /// A line's samples widened, as the checksum reads them.
+        bytes: Vec<u8>,
+    }
+
+    impl HalfLines<'_> {
+        /// The next line's half-float bits, pixel by pixel, each pixel's channels in the
+        /// table's order (R, G, B, ...), into `out` (`width * channels`); adds them to the
+        /// checksum.
+        pub(super) fn next_line(&mut self, out: &mut [u16]) -> Result<(), TableError> {
+            let b = self.blocks;
+            let c = b.checked;
+            let y = self.next;
+            let k = y / b.per_block;
+            if y >= b.height {
+                return Err(TableError::Corrupted {
+                    path: c.path.to_path_buf(),
+                    reason: format!("the OpenEXR pixel data ends at line {}", b.height),
+                });
+            }
+            if self.block.as_ref().is_none_or(|(at, _)| *at != k) {
+                let block = exr::block::UncompressedBlock::decompress_chunk(
+                    b.chunks[k].clone(),
+                    c.meta_data,
+                    false,
+                )
+                .map_err(|e| decode_error(c.path, "pixel data", e))?;
+                self.block = Some((k, block));
+            }
+            let Some((_, block)) = &self.block else {
+                unreachable!("decoded above")
+            };
+            let channels = b.slot.len();
+            let line_bytes = 2 * b.width;
+            let (at, size) = (block.index.pixel_position, block.index.pixel_size);
+            if at != exr::math::Vec2(0, k * b.per_block)
+                || size.0 != b.width
+                || block.data.len() != size.1 * channels * line_bytes
+                || y - at.1 >= size.1
+            {
+                return Err(TableError::Corrupted {
+                    path: c.path.to_path_buf(),
+                    reason: format!(
+                        "the OpenEXR block of line {y} holds lines {} to {} of {} pixels",
+                        at.1,
+                        at.1 + size.1,
+                        size.0
+                    ),
+                });
+            }
+            let row = &block.data[(y - at.1) * channels * line_bytes..][..channels * line_bytes];
+            for (line, &slot) in row.chunks_exact(line_bytes).zip(&b.slot) {
+                assert!(slot < channels, "a slot is a channel of the table");
+                for (px, h) in out.chunks_exact_mut(channels).zip(line.chunks_exact(2)) {
+                    px[slot] = u16::from_le_bytes([h[0], h[1]]);
+                }
+            }
+            self.bytes.resize(4 * out.len(), 0);
+            for (d, &h) in self.bytes.chunks_exact_mut(4).zip(out.iter()) {
+                d.copy_from_slice(&crate::stored::f16_to_f32(h).to_bits().to_le_bytes());
+            }
+            self.hasher.update(&self.bytes);
+            self.next += 1;
+            Ok(())
+        }
+    }
+
+    /// The lookup's node table of an averaged half-float table straight from the file's
+    /// lines ([`HalfBlocks`]): no samples in the table's order, no second pass for the
+    /// checksum. `None` for any other table (spatial, float samples, tiles), which the caller
+    /// reads as stored. The nodes are those of `lookup::pad` of the stored samples, lane for
+    /// lane; the values are checked as they pass (the first unphysical one in the table's
+    /// order is reported as [`StoredTable::new`] reports it).
+    pub(super) fn half_nodes(c: &Checked<'_>) -> Result<Option<crate::nodes::Nodes>, TableError> {
+        use crate::nodes::{Nodes, PlaneFill, Tiles, Values};
+        use half::f16;
+        if !c.half_lines() || c.meta.spatial.is_some() {
+            return Ok(None);
+        }
+        let g = c.meta.grid;
+        let blocks = HalfBlocks::new(c)?;
+        let (nto, npi, npo) = (g.n_theta_o as usize, g.n_phi_i as usize, g.n_phi_o as usize);
+        let width = npi * npo;
+
+        /// The filler of the theta_i rows from `first` on: the incident ring's `n_theta_o`
+        /// lines, decoded once, give its planes; the first ring also the pole rows.
+        struct Fill<'a> {
+            lines: HalfLines<'a>,
+            ring: Vec<u16>,
+            held: Option<usize>,
+            /// The first unphysical sample seen: index in the table's order and value.
+            bad: Option<(usize, f32)>,
+            /// The incident pole's rows (`n_theta_o` rows of `n_phi_o` nodes) and the pole
+            /// of both, once the first ring is read.
+            pole_i: Vec<[f16; 4]>,
+            pole_io: [f16; 4],
+            g: Grid,
+        }
+        impl Fill<'_> {
+            fn widened(&self, pi: usize, to: usize, po: usize, k: usize) -> f64 {
+                let npo = self.g.n_phi_o as usize;
+                let width = self.g.n_phi_i as usize * npo;
+                f64::from(crate::stored::f16_to_f32(
+                    self.ring[(to * width + pi * npo + po) * 3 + k],
+                ))
+            }
+
+            /// Reads incident ring `ti` unless held, checking its values.
+            fn ring(&mut self, ti: usize) -> Result<(), TableError> {
+                if self.held == Some(ti) {
+                    return Ok(());
+                }
+                let (nto, npi, npo) = (
+                    self.g.n_theta_o as usize,
+                    self.g.n_phi_i as usize,
+                    self.g.n_phi_o as usize,
+                );
+                let width = npi * npo;
+                for to in 0..nto {
+                    let line = &mut self.ring[to * width * 3..(to + 1) * width * 3];
+                    self.lines.next_line(line)?;
+                    // The whole line tested (no early exit, so that it vectorises).
+                    let physical = |ok, &h| ok & crate::stored::half_is_physical(h);
+                    if line.iter().fold(true, physical) {
+                        continue;
+                    }
+                    for (i, &h) in line.iter().enumerate() {
+                        if !crate::stored::half_is_physical(h) {
+                            let (x, k) = (i / 3, i % 3);
+                            let (pi, po) = (x / npo, x % npo);
+                            let cell = ((ti * npi + pi) * nto + to) * npo + po;
+                            let at = 3 * cell + k;
+                            if self.bad.is_none_or(|(b, _)| at < b) {
+                                self.bad = Some((at, f16::from_bits(h).to_f32()));
+                            }
+                        }
+                    }
+                }
+                self.held = Some(ti);
+                Ok(())
+            }
+
+            /// The mean of lane `k` over `cells`, in f64 in their order, as an f32 rounded
+            /// to half (as `lookup::poles` and the lane conversion make it).
+            fn mean(&self, cells: impl Iterator<Item = (usize, usize, usize)>) -> [f16; 4] {
+                let (mut sum, mut n) = ([0f64; 4], 0f64);
+                for (pi, to, po) in cells {
+                    for (k, s) in sum.iter_mut().enumerate().take(3) {
+                        *s += self.widened(pi, to, po, k);
+                    }
+                    n += 1.0;
+                }
+                sum.map(|s| f16::from_f32((s / n) as f32))
+            }
+        }
+        impl PlaneFill<f16> for Fill<'_> {
+            type Error = TableError;
+            fn fill(&mut self, ri: u32, pi: u32, plane: &mut [[f16; 4]]) -> Result<(), TableError> {
+                let (nto, npi, npo) = (
+                    self.g.n_theta_o as usize,
+                    self.g.n_phi_i as usize,
+                    self.g.n_phi_o as usize,
+                );
+                let width = npi * npo;
+                let (ri, pi) = (ri as usize, pi as usize);
+                self.ring(ri.saturating_sub(1))?;
+                let (pole, rows) = plane.split_at_mut(npo);
+                if ri == 0 {
+                    if self.pole_i.is_empty() {
+                        self.pole_i = (0..nto)
+                            .flat_map(|to| (0..npo).map(move |po| (to, po)))
+                            .map(|(to, po)| self.mean((0..npi).map(|p| (p, to, po))))
+                            .collect();
+                        self.pole_io =
+                            self.mean((0..npi).flat_map(|p| (0..npo).map(move |po| (p, 0, po))));
+                    }
+                    pole.fill(self.pole_io);
+                    rows.copy_from_slice(&self.pole_i);
+                } else {
+                    pole.fill(self.mean((0..npo).map(|po| (pi, 0, po))));
+                    for (to, row) in rows.chunks_exact_mut(npo).enumerate() {
+                        let line = &self.ring[(to * width + pi * npo) * 3..][..npo * 3];
+                        for (x, v) in row.iter_mut().zip(line.chunks_exact(3)) {
+                            *x = [
+                                f16::from_bits(v[0]),
+                                f16::from_bits(v[1]),
+                                f16::from_bits(v[2]),
+                                f16::ZERO,
+                            ];
+                        }
+                    }
+                }
+                Ok(())
+            }
+        }
+
+        let make = |first: u32| Fill {
+            lines: blocks.lines(first.saturating_sub(1) as usize * nto),
+            ring: vec![0; nto * width * 3],
+            held: None,
+            bad: None,
+            pole_i: Vec::new(),
+            pole_io: [f16::ZERO; 4],
+            g,
+        };
+        let (tiles, fills) = Tiles::from_planes(&g, &make)?;
+        let mut hasher = crc32fast::Hasher::new();
+        hasher.update(c.meta_json);
+        for f in &fills {
+            hasher.combine(&f.lines.hasher);
+        }
+        c.check_crc(hasher.finalize())?;
+        let bad = fills.iter().filter_map(|f| f.bad).min_by_key(|b| b.0);
+        crate::table::check_values(c.meta, 3 * g.len(), bad).map_err(|e| e.in_file(c.path))?;
+        Ok(Some(Nodes::with_values(&g, Values::F16(tiles))))
     }
 
     /// One channel's samples as decoded, borrowed from the image.
@@ -740,10 +1178,52 @@ mod exr_io {
         }
     }
 
+    /// The values of row-major `planes` (in [`Metadata::channel_names`] order) in the
+    /// table's order: each cell's R, G, B in cell order, then each class's `lanes` channels
+    /// cell by cell; `lane` converts a sample.
+    fn gather<T: Copy, V>(
+        grid: &Grid,
+        planes: &[&[T]],
+        lanes: usize,
+        lane: impl Fn(T) -> V,
+    ) -> Vec<V> {
+        let (nti, npi, nto, npo) = (
+            grid.n_theta_i as usize,
+            grid.n_phi_i as usize,
+            grid.n_theta_o as usize,
+            grid.n_phi_o as usize,
+        );
+        let width = npi * npo;
+        let mut out = Vec::with_capacity(planes.len() * grid.len());
+        // Each group of channels interleaved, cell by cell: the pixels of cell (ti, pi, to,
+        // po) for po = 0..npo are one run of a pixel row.
+        let groups = std::iter::once(0..3.min(planes.len())).chain(
+            (3..planes.len())
+                .step_by(lanes.max(1))
+                .map(|ch| ch..(ch + lanes).min(planes.len())),
+        );
+        for group in groups {
+            let chans = &planes[group];
+            for ti in 0..nti {
+                for pi in 0..npi {
+                    for to in 0..nto {
+                        let start = (ti * nto + to) * width + pi * npo;
+                        for x in start..start + npo {
+                            for p in chans {
+                                out.push(lane(p[x]));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// The [`ATTR_CRC32`] checksum of a metadata text and `pixels` pixels of `channels`
     /// row-major planes (in [`Metadata::channel_names`] order), pixel by pixel, sample `(ch, i)` widened
-    /// to f32 by `sample`, chunk by chunk (no full copy).
-    fn values_crc(
+    /// to f32 by `sample`, chunk by chunk (no full copy): the writer's.
+    fn values_crc_with(
         meta_json: &[u8],
         pixels: usize,
         channels: usize,
@@ -759,6 +1239,40 @@ mod exr_io {
                     bytes.extend_from_slice(&sample(ch, i).to_le_bytes());
                 }
             }
+            hasher.update(&bytes);
+        }
+        hasher.finalize()
+    }
+
+    /// The [`ATTR_CRC32`] checksum as [`values_crc_with`] computes it, of the decoded planes:
+    /// each plane's samples widened a run at a time.
+    fn planes_crc(meta_json: &[u8], planes: &[Plane<'_>]) -> u32 {
+        let mut hasher = crc32fast::Hasher::new();
+        hasher.update(meta_json);
+        let pixels = planes.first().map_or(0, Plane::len);
+        let mut words: Vec<u32> = Vec::with_capacity(CHUNK_VALUES * planes.len());
+        let mut bytes: Vec<u8> = Vec::with_capacity(4 * CHUNK_VALUES * planes.len());
+        for start in (0..pixels).step_by(CHUNK_VALUES) {
+            let end = pixels.min(start + CHUNK_VALUES);
+            words.clear();
+            words.resize((end - start) * planes.len(), 0);
+            for (ch, p) in planes.iter().enumerate() {
+                let out = words.iter_mut().skip(ch).step_by(planes.len());
+                match p {
+                    Plane::F16(v) => {
+                        for (w, h) in out.zip(&v[start..end]) {
+                            *w = crate::stored::f16_to_f32(h.to_bits()).to_bits();
+                        }
+                    }
+                    Plane::F32(v) => {
+                        for (w, x) in out.zip(&v[start..end]) {
+                            *w = x.to_bits();
+                        }
+                    }
+                }
+            }
+            bytes.clear();
+            bytes.extend(words.iter().flat_map(|w| w.to_le_bytes()));
             hasher.update(&bytes);
         }
         hasher.finalize()
@@ -788,6 +1302,16 @@ pub fn write_exr(
 /// [`ATTR_CRC32`] checksum.
 pub fn read_exr(path: &Path) -> Result<Table, TableError> {
     exr_io::read(path).map(StoredTable::into_table)
+}
+
+/// The metadata and the lookup's nodes of an averaged half-float OpenEXR table, read
+/// straight from its lines; `None` for another table (read it with [`read_exr_stored`]).
+pub(crate) fn read_half_nodes(
+    path: &Path,
+) -> Result<Option<(Metadata, crate::nodes::Nodes)>, TableError> {
+    exr_io::read_with(path, &|c| {
+        Ok(exr_io::half_nodes(c)?.map(|n| (c.meta.clone(), n)))
+    })
 }
 
 /// Reads an OpenEXR table like [`read_exr`], keeping the samples at their stored precision

@@ -25,6 +25,7 @@
 
 use std::fmt;
 use std::path::Path;
+use std::sync::OnceLock;
 
 pub use crate::angles::{above_horizon, HORIZON_COS};
 
@@ -38,6 +39,7 @@ use crate::spatial::SpatialLookup;
 use crate::stored::{Samples, StoredTable};
 use crate::table::{Grid, Metadata, Precision, Table};
 use clothbake_bsdf::{Footprint, Level, Local};
+use half::f16;
 
 /// True when a pair has a value: both directions above the horizon, no component NaN.
 #[inline(always)]
@@ -64,8 +66,8 @@ pub struct Options {
     /// Symmetrise every lookup: `0.5 (f(wi, wo) + f(wo, wi))` (Helmholtz reciprocity, for
     /// tables of physically based facet models). Costs two lookups.
     pub reciprocal: bool,
-    /// Build the importance-sampling CDFs at load time ([`Brdf::sample`], [`Brdf::pdf`]);
-    /// 4 bytes per table cell. Without them `sample` and `pdf` give a zero pdf.
+    /// Importance sampling ([`Brdf::sample`], [`Brdf::pdf`]): its CDFs, 4 bytes per table
+    /// cell, are built on the first call. Without it `sample` and `pdf` give a zero pdf.
     pub sampling: bool,
     /// Answer footprints under two crossing cells at the point level where the table carries
     /// its period's yarns (a spatial table of one bounce; docs/spatial.md). Off: the crossing
@@ -162,7 +164,11 @@ pub struct Brdf {
     nodes: Nodes,
     simd: SimdPath,
     reciprocal: bool,
-    sampler: Option<Sampler>,
+    /// Whether [`Options::sampling`] asked for importance sampling.
+    sampling: bool,
+    /// The sampling CDFs, built from the nodes on the first [`Brdf::sample`] or
+    /// [`Brdf::pdf`] (`Brdf::sampler`).
+    sampler: OnceLock<Sampler>,
     /// The classes of a spatially varying table (`crate::spatial`).
     spatial: Option<SpatialLookup>,
     /// The point level, where the table carries its yarns and the options ask for it.
@@ -187,16 +193,24 @@ fn unit(w: [f32; 3]) -> Option<clothbake_bsdf::UnitVec3> {
 }
 
 impl Brdf {
-    /// Loads a table file (either format, see [`crate::read_table_stored`]).
+    /// Loads a table file (either format, see [`crate::read_table_stored`]). An averaged
+    /// half-float OpenEXR table opened as stored goes from the file's lines straight into the
+    /// lookup's nodes (the same nodes, with the same checks).
     pub fn open(path: &Path, options: Options) -> Result<Brdf, TableError> {
-        let stored = crate::read::read_table_stored(path)?;
-        Brdf::from_stored(stored, options).map_err(|e| match e {
+        let corrupted = |e| match e {
             TableError::InvalidTable { reason } => TableError::Corrupted {
                 path: path.to_path_buf(),
                 reason,
             },
             other => other,
-        })
+        };
+        if options.memory == Memory::AsStored && crate::read::is_exr(path)? {
+            if let Some((meta, nodes)) = crate::exr::read_half_nodes(path)? {
+                return Ok(Brdf::assemble(meta, nodes, None, options));
+            }
+        }
+        let stored = crate::read::read_table_stored(path)?;
+        Brdf::from_stored(stored, options).map_err(corrupted)
     }
 
     /// A lookup of an `f32` table in memory.
@@ -216,13 +230,19 @@ impl Brdf {
             let classes = samples.split_off(3 * g.len());
             SpatialLookup::new(layout, g, &classes, f16)
         });
-        let value = |ti: u32, pi: u32, to: u32, po: u32| -> [f32; 3] {
-            let c = 3 * g.index(ti, pi, to, po);
-            [samples.get(c), samples.get(c + 1), samples.get(c + 2)]
-        };
-        let sampler = options.sampling.then(|| Sampler::new(&g, &value));
-        let nodes = pad(&g, &value, f16);
+        let nodes = pad(&g, &samples, f16);
         drop(samples);
+        Ok(Brdf::assemble(meta, nodes, spatial, options))
+    }
+
+    /// The lookup of `nodes` (and `spatial`'s classes) with the options' kernel, sampling and
+    /// point level.
+    fn assemble(
+        meta: Metadata,
+        nodes: Nodes,
+        spatial: Option<SpatialLookup>,
+        options: Options,
+    ) -> Brdf {
         let simd = if nodes.lanes.exact {
             SimdPath::best()
         } else {
@@ -235,14 +255,47 @@ impl Brdf {
             }),
             _ => None,
         };
-        Ok(Brdf {
+        Brdf {
             meta,
             nodes,
             simd,
             reciprocal: options.reciprocal,
-            sampler,
+            sampling: options.sampling,
+            sampler: OnceLock::new(),
             spatial,
             point,
+        }
+    }
+
+    /// The table this lookup was built from, for an averaged table: its values read back from
+    /// the nodes, at the precision they are held in (exactly the stored values when opened
+    /// [`Memory::AsStored`]). `None` for a spatial table, whose classes are held merged.
+    pub fn to_stored(&self) -> Option<StoredTable> {
+        if self.spatial.is_some() {
+            return None;
+        }
+        let g = *self.grid();
+        let cells = (0..g.n_theta_i).flat_map(move |ti| {
+            (0..g.n_phi_i).flat_map(move |pi| {
+                (0..g.n_theta_o).flat_map(move |to| (0..g.n_phi_o).map(move |po| (ti, pi, to, po)))
+            })
+        });
+        let samples = match &self.nodes.values {
+            Values::F16(_) => Samples::F16(
+                cells
+                    .flat_map(|(a, b, c, d)| self.nodes.cell(a, b, c, d))
+                    .map(f16::from_f32)
+                    .collect(),
+            ),
+            Values::F32(_) => Samples::F32(
+                cells
+                    .flat_map(|(a, b, c, d)| self.nodes.cell(a, b, c, d))
+                    .collect(),
+            ),
+        };
+        Some(StoredTable {
+            meta: self.meta.clone(),
+            samples,
         })
     }
 
@@ -416,7 +469,8 @@ impl Brdf {
         }
     }
 
-    /// Bytes held by the values and the sampling CDFs.
+    /// Bytes held by the values and the sampling CDFs (counted with [`Options::sampling`]
+    /// also before the first [`Brdf::sample`] or [`Brdf::pdf`] builds them).
     pub fn memory_bytes(&self) -> usize {
         let lane = match self.nodes.values {
             Values::F16(_) => 2,
@@ -424,13 +478,29 @@ impl Brdf {
         };
         let values = lane * self.nodes.len();
         values
-            + self.sampler.as_ref().map_or(0, Sampler::memory_bytes)
+            + if self.sampling {
+                Sampler::bytes_of(self.grid())
+            } else {
+                0
+            }
             + self.spatial.as_ref().map_or(0, SpatialLookup::memory_bytes)
     }
 
     /// True when the table was opened with importance sampling ([`Options::sampling`]).
     pub fn has_sampling(&self) -> bool {
-        self.sampler.is_some()
+        self.sampling
+    }
+
+    /// The sampling CDFs, built on the first call from the values the lookups read (so an
+    /// open does not wait for them); `None` without [`Options::sampling`].
+    fn sampler(&self) -> Option<&Sampler> {
+        self.sampling.then(|| {
+            self.sampler.get_or_init(|| {
+                Sampler::new(self.grid(), |ti, pi, to, po| {
+                    self.nodes.cell(ti, pi, to, po)
+                })
+            })
+        })
     }
 
     /// True when lookups are symmetrised (see [`Options::reciprocal`]).
@@ -531,7 +601,7 @@ impl Brdf {
             weight: [0.0; 3],
             pdf: 0.0,
         };
-        let Some(sampler) = &self.sampler else {
+        let Some(sampler) = self.sampler() else {
             return none;
         };
         if !above_horizon(wo) {
@@ -556,7 +626,7 @@ impl Brdf {
     /// The density of [`Brdf::sample`] drawing `wi` for `wo`, per unit solid angle; 0 when
     /// either is below the horizon or sampling was not built.
     pub fn pdf(&self, wo: [f32; 3], wi: [f32; 3]) -> f32 {
-        let Some(sampler) = &self.sampler else {
+        let Some(sampler) = self.sampler() else {
             return 0.0;
         };
         if !(above_horizon(wo) && above_horizon(wi)) {
@@ -598,21 +668,62 @@ impl Brdf {
     }
 }
 
-/// The padded node table ([`Nodes`]), where polar row 0 is the pole node (the mean over the
-/// azimuths of the first ring) and row `k + 1` is cell `k`; half floats when `f16`.
-fn pad(g: &Grid, value: &dyn Fn(u32, u32, u32, u32) -> [f32; 3], f16: bool) -> Nodes {
-    pad4(
-        g,
-        &|a, b, c, d| {
-            let [r, g, b] = value(a, b, c, d);
-            [r, g, b, 0.0]
-        },
-        f16,
-    )
+/// The padded node table ([`Nodes`]) of an averaged table's values, where polar row 0 is
+/// the pole node (the mean over the azimuths of the first ring) and row `k + 1` is cell `k`;
+/// half floats when `f16` and the samples are half. The same lanes as [`pad4`] of the
+/// widened values (a half's bits are copied, which is what rounding its widened value gives),
+/// filled a row at a time from the samples.
+fn pad(g: &Grid, samples: &Samples, f16: bool) -> Nodes {
+    let widen = |h: f16| crate::stored::f16_to_f32(h.to_bits());
+    let values = match samples {
+        Samples::F16(s) if f16 => Values::F16(pad_rows(g, s, widen, |h| h, f16::from_f32)),
+        Samples::F16(s) => Values::F32(pad_rows(g, s, widen, widen, |x| x)),
+        Samples::F32(s) => Values::F32(pad_rows(g, s, |x| x, |x| x, |x| x)),
+    };
+    Nodes::with_values(g, values)
 }
 
-/// [`pad`] of four lanes (a spatial table's two classes a node, `crate::spatial`).
-pub(crate) fn pad4(g: &Grid, value: &dyn Fn(u32, u32, u32, u32) -> [f32; 4], f16: bool) -> Nodes {
+/// The tiles of [`pad`] from samples `s` (interleaved RGB in cell order): `widen` gives a
+/// sample's f32 value, `copy` its lane, `lane` the lane of an f32 (the pole means, 0).
+fn pad_rows<S: Copy + Sync, V: Copy + Default + Send + Sync>(
+    g: &Grid,
+    s: &[S],
+    widen: impl Fn(S) -> f32 + Sync,
+    copy: impl Fn(S) -> V + Sync,
+    lane: impl Fn(f32) -> V + Sync,
+) -> nodes::Tiles<V> {
+    let (npi, npo) = (g.n_phi_i as usize, g.n_phi_o as usize);
+    let value = |ti: u32, pi: u32, to: u32, po: u32| -> [f32; 4] {
+        let c = 3 * g.index(ti, pi, to, po);
+        [widen(s[c]), widen(s[c + 1]), widen(s[c + 2]), 0.0]
+    };
+    let (pole_i, pole_o, pole_io) = poles(g, &value);
+    let zero = lane(0.0);
+    let pole_i: Vec<[V; 4]> = pole_i.iter().map(|x| x.map(&lane)).collect();
+    let pole_o: Vec<[V; 4]> = pole_o.iter().map(|x| x.map(&lane)).collect();
+    let pole_io = pole_io.map(&lane);
+    nodes::Tiles::from_rows(g, &|ri, pi, ro, row: &mut [[V; 4]]| match (ri, ro) {
+        (0, 0) => row.fill(pole_io),
+        (0, _) => row.copy_from_slice(&pole_i[(ro as usize - 1) * npo..ro as usize * npo]),
+        (_, 0) => row.fill(pole_o[(ri as usize - 1) * npi + pi as usize]),
+        _ => {
+            let c = 3 * g.index(ri - 1, pi, ro - 1, 0);
+            for (x, v) in row.iter_mut().zip(s[c..c + 3 * npo].chunks_exact(3)) {
+                *x = [copy(v[0]), copy(v[1]), copy(v[2]), zero];
+            }
+        }
+    })
+}
+
+/// The pole nodes of `value` (cell `(ti, pi, to, po)`, four lanes): at the incident pole, per
+/// outgoing cell `(to, po)`, the mean over `phi_i` of the first incident ring; at the
+/// outgoing pole, per incident cell, the mean over `phi_o`; at both, the mean of both first
+/// rings. Means in f64, in a fixed order.
+#[allow(clippy::type_complexity)]
+fn poles(
+    g: &Grid,
+    value: &dyn Fn(u32, u32, u32, u32) -> [f32; 4],
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>, [f32; 4]) {
     let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
     // Mean of `value` over the listed azimuth pairs, in f64, in a fixed order.
     let mean = |pairs: &mut dyn Iterator<Item = [f32; 4]>| -> [f32; 4] {
@@ -634,6 +745,18 @@ pub(crate) fn pad4(g: &Grid, value: &dyn Fn(u32, u32, u32, u32) -> [f32; 4], f16
         .map(|(ti, pi)| mean(&mut (0..npo).map(|po| value(ti, pi, 0, po))))
         .collect();
     let pole_io = mean(&mut (0..npi).flat_map(|pi| (0..npo).map(move |po| value(0, pi, 0, po))));
+    (pole_i, pole_o, pole_io)
+}
+
+/// [`pad`] of four lanes (a spatial table's two classes a node, `crate::spatial`).
+pub(crate) fn pad4(
+    g: &Grid,
+    value: &(dyn Fn(u32, u32, u32, u32) -> [f32; 4] + Sync),
+    f16: bool,
+) -> Nodes {
+    let npo = g.n_phi_o;
+    let npi = g.n_phi_i;
+    let (pole_i, pole_o, pole_io) = poles(g, value);
     let node = |ri: u32, pi: u32, ro: u32, po: u32| match (ri, ro) {
         (0, 0) => pole_io,
         (0, _) => pole_i[((ro - 1) * npo + po) as usize],

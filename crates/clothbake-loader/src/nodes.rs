@@ -93,40 +93,154 @@ fn tiles_per_row(npo: u32) -> usize {
     (npo as usize - 1) / TILE_STEP + 1
 }
 
-impl<V: Copy + Default> Tiles<V> {
+/// A source of the padded grid one `phi_o` row at a time: `fill(ri, pi, ro, row)` writes the
+/// `n_phi_o` nodes of polar row `ri`, `phi_i` column `pi` and polar row `ro` (rows as in the
+/// module documentation: row 0 the pole) into `row`, one `[V; LANES]` a node.
+pub(crate) type RowFill<'a, V> = dyn Fn(u32, u32, u32, &mut [[V; LANES]]) + Sync + 'a;
+
+/// Fills the `(theta_o, phi_o)` planes of the padded grid in order (see
+/// [`Tiles::from_planes`]): `fill(ri, pi, plane)` writes the `n_theta_o + 1` polar rows of
+/// `n_phi_o` nodes of polar row `ri`, `phi_i` column `pi`.
+pub(crate) trait PlaneFill<V> {
+    /// Why a plane could not be filled (a damaged file).
+    type Error;
+    /// Fills the plane `(ri, pi)`.
+    fn fill(&mut self, ri: u32, pi: u32, plane: &mut [[V; LANES]]) -> Result<(), Self::Error>;
+}
+
+impl<V: Copy + Default + Send + Sync> Tiles<V> {
     /// The tiles of `g` (see the module documentation) from `node(polar row i, phi_i, polar
     /// row o, phi_o)`, each lane converted by `lane`.
     fn of(
         g: &Grid,
-        node: &dyn Fn(u32, u32, u32, u32) -> [f32; 4],
-        lane: impl Fn(f32) -> V,
+        node: &(dyn Fn(u32, u32, u32, u32) -> [f32; 4] + Sync),
+        lane: impl Fn(f32) -> V + Sync,
     ) -> Tiles<V> {
+        Tiles::from_rows(g, &|ri, pi, ro, row: &mut [[V; LANES]]| {
+            for (po, x) in row.iter_mut().enumerate() {
+                *x = node(ri, pi, ro, po as u32).map(&lane);
+            }
+        })
+    }
+
+    /// The tiles of `g` from whole `phi_o` rows ([`RowFill`]): each `(theta_i, phi_i)` node's
+    /// `(theta_o, phi_o)` plane is filled once into a small buffer and cut into its tiles, on
+    /// up to two threads (each writes its own `theta_i` rows; the bytes do not depend on the
+    /// split).
+    pub(crate) fn from_rows(g: &Grid, fill: &RowFill<'_, V>) -> Tiles<V> {
+        /// A [`PlaneFill`] of whole rows.
+        struct Rows<'f, 'a, V> {
+            fill: &'f RowFill<'a, V>,
+            npo: usize,
+        }
+        impl<V> PlaneFill<V> for Rows<'_, '_, V> {
+            type Error = std::convert::Infallible;
+            fn fill(
+                &mut self,
+                ri: u32,
+                pi: u32,
+                plane: &mut [[V; LANES]],
+            ) -> Result<(), Self::Error> {
+                for (ro, row) in plane.chunks_exact_mut(self.npo).enumerate() {
+                    (self.fill)(ri, pi, ro as u32, row);
+                }
+                Ok(())
+            }
+        }
+        let npo = g.n_phi_o as usize;
+        match Tiles::from_planes(g, &|_| Rows { fill, npo }) {
+            Ok((tiles, _)) => tiles,
+            Err(never) => match never {},
+        }
+    }
+
+    /// The tiles of `g` from whole `(theta_o, phi_o)` planes: `make(first)` gives the filler
+    /// of the polar rows `theta_i` from `first` on, which is called with `(ri, pi, plane)` in
+    /// order (`ri` ascending, then `pi`) and writes the `n_theta_o + 1` rows of `n_phi_o`
+    /// nodes of that plane. Up to two fillers run on two threads, each on its own rows; they
+    /// are returned in the order of their rows, with the first error if any.
+    pub(crate) fn from_planes<F>(
+        g: &Grid,
+        make: &(dyn Fn(u32) -> F + Sync),
+    ) -> Result<(Tiles<V>, Vec<F>), F::Error>
+    where
+        F: PlaneFill<V> + Send,
+        F::Error: Send,
+    {
         let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
         let per_row = tiles_per_row(npo);
-        let count = (nti as usize + 1) * npi as usize * nto as usize * per_row;
-        let mut tiles = Vec::with_capacity(count);
+        let per_ti = npi as usize * nto as usize * per_row;
+        let rows_i = nti as usize + 1;
+        let count = rows_i * per_ti;
+        let mut tiles: Vec<Tile<V>> = Vec::with_capacity(count);
         huge_pages(&tiles);
-        for ri in 0..=nti {
-            for pi in 0..npi {
-                for c in 0..nto {
-                    for e in 0..per_row {
-                        let mut t = [V::default(); TILE];
-                        for (k, row) in t.chunks_exact_mut(TILE_ROW).enumerate() {
-                            for (j, x) in row.chunks_exact_mut(LANES).enumerate() {
-                                // Columns beyond the copied one are never read: any node.
-                                let po = (TILE_STEP * e + j) as u32 % npo;
-                                let n = node(ri, pi, c + k as u32, po);
-                                for (x, v) in x.iter_mut().zip(n) {
-                                    *x = lane(v);
+        // Column of the plane each tile column shows (beyond the copied column `npo`, never
+        // read: any node; the column modulo `npo`).
+        let cols: Vec<usize> = (0..per_row * TILE_COLUMNS)
+            .map(|k| (TILE_STEP * (k / TILE_COLUMNS) + k % TILE_COLUMNS) % npo as usize)
+            .collect();
+        let fill_rows = |first: usize,
+                         out: &mut [std::mem::MaybeUninit<Tile<V>>]|
+         -> (F, Result<(), F::Error>) {
+            let mut fill = make(first as u32);
+            let mut plane = vec![[V::default(); LANES]; (nto as usize + 1) * npo as usize];
+            let mut at = 0;
+            for ri in first..first + out.len() / per_ti.max(1) {
+                for pi in 0..npi {
+                    if let Err(e) = fill.fill(ri as u32, pi, &mut plane) {
+                        return (fill, Err(e));
+                    }
+                    for c in 0..nto as usize {
+                        let rows = &plane[c * npo as usize..(c + 2) * npo as usize];
+                        for e in 0..per_row {
+                            let mut t = [V::default(); TILE];
+                            for (k, half) in t.chunks_exact_mut(TILE_ROW).enumerate() {
+                                let row = &rows[k * npo as usize..(k + 1) * npo as usize];
+                                for (j, x) in half.chunks_exact_mut(LANES).enumerate() {
+                                    x.copy_from_slice(&row[cols[TILE_COLUMNS * e + j]]);
                                 }
                             }
+                            out[at].write(Tile(t));
+                            at += 1;
                         }
-                        tiles.push(Tile(t));
                     }
                 }
             }
+            debug_assert_eq!(at, out.len());
+            (fill, Ok(()))
+        };
+        let spare = &mut tiles.spare_capacity_mut()[..count];
+        // Two halves of the theta_i rows where there is enough work to share.
+        let split = if count >= 1 << 16 && rows_i >= 4 {
+            rows_i / 2
+        } else {
+            rows_i
+        };
+        let (low, high) = spare.split_at_mut(split * per_ti);
+        let mut fillers = Vec::with_capacity(2);
+        if high.is_empty() {
+            let (f, r) = fill_rows(0, low);
+            r?;
+            fillers.push(f);
+        } else {
+            let (a, b) = std::thread::scope(|s| {
+                let b = s.spawn(|| fill_rows(split, high));
+                let a = fill_rows(0, low);
+                (a, b.join())
+            });
+            let b = match b {
+                Ok(b) => b,
+                Err(panic) => std::panic::resume_unwind(panic),
+            };
+            a.1?;
+            b.1?;
+            fillers.extend([a.0, b.0]);
         }
-        Tiles { tiles }
+        // SAFETY: both fillers succeeded, so `fill_rows` wrote every one of the `count` tiles
+        // (each (ri, pi, c, e) once, in order, the halves covering the theta_i rows 0..split
+        // and split..rows_i).
+        unsafe { tiles.set_len(count) };
+        Ok((Tiles { tiles }, fillers))
     }
 }
 
@@ -134,7 +248,7 @@ impl<V: Copy + Default> Tiles<V> {
 /// `madvise(MADV_HUGEPAGE)` on the whole pages inside it, before they are first touched): a
 /// random lookup's 4 pages then cost no page walk from memory. A hint: no effect on any value,
 /// and none at all where transparent huge pages are off or the call fails.
-fn huge_pages<T>(v: &Vec<T>) {
+pub(crate) fn huge_pages<T>(v: &Vec<T>) {
     #[cfg(target_os = "linux")]
     {
         const PAGE: usize = 4096;
@@ -341,7 +455,11 @@ impl Nodes {
     /// The padded table of `g` from `node(polar row i, phi_i, polar row o, phi_o)` (rows as in
     /// the module documentation), widened or narrowed by `f16`; the fourth lane 0.
     #[cfg(test)]
-    pub(crate) fn new(g: &Grid, node: &dyn Fn(u32, u32, u32, u32) -> [f32; 3], f16: bool) -> Nodes {
+    pub(crate) fn new(
+        g: &Grid,
+        node: &(dyn Fn(u32, u32, u32, u32) -> [f32; 3] + Sync),
+        f16: bool,
+    ) -> Nodes {
         Nodes::new4(
             g,
             &|a, b, c, d| {
@@ -355,17 +473,44 @@ impl Nodes {
     /// As [`Nodes::new`] with all four lanes given (a spatial table's two classes a node).
     pub(crate) fn new4(
         g: &Grid,
-        node: &dyn Fn(u32, u32, u32, u32) -> [f32; 4],
+        node: &(dyn Fn(u32, u32, u32, u32) -> [f32; 4] + Sync),
         f16: bool,
     ) -> Nodes {
+        Nodes::with_values(
+            g,
+            if f16 {
+                Values::F16(Tiles::of(g, node, f16::from_f32))
+            } else {
+                Values::F32(Tiles::of(g, node, |x| x))
+            },
+        )
+    }
+
+    /// The constants of `g`'s lookups with `values`, tiles of `g` ([`Tiles::from_rows`]).
+    pub(crate) fn with_values(g: &Grid, values: Values) -> Nodes {
         let mut nodes = Nodes::empty(g);
-        nodes.values = if f16 {
-            Values::F16(Tiles::of(g, node, f16::from_f32))
-        } else {
-            Values::F32(Tiles::of(g, node, |x| x))
-        };
+        nodes.values = values;
         debug_assert_eq!(nodes.len(), nodes.strides[0] * (g.n_theta_i as usize + 1));
         nodes
+    }
+
+    /// The lanes R, G, B of table cell `(ti, pi, to, po)` widened to f32 (exact): node
+    /// `(ti + 1, pi, to + 1, po)` of the tiles, where the lookups read it.
+    pub(crate) fn cell(&self, ti: u32, pi: u32, to: u32, po: u32) -> [f32; 3] {
+        let [s_ti, s_pi, s_to] = self.strides;
+        // Polar row `to + 1` is the second row of tile `to`.
+        let at = (ti as usize + 1) * s_ti
+            + pi as usize * s_pi
+            + to as usize * s_to
+            + TILE_ROW
+            + column_offset(po as usize);
+        fn rgb<V: Lane>(v: &[V], at: usize) -> [f32; 3] {
+            std::array::from_fn(|k| v[at + k].widen())
+        }
+        match &self.values {
+            Values::F16(v) => rgb(v, at),
+            Values::F32(v) => rgb(v, at),
+        }
     }
 
     /// The constants of `g`'s lookups, with no values (every lookup out of range).

@@ -43,3 +43,12 @@ pub fn read_table_stored(path: &Path) -> Result<StoredTable, TableError> {
         })
     }
 }
+
+/// True when the file starts with the OpenEXR magic bytes (an error when it cannot be read).
+pub(crate) fn is_exr(path: &Path) -> Result<bool, TableError> {
+    let mut file = open_regular(path, "table")?;
+    let mut head = [0u8; 4];
+    let n =
+        read_up_to(&mut file, &mut head).map_err(|e| TableError::io(path, "read the table", e))?;
+    Ok(head[..n] == EXR_MAGIC)
+}

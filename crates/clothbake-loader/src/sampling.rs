@@ -26,7 +26,7 @@ use crate::table::Grid;
 /// Weight of the uniform part of the sampling density (see the module documentation).
 pub const DEFENSIVE: f64 = 0.01;
 
-/// The CDFs of every outgoing cell, built at load time.
+/// The CDFs of every outgoing cell, built on the first `sample` or `pdf` of a table.
 #[derive(Clone, Debug)]
 pub(crate) struct Sampler {
     grid: Grid,
@@ -78,7 +78,7 @@ fn mass(c: &[f32], k: usize) -> f32 {
 
 impl Sampler {
     /// CDFs of the table `value(ti, pi, to, po)` (RGB f_r at cell centres) on grid `g`.
-    pub(crate) fn new(g: &Grid, value: &dyn Fn(u32, u32, u32, u32) -> [f32; 3]) -> Sampler {
+    pub(crate) fn new(g: &Grid, value: impl Fn(u32, u32, u32, u32) -> [f32; 3]) -> Sampler {
         let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
         let d_theta = std::f64::consts::FRAC_PI_2 / f64::from(nti);
         let d_phi = std::f64::consts::TAU / f64::from(npi);
@@ -131,9 +131,10 @@ impl Sampler {
         }
     }
 
-    /// Bytes held by the CDFs.
-    pub(crate) fn memory_bytes(&self) -> usize {
-        4 * (self.marginal.len() + self.conditional.len())
+    /// Bytes held by the CDFs of a table on `g` (f32 marginals and conditionals).
+    pub(crate) fn bytes_of(g: &Grid) -> usize {
+        let outgoing = g.n_theta_o as usize * g.n_phi_o as usize;
+        4 * outgoing * g.n_theta_i as usize * (1 + g.n_phi_i as usize)
     }
 
     /// Index of the outgoing cell that holds (theta_o, phi_o), radians.

@@ -35,7 +35,9 @@ pub fn table_err(e: TableError) -> PyErr {
 /// A baked table of f_r (1/sr, RGB) on a cell-centred (theta_i, phi_i, theta_o, phi_o) grid.
 #[pyclass(name = "Table", module = "clothbake", frozen)]
 pub struct PyTable {
-    stored: StoredTable,
+    /// A spatial table's values as stored (an averaged table's are read back from the
+    /// lookup's nodes when asked for: `Brdf::to_stored`).
+    stored: Option<StoredTable>,
     brdf: Brdf,
     reciprocal: bool,
 }
@@ -54,12 +56,53 @@ impl PyTable {
             sampling: true,
             point_level,
         };
-        let brdf = Brdf::from_stored(stored.clone(), options)?;
+        let spatial = stored.meta.spatial.is_some();
+        let (brdf, stored) = if spatial {
+            (Brdf::from_stored(stored.clone(), options)?, Some(stored))
+        } else {
+            (Brdf::from_stored(stored, options)?, None)
+        };
         Ok(PyTable {
             stored,
             brdf,
             reciprocal,
         })
+    }
+
+    /// Opens a table file as [`Brdf::open`] does (an averaged half-float OpenEXR table straight
+    /// into the lookup's nodes); a spatial table is read as stored, which it keeps.
+    fn open_file(
+        path: &std::path::Path,
+        reciprocal: bool,
+        point_level: bool,
+    ) -> Result<PyTable, TableError> {
+        let options = Options {
+            memory: Memory::AsStored,
+            reciprocal,
+            sampling: true,
+            point_level,
+        };
+        let brdf = Brdf::open(path, options)?;
+        if brdf.spatial().is_none() {
+            return Ok(PyTable {
+                stored: None,
+                brdf,
+                reciprocal,
+            });
+        }
+        let stored = clothbake_loader::read_table_stored(path)?;
+        PyTable::from_stored(stored, reciprocal, point_level)
+    }
+
+    /// The table's values as stored.
+    fn stored(&self) -> StoredTable {
+        match &self.stored {
+            Some(s) => s.clone(),
+            None => self
+                .brdf
+                .to_stored()
+                .expect("an averaged table's values are its nodes'"),
+        }
     }
 }
 
@@ -87,8 +130,7 @@ impl PyTable {
         point_level: bool,
     ) -> PyResult<PyTable> {
         py.detach(|| {
-            let stored = clothbake_loader::read_table_stored(&path)?;
-            PyTable::from_stored(stored, reciprocal, point_level).map_err(|e| match e {
+            PyTable::open_file(&path, reciprocal, point_level).map_err(|e| match e {
                 TableError::InvalidTable { reason } => TableError::Corrupted {
                     path: path.clone(),
                     reason,
@@ -141,7 +183,8 @@ impl PyTable {
     /// f_r in 1/sr at the cell centres, RGB last (a copy).
     fn to_numpy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let g = self.brdf.grid();
-        let s = &self.stored.samples;
+        let stored = self.stored();
+        let s = &stored.samples;
         let v: Vec<f32> = (0..s.len()).map(|i| s.get(i)).collect();
         let shape = [
             g.n_theta_i as usize,
@@ -288,7 +331,7 @@ impl PyTable {
     /// The same table without its point level: its crossing cells answer every footprint
     /// under a period (what a spatial table held before it carried its yarns).
     fn without_point_level(&self, py: Python<'_>) -> PyResult<PyTable> {
-        py.detach(|| PyTable::from_stored(self.stored.clone(), self.reciprocal, false))
+        py.detach(|| PyTable::from_stored(self.stored(), self.reciprocal, false))
             .map_err(table_err)
     }
 
@@ -365,7 +408,7 @@ impl PyTable {
                 )))
             }
         };
-        let table = self.stored.clone().into_table();
+        let table = self.stored().into_table();
         let exr = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
