@@ -520,6 +520,23 @@ mod exr_io {
         }
     }
 
+    /// The error of a damaged file at `path`, with its reason.
+    fn corrupted_in(path: &Path) -> impl Fn(String) -> TableError + '_ {
+        move |reason| TableError::Corrupted {
+            path: path.to_path_buf(),
+            reason,
+        }
+    }
+
+    /// The error of a file at `path` that is not a clothbake table, with its reason.
+    fn foreign_in(path: &Path) -> impl Fn(String) -> TableError + '_ {
+        move |reason| TableError::Foreign {
+            path: path.to_path_buf(),
+            what: "table".into(),
+            reason,
+        }
+    }
+
     pub(super) fn read(path: &Path) -> Result<StoredTable, TableError> {
         read_with(path, &decode_stored)
     }
@@ -547,15 +564,7 @@ mod exr_io {
                 ),
             });
         }
-        let corrupted = |reason: String| TableError::Corrupted {
-            path: path.to_path_buf(),
-            reason,
-        };
-        let foreign = |reason: String| TableError::Foreign {
-            path: path.to_path_buf(),
-            what: "table".into(),
-            reason,
-        };
+        let (corrupted, foreign) = (corrupted_in(path), foreign_in(path));
 
         // The exr decoder is not trusted to never panic on damaged files.
         let guarded = |f: &dyn Fn() -> Result<T, TableError>| {
@@ -664,15 +673,7 @@ mod exr_io {
         let (path, bytes, meta) = (c.path, c.bytes, c.meta);
         let grid = meta.grid;
         let expected = meta.channel_names();
-        let corrupted = |reason: String| TableError::Corrupted {
-            path: path.to_path_buf(),
-            reason,
-        };
-        let foreign = |reason: String| TableError::Foreign {
-            path: path.to_path_buf(),
-            what: "table".into(),
-            reason,
-        };
+        let (corrupted, foreign) = (corrupted_in(path), foreign_in(path));
         {
             // Half samples in scan-line blocks (what clothbake writes): decoded block by block
             // straight into the table's order, the checksum taken as the lines pass.

@@ -42,6 +42,16 @@ pub struct PyTable {
     reciprocal: bool,
 }
 
+/// The options a Python table is opened with: as stored, sampling ready.
+fn table_options(reciprocal: bool, point_level: bool) -> Options {
+    Options {
+        memory: Memory::AsStored,
+        reciprocal,
+        sampling: true,
+        point_level,
+    }
+}
+
 impl PyTable {
     /// A table in memory, ready for lookups and sampling; `point_level` as
     /// [`Options::point_level`].
@@ -50,12 +60,7 @@ impl PyTable {
         reciprocal: bool,
         point_level: bool,
     ) -> Result<PyTable, TableError> {
-        let options = Options {
-            memory: Memory::AsStored,
-            reciprocal,
-            sampling: true,
-            point_level,
-        };
+        let options = table_options(reciprocal, point_level);
         let spatial = stored.meta.spatial.is_some();
         let (brdf, stored) = if spatial {
             (Brdf::from_stored(stored.clone(), options)?, Some(stored))
@@ -76,12 +81,7 @@ impl PyTable {
         reciprocal: bool,
         point_level: bool,
     ) -> Result<PyTable, TableError> {
-        let options = Options {
-            memory: Memory::AsStored,
-            reciprocal,
-            sampling: true,
-            point_level,
-        };
+        let options = table_options(reciprocal, point_level);
         let brdf = Brdf::open(path, options)?;
         if brdf.spatial().is_none() {
             return Ok(PyTable {
