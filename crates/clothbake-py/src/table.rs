@@ -268,7 +268,7 @@ impl PyTable {
     /// numbers `u` (N, 2) in [0, 1): density proportional to f_r cos(theta_i) per table cell.
     /// Returns (wi (N, 3), weight (N, 3) = f_r cos(theta_i) / pdf, pdf (N,) per steradian),
     /// float32; pdf 0 (and weight 0) where `wo` is below the horizon. GIL released; rows
-    /// in chunks of [`PAR_CHUNK`] on rayon's threads (each row's answer is the same).
+    /// in chunks of 4096 on rayon's threads (each row's answer is the same).
     fn sample<'py>(
         &self,
         py: Python<'py>,
