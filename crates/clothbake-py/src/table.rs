@@ -12,6 +12,7 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyFileExistsError, PyFileNotFoundError, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rayon::prelude::*;
 use std::path::PathBuf;
 
 /// The Python exception of a table error: FileNotFoundError, FileExistsError, OSError for
@@ -110,6 +111,10 @@ impl PyTable {
 type Triple = (f32, f32, f32);
 
 /// Rows as f32 vectors (the loader's precision).
+/// The fewest rows `sample` and `pdf` hand one of rayon's threads (a renderer's wavefronts of
+/// tens of thousands of rows use every core; a few rows stay on the caller's thread).
+const PAR_CHUNK: usize = 4096;
+
 fn narrow(r: &[[f64; 3]]) -> Vec<[f32; 3]> {
     r.iter().map(|w| w.map(|x| x as f32)).collect()
 }
@@ -262,16 +267,17 @@ impl PyTable {
     /// Importance-samples incident directions for unit vectors `wo` (N, 3) with uniform
     /// numbers `u` (N, 2) in [0, 1): density proportional to f_r cos(theta_i) per table cell.
     /// Returns (wi (N, 3), weight (N, 3) = f_r cos(theta_i) / pdf, pdf (N,) per steradian),
-    /// float32; pdf 0 (and weight 0) where `wo` is below the horizon.
+    /// float32; pdf 0 (and weight 0) where `wo` is below the horizon. GIL released; rows
+    /// in chunks of 4096 on rayon's threads (each row's answer is the same).
     fn sample<'py>(
         &self,
         py: Python<'py>,
         wo: &Bound<'py, PyAny>,
         u: &Bound<'py, PyAny>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let b = unit_rows("wo", wo)?;
+        let (wo32, single_o) = unit_rows_f32("wo", wo)?;
         let u = rows::<2>("u", u)?;
-        same_len(("wo", b.rows.len()), ("u", u.rows.len()))?;
+        same_len(("wo", wo32.len()), ("u", u.rows.len()))?;
         if let Some(i) = u
             .rows
             .iter()
@@ -282,14 +288,14 @@ impl PyTable {
                 u.rows[i][0], u.rows[i][1]
             )));
         }
-        let wo32 = narrow(&b.rows);
         let s: Vec<_> = py.detach(|| {
-            wo32.iter()
-                .zip(&u.rows)
+            wo32.par_iter()
+                .zip(u.rows.par_iter())
+                .with_min_len(PAR_CHUNK)
                 .map(|(&w, r)| self.brdf.sample(w, r[0] as f32, r[1] as f32))
                 .collect()
         });
-        let single = b.single && u.single;
+        let single = single_o && u.single;
         let wi: Vec<[f32; 3]> = s.iter().map(|x| x.wi).collect();
         let weight: Vec<[f32; 3]> = s.iter().map(|x| x.weight).collect();
         let pdf: Vec<f32> = s.iter().map(|x| x.pdf).collect();
@@ -301,24 +307,24 @@ impl PyTable {
     }
 
     /// The density (per steradian, float32 (N,)) with which `sample` draws `wi` for `wo`,
-    /// both unit vectors (N, 3).
+    /// both unit vectors (N, 3). GIL released; rows in chunks on rayon's threads, as `sample`.
     fn pdf<'py>(
         &self,
         py: Python<'py>,
         wo: &Bound<'py, PyAny>,
         wi: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let b = unit_rows("wo", wo)?;
-        let a = unit_rows("wi", wi)?;
-        same_len(("wo", b.rows.len()), ("wi", a.rows.len()))?;
-        let (wo32, wi32) = (narrow(&b.rows), narrow(&a.rows));
+        let (wo32, single_o) = unit_rows_f32("wo", wo)?;
+        let (wi32, single_i) = unit_rows_f32("wi", wi)?;
+        same_len(("wo", wo32.len()), ("wi", wi32.len()))?;
         let p: Vec<f32> = py.detach(|| {
-            wo32.iter()
-                .zip(&wi32)
+            wo32.par_iter()
+                .zip(wi32.par_iter())
+                .with_min_len(PAR_CHUNK)
                 .map(|(&o, &i)| self.brdf.pdf(o, i))
                 .collect()
         });
-        to_array1(py, p, a.single && b.single)
+        to_array1(py, p, single_i && single_o)
     }
 
     /// Whether `eval_at` answers footprints under two crossing cells at the point level (the

@@ -1,6 +1,9 @@
 """The Mitsuba plugin in the llvm variants: each method takes the wavefront of lanes Mitsuba
-hands it (concrete Dr.Jit arrays, symbolic loops and calls off), converts the directions in
-the cloth frame to numpy and answers with one batch call into the native module.
+hands it (concrete Dr.Jit arrays, symbolic loops and calls off), computes the directions in
+the cloth frame in Dr.Jit (the frame, the mirroring of the back, the valid lanes: one kernel
+a call), hands them to numpy as contiguous float32 (N, 3) rows and answers with one batch
+call into the native module, whose results go back to Dr.Jit whole (``dr.unravel``), the
+cosine and the masks applied lazily (fused into the integrator's next kernel).
 
 The conventions are those of the scalar plugin (``clothbake.mitsuba``): the cloth frame is
 (dp_du made orthogonal to the shading normal, n x s, n); seen from the back a two-sided cloth
@@ -11,41 +14,14 @@ import numpy as np
 
 
 def _rows(v):
-    """A Dr.Jit 3-vector array as a numpy (N, 3) float64 array."""
-    return np.asarray(v, dtype=np.float64).reshape(3, -1).T
-
-
-def _mask(m, n):
-    """A Dr.Jit mask (or Python bool) as a numpy (N,) bool array."""
-    a = np.asarray(m, dtype=bool).reshape(-1)
-    return np.broadcast_to(a, (n,)) if a.size == 1 else a
+    """A Dr.Jit 2- or 3-vector array as a numpy (N, k) float64 array."""
+    a = np.asarray(v, dtype=np.float64)
+    return a.reshape(a.shape[0], -1).T
 
 
 def _unit(v):
-    """Rows normalised (the frame changes round-trip through float32)."""
+    """Rows normalised."""
     return v / np.linalg.norm(v, axis=1, keepdims=True)
-
-
-def _directions(cloth, eye, light, active):
-    """The rows where the pair is valid (both above the cloth after mirroring the back) and
-    the pair made valid everywhere: (ok, eye, light), eye and light unit (N, 3). Invalid rows
-    hold the normal, so that every batch call gets unit vectors."""
-    flip = eye[:, 2] < 0.0
-    ok = active.copy()
-    if not cloth.two_sided:
-        ok &= ~flip
-    sign = np.where(flip, -1.0, 1.0)
-    eye = eye * np.stack([np.ones_like(sign), np.ones_like(sign), sign], axis=1)
-    ok &= eye[:, 2] > 0.0
-    if light is not None:
-        light = light * np.stack([np.ones_like(sign), np.ones_like(sign), sign], axis=1)
-        ok &= light[:, 2] > 0.0
-    up = np.array([0.0, 0.0, 1.0])
-    eye = np.where(ok[:, None], eye, up)
-    eye = _unit(eye)
-    if light is not None:
-        light = _unit(np.where(ok[:, None], light, up))
-    return ok, eye, light, flip
 
 
 def _f(cloth, light, eye, uv, width=None):
@@ -77,9 +53,18 @@ def wavefront_class(mi, dr, Cloth):
                 "turns them on)"
             )
 
-    def to_color(rows):
-        rows = np.ascontiguousarray(rows, dtype=np.float32)
-        return mi.Color3f(mi.Float(rows[:, 0]), mi.Float(rows[:, 1]), mi.Float(rows[:, 2]))
+    def up():
+        """The normal (a fresh literal each call)."""
+        return mi.Vector3f(0.0, 0.0, 1.0)
+
+    def rows3(v):
+        """A Dr.Jit 3-vector as a contiguous numpy (N, 3) float32 array."""
+        return np.asarray(dr.ravel(v)).reshape(-1, 3)
+
+    def color(rows):
+        """Numpy (N, 3) rows as a Color3f (one array, unravelled)."""
+        flat = np.ascontiguousarray(rows, dtype=np.float32).reshape(-1)
+        return dr.unravel(mi.Color3f, mi.Float(flat))
 
     class ClothWavefrontBSDF(mi.BSDF):
         """Woven cloth from clothbake, a wavefront at a time (llvm variants)."""
@@ -99,18 +84,48 @@ def wavefront_class(mi, dr, Cloth):
             s = dr.normalize(s)
             return mi.Frame3f(s, dr.cross(n, s), n)
 
-        def _local(self, si, frame, v):
-            return _rows(frame.to_local(si.sh_frame.to_world(v)))
-
-        def _pair(self, si, wo, active):
-            """(ok, eye, light, flip, frame): the numpy pair in the cloth frame."""
+        def _pair(self, si, wo, active, u=None):
+            """(ok, flip, frame, eye, light, light_z, u): the pair in the cloth frame, made
+            valid everywhere (both above the cloth after mirroring the back; invalid lanes
+            hold the normal, so that every batch call gets unit vectors). ok and flip are
+            Dr.Jit masks, eye and light numpy (N, 3) float32 rows (light None without wo),
+            light_z the light's cosine as a Dr.Jit Float, u the 2-vector ``u`` (the sample)
+            as numpy (N, 2) float32 rows (or None). One kernel computes them all and lays
+            the rows out interleaved (``dr.ravel``) for numpy."""
             check()
             frame = self._frame(si)
-            eye = self._local(si, frame, si.wi)
-            n = eye.shape[0]
-            light = self._local(si, frame, wo) if wo is not None else None
-            ok, eye, light, flip = _directions(self._cloth, eye, light, _mask(active, n))
-            return ok, eye, light, flip, frame
+
+            def cloth(v):
+                return frame.to_local(si.sh_frame.to_world(v))
+
+            eye = cloth(si.wi)
+            flip = eye.z < 0.0
+            ok = mi.Bool(active)
+            if not self._cloth.two_sided:
+                ok &= ~flip
+            sign = dr.select(flip, -1.0, 1.0)
+            eye = mi.Vector3f(eye.x, eye.y, eye.z * sign)
+            ok &= eye.z > 0.0
+            light = None
+            if wo is not None:
+                light = cloth(wo)
+                light = mi.Vector3f(light.x, light.y, light.z * sign)
+                ok &= light.z > 0.0
+            eye = dr.normalize(dr.select(ok, eye, up()))
+            flat = [dr.ravel(eye)]
+            if light is not None:
+                light = dr.normalize(dr.select(ok, light, up()))
+                flat.append(dr.ravel(light))
+            if u is not None:
+                flat.append(dr.ravel(u))
+            lz = None if light is None else light.z
+            dr.eval(ok, flip, lz, *flat)  # one kernel
+            rows = [np.asarray(f).reshape(-1, k) for f, k in
+                    zip(flat, [3, 3 if light is not None else 2, 2])]
+            eye_rows = rows[0]
+            light_rows = rows[1] if light is not None else None
+            u_rows = rows[-1] if u is not None else None
+            return ok, flip, frame, eye_rows, light_rows, lz, u_rows
 
         def _uv(self, si):
             if self._cloth.periods is None:
@@ -130,66 +145,71 @@ def wavefront_class(mi, dr, Cloth):
             side = np.maximum(length(si.duv_dx), length(si.duv_dy))
             return np.where(np.isfinite(side), side * self._cloth.periods, 0.0)
 
-        def _value(self, si, ok, eye, light):
+        def _value(self, si, ok, eye, light, light_z):
             uv = self._uv(si)
-            f = _f(self._cloth, light, eye, uv, self._width(si, len(eye))) * light[:, 2:3]
-            return np.where(ok[:, None], f, 0.0)
+            f = color(_f(self._cloth, light, eye, uv, self._width(si, len(eye))))
+            return dr.select(ok, f * light_z, 0.0)
 
-        def _density(self, ok, eye, light):
+        def _density(self, ok, eye, light, light_z):
             if self._cloth.table is not None:
-                pdf = np.asarray(self._cloth.table.pdf(eye, light), dtype=np.float64)
+                pdf = mi.Float(self._cloth.table.pdf(eye, light))
             else:
-                pdf = light[:, 2] / np.pi
-            return np.where(ok, pdf, 0.0)
+                pdf = light_z / np.pi
+            return dr.select(ok, pdf, 0.0)
 
         def eval(self, ctx, si, wo, active=True):
-            ok, eye, light, _, _ = self._pair(si, wo, active)
-            return to_color(self._value(si, ok, eye, light))
+            ok, _, _, eye, light, lz, _ = self._pair(si, wo, active)
+            return self._value(si, ok, eye, light, lz)
 
         def pdf(self, ctx, si, wo, active=True):
-            ok, eye, light, _, _ = self._pair(si, wo, active)
-            return mi.Float(self._density(ok, eye, light).astype(np.float32))
+            ok, _, _, eye, light, lz, _ = self._pair(si, wo, active)
+            return self._density(ok, eye, light, lz)
 
         def eval_pdf(self, ctx, si, wo, active=True):
-            ok, eye, light, _, _ = self._pair(si, wo, active)
-            value = to_color(self._value(si, ok, eye, light))
-            return value, mi.Float(self._density(ok, eye, light).astype(np.float32))
+            ok, _, _, eye, light, lz, _ = self._pair(si, wo, active)
+            return self._value(si, ok, eye, light, lz), self._density(ok, eye, light, lz)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
-            ok, eye, _, flip, frame = self._pair(si, None, active)
+            table = self._cloth.table is not None
+            ok, flip, frame, eye, _, _, u = self._pair(si, None, active,
+                                                       sample2 if table else None)
             n = eye.shape[0]
-            u = np.asarray(sample2, dtype=np.float64).reshape(2, -1).T
-            if self._cloth.table is not None:
+            if table:
+                if u.shape[0] != n:
+                    u = np.broadcast_to(u, (n, 2))
                 light, weight, pdf = self._cloth.table.sample(eye, u)
-                light = np.asarray(light, dtype=np.float64)
-                weight = np.asarray(weight, dtype=np.float64)
-                pdf = np.asarray(pdf, dtype=np.float64)
-                ok &= pdf > 0.0
+                pdf_dr = mi.Float(pdf)
+                ok &= pdf_dr > 0.0
                 if self._cloth.periods is not None:
                     # Sampled from the averaged table; weighted by the point's own f_r.
-                    lu = _unit(np.where(ok[:, None], light, [0.0, 0.0, 1.0]))
+                    okn = np.broadcast_to(np.asarray(ok, dtype=bool).reshape(-1), (n,))
+                    lu = _unit(np.where(okn[:, None], np.asarray(light, dtype=np.float64),
+                                        [0.0, 0.0, 1.0]))
                     f = _f(self._cloth, lu, eye, self._uv(si), self._width(si, n))
-                    weight = f * lu[:, 2:3] / np.where(ok, pdf, 1.0)[:, None]
+                    pdf64 = np.asarray(pdf, dtype=np.float64)
+                    weight = f * lu[:, 2:3] / np.where(okn, pdf64, 1.0)[:, None]
+                wo = dr.unravel(mi.Vector3f, mi.Float(np.ascontiguousarray(light).reshape(-1)))
+                weight = color(weight)
             else:
-                w = _rows(mi.warp.square_to_cosine_hemisphere(sample2))
-                pdf = w[:, 2] / np.pi
-                ok &= pdf > 0.0
-                lu = _unit(np.where(ok[:, None], w, [0.0, 0.0, 1.0]))
-                weight = np.pi * _f(self._cloth, lu, eye, self._uv(si), self._width(si, n))
-                light = w
-            weight = np.where(ok[:, None], weight, 0.0)
-            pdf = np.where(ok, pdf, 0.0)
-            light = np.where(ok[:, None], light, [0.0, 0.0, 1.0])
-            light[:, 2] = np.where(flip, -light[:, 2], light[:, 2])
-            lf = np.ascontiguousarray(light, dtype=np.float32)
-            v = mi.Vector3f(mi.Float(lf[:, 0]), mi.Float(lf[:, 1]), mi.Float(lf[:, 2]))
+                w = mi.warp.square_to_cosine_hemisphere(sample2)
+                pdf_dr = w.z / np.pi
+                ok &= pdf_dr > 0.0
+                lu = dr.normalize(dr.select(ok, w, up()))
+                dr.eval(lu)
+                weight = np.pi * color(_f(self._cloth, rows3(lu), eye, self._uv(si),
+                                          self._width(si, n)))
+                wo = w
+            weight = dr.select(ok, weight, 0.0)
+            pdf_dr = dr.select(ok, pdf_dr, 0.0)
+            wo = dr.select(ok, wo, up())
+            wo = mi.Vector3f(wo.x, wo.y, dr.select(flip, -wo.z, wo.z))
             bs = dr.zeros(mi.BSDFSample3f, n)
-            bs.wo = si.sh_frame.to_local(frame.to_world(v))
-            bs.pdf = mi.Float(pdf.astype(np.float32))
+            bs.wo = si.sh_frame.to_local(frame.to_world(wo))
+            bs.pdf = pdf_dr
             bs.eta = 1.0
             bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
             bs.sampled_component = mi.UInt32(0)
-            return bs, to_color(weight)
+            return bs, weight
 
         def traverse(self, callback):
             pass
