@@ -1065,7 +1065,8 @@ impl AnalyticModel {
 
     /// What of unit `u` is visible from the eye's view `e`: `None` where nothing is.
     fn visible(&self, u: &Unit, e: &View) -> Option<Visible> {
-        self.visible_of(u, e, self.side_arc(u, e).meet(&u.seg.floor))
+        let arc = self.side_arc(u, e).meet(&u.seg.floor);
+        self.visible_of(u, std::slice::from_ref(&u.range), e, arc)
     }
 
     /// The visible length l_v and projected width of unit `u` from the eye's view `e`, whose
@@ -1087,31 +1088,24 @@ impl AnalyticModel {
     /// slice's ranges).
     fn slice_visible(&self, u: &Unit, sl: &Slice, e: &View) -> Option<Visible> {
         let arc = side_arc_in(&u.seg, sl.tables(), e).meet(&u.seg.floor);
-        if arc.arc.is_empty() {
-            return None;
-        }
-        let along = self.end_interval(u, e, &arc, e.p.p);
-        let l_v: f64 = sl.ranges.iter().map(|&r| overlap(r, along)).sum();
-        if l_v <= 0.0 {
-            return None;
-        }
-        Some(Visible {
-            arc,
-            along,
-            l_v,
-            width: projected_width(u.seg.radius, &arc, e.p.p),
-        })
+        self.visible_of(u, &sl.ranges, e, arc)
     }
 
-    /// As [`AnalyticModel::visible`], given the arc of the cross-section that faces the eye
-    /// above the floor and not behind the side neighbour.
-    fn visible_of(&self, u: &Unit, e: &View, arc: ArcTrig) -> Option<Visible> {
+    /// As [`AnalyticModel::visible`] over the parts `ranges` of the piece, given the arc of the
+    /// cross-section that faces the eye above the floor and not behind the side neighbour.
+    fn visible_of(
+        &self,
+        u: &Unit,
+        ranges: &[(f64, f64)],
+        e: &View,
+        arc: ArcTrig,
+    ) -> Option<Visible> {
         let seg = &u.seg;
         if arc.arc.is_empty() {
             return None;
         }
         let along = self.end_interval(u, e, &arc, e.p.p);
-        let l_v = overlap(u.range, along);
+        let l_v: f64 = ranges.iter().map(|&r| overlap(r, along)).sum();
         if l_v <= 0.0 {
             return None;
         }
@@ -1145,7 +1139,7 @@ impl AnalyticModel {
         // square roots that the processor can overlap.
         let seen = self.side_arc(u, &views.e).meet(&seg.floor);
         let lit = self.side_arc(u, &views.l).meet(&seg.floor);
-        let v = self.visible_of(u, &views.e, seen)?;
+        let v = self.visible_of(u, std::slice::from_ref(&u.range), &views.e, seen)?;
         let ep = views.e.p.p;
         let vi = v.arc.meet(&lit);
         let lit_len = self.end_interval(u, &views.l, &vi, ep);
@@ -1559,25 +1553,28 @@ impl AnalyticModel {
             .iter()
             .map(|u| {
                 let v = &views[u.seg.group as usize];
-                let whole = Slice {
-                    ranges: vec![u.range],
-                    side_plus: u.side_plus.clone(),
-                    side_minus: u.side_minus.clone(),
-                };
-                let slices = if u.slices.is_empty() {
-                    std::slice::from_ref(&whole)
+                // The unit's parts: its slices, or its whole range with its own tables.
+                let parts: Vec<(&[(f64, f64)], _)> = if u.slices.is_empty() {
+                    vec![(
+                        std::slice::from_ref(&u.range),
+                        (&u.side_plus, &u.side_minus),
+                    )]
                 } else {
-                    &u.slices[..]
+                    u.slices
+                        .iter()
+                        .map(|sl| (&sl.ranges[..], sl.tables()))
+                        .collect()
                 };
-                let lit_area: f64 = slices
-                    .iter()
-                    .filter_map(|sl| {
-                        let seen = self.slice_visible(u, sl, &v.e)?;
-                        let lit = side_arc_in(&u.seg, sl.tables(), &v.l).meet(&u.seg.floor);
+                let lit_area: f64 = parts
+                    .into_iter()
+                    .filter_map(|(ranges, tables)| {
+                        let arc = side_arc_in(&u.seg, tables, &v.e).meet(&u.seg.floor);
+                        let seen = self.visible_of(u, ranges, &v.e, arc)?;
+                        let lit = side_arc_in(&u.seg, tables, &v.l).meet(&u.seg.floor);
                         let vi = seen.arc.meet(&lit);
                         let lit_len = self.end_interval(u, &v.l, &vi, v.e.p.p);
                         let lit_along = meet(seen.along, lit_len);
-                        let l_vi: f64 = sl.ranges.iter().map(|&r| overlap(r, lit_along)).sum();
+                        let l_vi: f64 = ranges.iter().map(|&r| overlap(r, lit_along)).sum();
                         Some(l_vi * projected_width(u.seg.radius, &vi, v.e.p.p))
                     })
                     .sum();
