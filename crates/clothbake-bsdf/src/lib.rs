@@ -9,8 +9,11 @@
 //!
 //! Conventions: local frame with +X the weft direction, +Y the warp direction, +Z the macro
 //! normal; `wi` points toward the light, `wo` toward the eye, both unit vectors
-//! ([`UnitVec3`]); values are linear RGB. Directions at or below the horizon
-//! (cos theta <= [`HORIZON_COS`]) reflect nothing.
+//! ([`UnitVec3`]); values are linear RGB. A one-faced cloth (the thesis's, over its floor)
+//! reflects nothing at or below the horizon (cos theta <= [`HORIZON_COS`]); a two-faced one
+//! (docs/transmission.md) also reflects from its back (-Z) and transmits, and passes light
+//! straight through its gaps ([`Bsdf::openness`]); within [`HORIZON_COS`] of the plane every
+//! direction gives zero.
 
 pub mod vec3;
 
@@ -162,9 +165,20 @@ impl Local {
 /// A bidirectional reflectance distribution: f_r, a sampler of incident directions and its
 /// density, on local-frame unit directions.
 pub trait Bsdf: Sync {
-    /// f_r(wi, wo) in 1/sr, RGB; zero when either direction is at or below the horizon. For
-    /// cloth, the average over the weave period (eq. 4.11).
+    /// f(wi, wo) in 1/sr, RGB, over the whole sphere: reflection where `wi` and `wo` are on
+    /// the same side of the cloth, transmission where they are on opposite sides (the
+    /// straight-through part excluded: [`Bsdf::openness`]). A one-faced reflectance gives zero
+    /// unless both are above the horizon. For cloth, the average over the weave period
+    /// (eq. 4.11).
     fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb;
+
+    /// The share of the light arriving from `wi` (from either side) that passes through the
+    /// cloth's gaps without meeting a yarn and leaves toward `-wi`: a delta lobe beside
+    /// [`Bsdf::f`]. The default is opaque: 0.
+    fn openness(&self, wi: UnitVec3) -> f64 {
+        let _ = wi;
+        0.0
+    }
 
     /// [`Bsdf::f`] of each pair (light, eye): `out[k]` is `f(pairs[k])`, bit for bit. The
     /// default evaluates them one by one; a BSDF that evaluates several pairs faster at once

@@ -132,6 +132,22 @@ impl UnitVec3 {
     pub fn above_horizon(self) -> bool {
         self.0.z > HORIZON_COS
     }
+    /// True when the direction is below the horizon, on the cloth's back: cos(theta) <
+    /// -[`HORIZON_COS`].
+    #[inline]
+    pub fn below_horizon(self) -> bool {
+        self.0.z < -HORIZON_COS
+    }
+    /// The opposite direction.
+    #[inline]
+    pub fn reverse(self) -> Self {
+        UnitVec3(Vec3::new(-self.0.x, -self.0.y, -self.0.z))
+    }
+    /// Mirror image under z -> -z: a direction of the back seen in the front's frame.
+    #[inline]
+    pub fn mirror_z(self) -> Self {
+        UnitVec3(Vec3::new(self.0.x, self.0.y, -self.0.z))
+    }
     /// Mirror image under x -> -x.
     #[inline]
     pub fn mirror_x(self) -> Self {
