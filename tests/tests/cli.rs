@@ -146,13 +146,15 @@ fn shipped_tables_use_the_thesis_material() {
         albedo: [DEFAULT_ALBEDO; 3],
         specular: DEFAULT_SPECULAR,
         exponent: DEFAULT_EXPONENT,
+        translucency: 0.0,
     };
     assert_eq!(
         thesis,
         Material {
             albedo: [0.4; 3],
             specular: 0.3,
-            exponent: 10.0
+            exponent: 10.0,
+            translucency: 0.0,
         }
     );
     for Shipped {

@@ -28,5 +28,6 @@ pub mod shard;
 pub mod spatial;
 pub mod sweep;
 pub mod transport;
+pub mod two_faced;
 
 pub use sweep::*;

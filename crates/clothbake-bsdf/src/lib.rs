@@ -27,7 +27,8 @@ pub type Rgb = [f64; 3];
 /// An incident direction drawn by [`Bsdf::sample`], with f_r and the density there.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BsdfSample {
-    /// The sampled incident direction (toward the light), above the horizon.
+    /// The sampled incident direction (toward the light): above the horizon, or on either
+    /// side for a two-faced cloth.
     pub wi: UnitVec3,
     /// f_r(wi, wo) in 1/sr.
     pub f: Rgb,
@@ -36,9 +37,9 @@ pub struct BsdfSample {
 }
 
 impl BsdfSample {
-    /// The estimator's weight f_r(wi, wo) cos(theta_i) / pdf.
+    /// The estimator's weight f(wi, wo) |cos(theta_i)| / pdf.
     pub fn weight(&self) -> Rgb {
-        let c = self.wi.cos_theta() / self.pdf;
+        let c = self.wi.cos_theta().abs() / self.pdf;
         self.f.map(|f| f * c)
     }
 }

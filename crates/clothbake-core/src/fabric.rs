@@ -91,6 +91,8 @@ pub enum Field {
     Specular,
     /// The group material's specular exponent.
     Exponent,
+    /// The group material's translucency.
+    Translucency,
 }
 
 /// How a source names the fields of its fabric in error messages (each format its own way).
@@ -121,6 +123,7 @@ impl Naming for PlainNaming<'_> {
             Field::Albedo(k) => format!("{g}.material.albedo[{k}]"),
             Field::Specular => format!("{g}.material.specular"),
             Field::Exponent => format!("{g}.material.exponent"),
+            Field::Translucency => format!("{g}.material.translucency"),
         }
     }
 }
@@ -163,6 +166,8 @@ struct MaterialFile {
     specular: Option<f64>,
     #[serde(default)]
     exponent: Option<f64>,
+    #[serde(default)]
+    translucency: Option<f64>,
 }
 
 struct Ctx<'a> {
@@ -410,6 +415,10 @@ impl Fabric {
                     "exponent": g.material.exponent,
                 },
             });
+            // Written only when set, so that the tables of opaque yarns keep their headers.
+            if g.material.translucency > 0.0 {
+                v["material"]["translucency"] = g.material.translucency.into();
+            }
             if g.threads.iter().all(|y| y.segment_length.is_some()) {
                 v["segment_length"] = col(|y| y.segment_length.unwrap_or(0.0));
             }
@@ -496,6 +505,22 @@ impl Fabric {
             },
             &PlainNaming("the material options"),
         )
+    }
+
+    /// The fabric's back seen from below, as a fabric of its own: the weave inverted
+    /// ([`Weave::inverted`]), the same threads (the two-faced cloth mirrors the back's floats
+    /// below z = 0, so from below their axes stand at the threads' heights;
+    /// docs/transmission.md). An error where the inverted weave's floats do not fit the
+    /// threads' given segment lengths.
+    pub fn back(&self) -> Result<Fabric, FabricError> {
+        Fabric::new(
+            format!("{} (back)", self.name),
+            self.weave.inverted(),
+            self.warp.clone(),
+            self.weft.clone(),
+            &PlainNaming("the fabric's back"),
+        )
+        .map(|f| f.with_notes(self.notes.clone()))
     }
 
     /// The facet material of thread `thread` of group `g`: the group's material with the
@@ -632,6 +657,13 @@ impl Fabric {
                 "give a non-negative specular exponent n (cloth: 6 to 15)",
             ));
         }
+        if !(0.0..=1.0).contains(&m.translucency) {
+            return Err(err(
+                naming.field(g, Field::Translucency, 0),
+                format!("is {}, outside [0, 1]", m.translucency),
+                "give a translucency between 0 (opaque yarn) and 1 (no absorption)",
+            ));
+        }
         Ok(())
     }
 
@@ -746,6 +778,7 @@ impl Naming for JsonNaming<'_> {
             }
             Field::Specular => format!("{name}.material.specular"),
             Field::Exponent => format!("{name}.material.exponent"),
+            Field::Translucency => format!("{name}.material.translucency"),
             Field::Pattern => unreachable!("named above"),
         }
     }
@@ -812,6 +845,9 @@ fn material(cx: &Ctx<'_>, name: &str, m: Option<&MaterialFile>) -> Result<Materi
     }
     if let Some(n) = m.exponent {
         out.exponent = n;
+    }
+    if let Some(t) = m.translucency {
+        out.translucency = t;
     }
     Ok(out)
 }

@@ -197,6 +197,7 @@ mod tests {
                 albedo: [0.5; 3],
                 specular: 0.7,
                 exponent,
+                translucency: 0.0,
             };
             let n = UnitVec3::from_degrees(n.0, n.1).get();
             let l = UnitVec3::from_degrees(l.0, l.1).get();
@@ -220,6 +221,7 @@ mod tests {
             albedo: [0.0; 3],
             specular: 1.0,
             exponent: 7.0,
+            translucency: 0.0,
         };
         let n = Vec3::new(0.0, 0.0, 1.0);
         let (nt, np) = (400, 64);

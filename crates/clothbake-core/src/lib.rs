@@ -16,6 +16,7 @@ pub mod facet;
 pub mod geometry;
 pub mod interreflection;
 pub mod lanes;
+pub mod openness;
 pub mod point;
 pub mod quad;
 pub mod reflect;
@@ -38,7 +39,9 @@ pub use analytic::{
 };
 pub use brdf::{AnalyticBsdf, Component};
 pub use cells::{Cell, CellGrid, PeriodPoint};
-pub use clothbake_bsdf::{vec3, Bsdf, BsdfSample, Footprint, FromFn, Level, Local, Rgb};
+pub use clothbake_bsdf::{
+    cosine_sample, vec3, Bsdf, BsdfSample, Footprint, FromFn, Level, Local, Rgb,
+};
 pub use fabric::{Fabric, FabricError, Field, Naming, PlainNaming};
 pub use facet::{Facet, FacetIntensity, FacetModel};
 pub use geometry::Geometry;

@@ -62,6 +62,16 @@ impl Weave {
         })
     }
 
+    /// The weave seen from the back: every crossing flipped (the back of a 2/1 twill is a
+    /// 1/2 twill, of a warp-faced satin a weft-faced one).
+    pub fn inverted(&self) -> Weave {
+        Weave {
+            rows: self.rows,
+            cols: self.cols,
+            warp_over: self.warp_over.iter().map(|&o| !o).collect(),
+        }
+    }
+
     /// Number of weft threads (rows) in the period.
     pub fn n_weft(&self) -> usize {
         self.rows

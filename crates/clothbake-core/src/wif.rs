@@ -891,9 +891,11 @@ impl Naming for WifNaming<'_> {
             Field::Pattern => "[WARP] Threads / [WEFT] Threads".into(),
             Field::Radius => format!("[{s}] Thickness (thread {t})"),
             Field::Spacing => format!("[{s}] Spacing (thread {t})"),
-            Field::Height | Field::SegmentLength | Field::Specular | Field::Exponent => {
-                PlainNaming(self.0).field(g, field, thread)
-            }
+            Field::Height
+            | Field::SegmentLength
+            | Field::Specular
+            | Field::Exponent
+            | Field::Translucency => PlainNaming(self.0).field(g, field, thread),
             Field::ThreadAlbedo(_) | Field::Albedo(_) => format!("[{s} COLORS] (thread {t})"),
         }
     }

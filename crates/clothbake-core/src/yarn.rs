@@ -27,6 +27,23 @@ pub struct Material {
     pub specular: f64,
     /// Specular exponent n >= 0.
     pub exponent: f64,
+    /// Translucency tau in [0, 1]: the share of the light a facet does not reflect
+    /// (1 - rho_d - rho_s) that passes through the yarn ([`Material::transmittance`]); the
+    /// rest is absorbed. 0, the thesis's, absorbs it all. Only the two-faced cloth (no floor,
+    /// docs/transmission.md) shows it.
+    pub translucency: f64,
+}
+
+impl Material {
+    /// The diffuse transmittance t of a facet per RGB channel: the share of the light that
+    /// enters the yarn at a point and leaves it diffusely (Lambertian) from the other end of the
+    /// chord through the yarn's axis, t = tau (1 - rho_d - rho_s) (clamped at 0) with tau the
+    /// [`Material::translucency`]. With Lewis facets the reflected share is at most
+    /// rho_d + rho_s, so R + t <= 1 at every incident direction, and the absorbed share
+    /// (1 - tau)(1 - rho_d - rho_s) goes to 0 as tau goes to 1 (docs/transmission.md).
+    pub fn transmittance(&self, albedo: [f64; 3]) -> [f64; 3] {
+        albedo.map(|a| self.translucency * (1.0 - a - self.specular).max(0.0))
+    }
 }
 
 impl Default for Material {
@@ -35,6 +52,7 @@ impl Default for Material {
             albedo: [DEFAULT_ALBEDO; 3],
             specular: DEFAULT_SPECULAR,
             exponent: DEFAULT_EXPONENT,
+            translucency: 0.0,
         }
     }
 }

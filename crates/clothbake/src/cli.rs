@@ -491,13 +491,22 @@ pub struct EvalArgs {
     #[arg(long, value_name = "FILE")]
     pub weave: PathBuf,
 
-    /// Direction toward the light, in degrees: theta from +Z (0 to 90), phi from +X toward +Y.
-    #[arg(long, value_name = "THETA,PHI", value_parser = parse_direction, allow_hyphen_values = true)]
+    /// Direction toward the light, in degrees: theta from +Z (0 to 90; to 180 with --faces
+    /// two, the light behind the cloth), phi from +X toward +Y.
+    #[arg(long, value_name = "THETA,PHI", value_parser = parse_sphere_direction, allow_hyphen_values = true)]
     pub wi: Direction,
 
-    /// Direction toward the eye, in degrees: theta from +Z (0 to 90), phi from +X toward +Y.
-    #[arg(long, value_name = "THETA,PHI", value_parser = parse_direction, allow_hyphen_values = true)]
+    /// Direction toward the eye, in degrees: theta from +Z (0 to 90; to 180 with --faces two,
+    /// the eye behind the cloth), phi from +X toward +Y.
+    #[arg(long, value_name = "THETA,PHI", value_parser = parse_sphere_direction, allow_hyphen_values = true)]
     pub wo: Direction,
+
+    /// The cloth: `one` face over the thesis's opaque floor (reflection only), or `two` faces
+    /// and no floor: light through the gaps and translucent yarns, the back the inverted weave
+    /// (docs/transmission.md). With `two`, f covers the whole sphere and every bounce, and the
+    /// report adds the openness along --wi.
+    #[arg(long, value_enum, default_value_t = Faces::One)]
+    pub faces: Faces,
 
     /// Analytic model (thesis ch. 3-4) or the ray-traced ground truth of the same geometry.
     #[arg(long, value_enum, default_value_t = Method::Analytic)]
@@ -571,6 +580,11 @@ pub struct MaterialArgs {
     /// Specular exponent n >= 0 (cloth: 6 to 15).
     #[arg(long, value_name = "N", value_parser = parse_exponent, allow_hyphen_values = true)]
     pub exponent: Option<f64>,
+
+    /// Translucency tau in [0, 1]: the share of the light a facet does not reflect that passes
+    /// through the yarn; only the two-faced cloth shows it (docs/transmission.md).
+    #[arg(long, value_name = "X", value_parser = parse_translucency, allow_hyphen_values = true)]
+    pub translucency: Option<f64>,
 }
 
 /// Yarn sizes for a WIF draft, in place of its `[WARP]` / `[WEFT]` sizes (docs/wif.md).
@@ -611,6 +625,15 @@ pub fn parse_length(s: &str) -> Result<f64, String> {
         return Err(format!("length {x} is not positive; {FIX}"));
     }
     Ok(x)
+}
+
+/// Which cloth: the thesis's over its floor, or the two-faced one (docs/transmission.md).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Faces {
+    /// One face over the thesis's opaque floor.
+    One,
+    /// Two faces, no floor: light through the gaps and the yarns.
+    Two,
 }
 
 /// How to compute the reflection.
@@ -813,7 +836,7 @@ impl From<KernelArg> for Kernel {
 /// A direction given on the command line, in degrees.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Direction {
-    /// Polar angle from +Z, in [0, 90].
+    /// Polar angle from +Z, in [0, 90] (to 180 where a command takes the whole sphere).
     pub theta: f64,
     /// Azimuth from +X toward +Y, any finite value.
     pub phi: f64,
@@ -829,6 +852,19 @@ impl Direction {
     pub fn above_horizon(self) -> bool {
         self.theta < 90.0
     }
+
+    /// An error unless theta lies in [0, 90] (a cloth over its floor has nothing below).
+    pub fn check_upper(self) -> Result<(), String> {
+        if (0.0..=90.0).contains(&self.theta) {
+            return Ok(());
+        }
+        Err(format!(
+            "theta {} is outside [0, 90]; give the polar angle from the normal +Z, 0 (overhead) \
+             to 90 (horizon): directions below the surface need the two-faced cloth \
+             (eval --faces two)",
+            self.theta
+        ))
+    }
 }
 
 fn number(s: &str, what: &str) -> Result<f64, String> {
@@ -840,8 +876,18 @@ fn number(s: &str, what: &str) -> Result<f64, String> {
     }
 }
 
+/// Parses `THETA,PHI` in degrees; theta must lie in [0, 180] (the commands that take only the
+/// upper hemisphere check [`Direction::check_upper`]).
+pub fn parse_sphere_direction(s: &str) -> Result<Direction, String> {
+    direction(s, 180.0)
+}
+
 /// Parses `THETA,PHI` in degrees; theta must lie in [0, 90].
 pub fn parse_direction(s: &str) -> Result<Direction, String> {
+    direction(s, 90.0)
+}
+
+fn direction(s: &str, max: f64) -> Result<Direction, String> {
     const FIX: &str =
         "write THETA,PHI in degrees, e.g. 45,90 (theta from +Z, 0 to 90; phi from +X toward +Y)";
     let parts: Vec<&str> = s.split(',').collect();
@@ -857,13 +903,17 @@ pub fn parse_direction(s: &str) -> Result<Direction, String> {
     };
     let theta = number(t, "theta").map_err(|e| format!("{e}; {FIX}"))?;
     let phi = number(p, "phi").map_err(|e| format!("{e}; {FIX}"))?;
-    if !(0.0..=90.0).contains(&theta) {
+    let d = Direction { theta, phi };
+    if max > 90.0 && !(0.0..=max).contains(&theta) {
         return Err(format!(
-            "theta {theta} is outside [0, 90]; give the polar angle from the normal +Z, \
-             0 (overhead) to 90 (horizon): directions below the surface are not supported"
+            "theta {theta} is outside [0, 90] (or [0, 180] with --faces two); give the polar \
+             angle from the normal +Z, 0 (overhead) to 90 (horizon), past 90 behind the cloth"
         ));
     }
-    Ok(Direction { theta, phi })
+    if max <= 90.0 {
+        d.check_upper()?;
+    }
+    Ok(d)
 }
 
 /// Parses a point of the weave period, `U,V` in period fractions.
@@ -935,6 +985,15 @@ pub fn parse_specular(s: &str) -> Result<f64, String> {
         s,
         "specular",
         "give a specular coefficient rho_s between 0 and 1, e.g. 0.3",
+    )
+}
+
+/// Parses a translucency in [0, 1].
+pub fn parse_translucency(s: &str) -> Result<f64, String> {
+    unit_interval(
+        s,
+        "translucency",
+        "give a translucency between 0 (opaque yarn) and 1 (no absorption), e.g. 0.5",
     )
 }
 

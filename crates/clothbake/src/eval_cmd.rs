@@ -1,6 +1,6 @@
 //! `clothbake eval`: the reflection of a fabric for one light and one eye direction.
 
-use crate::cli::{DraftArgs, EvalArgs, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
+use crate::cli::{DraftArgs, EvalArgs, Faces, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
 use crate::report::{self, Report};
 use clothbake_core::interreflection::Ranges;
@@ -14,6 +14,13 @@ use std::path::Path;
 
 /// Runs `clothbake eval` and returns the text to print on stdout.
 pub fn run(args: &EvalArgs) -> Result<String, CliError> {
+    if args.faces == Faces::Two {
+        return crate::two_faced_cmd::run(args);
+    }
+    for (flag, d) in [("--wi", args.wi), ("--wo", args.wo)] {
+        d.check_upper()
+            .map_err(|e| CliError::line(format!("{flag}: {e}")))?;
+    }
     let full = args.bounces.bounces > 2;
     if args.method == Method::Analytic && !full && (args.samples.is_some() || args.seed.is_some()) {
         return Err(CliError::new(
@@ -317,7 +324,11 @@ pub fn load_fabric(weave: &Path, draft: &DraftArgs, m: &MaterialArgs) -> Result<
 /// given keep each group's value from the file. `--albedo` also replaces per-thread albedos.
 /// (The values were range-checked by the parsers.)
 pub fn apply_material(fabric: Fabric, m: &MaterialArgs) -> Result<Fabric, FabricError> {
-    if m.albedo.is_none() && m.specular.is_none() && m.exponent.is_none() {
+    if m.albedo.is_none()
+        && m.specular.is_none()
+        && m.exponent.is_none()
+        && m.translucency.is_none()
+    {
         return Ok(fabric);
     }
     fabric.with_groups(
@@ -331,6 +342,9 @@ pub fn apply_material(fabric: Fabric, m: &MaterialArgs) -> Result<Fabric, Fabric
             }
             if let Some(n) = m.exponent {
                 g.material.exponent = n;
+            }
+            if let Some(t) = m.translucency {
+                g.material.translucency = t;
             }
         },
         &PlainNaming("the material options"),
@@ -355,10 +369,12 @@ mod tests {
             albedo: Some([0.1, 0.2, 0.3]),
             specular: None,
             exponent: Some(4.0),
+            translucency: Some(0.5),
         };
         let f = apply_material(f, &m).unwrap();
         assert_eq!(f.warp().material.albedo, [0.1, 0.2, 0.3]);
         assert_eq!(f.weft().material.exponent, 4.0);
+        assert_eq!(f.weft().material.translucency, 0.5);
         assert_eq!(f.warp().material.specular, 0.1);
         assert_eq!(f.weft().material.specular, 0.2);
     }

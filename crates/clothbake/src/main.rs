@@ -17,6 +17,7 @@ mod merge_cmd;
 mod render_cmd;
 mod report;
 mod signals;
+mod two_faced_cmd;
 
 use clap::error::{ContextKind, ErrorKind};
 use clap::FromArgMatches;

@@ -270,6 +270,7 @@ mod tests {
             albedo: [0.4; 3],
             specular: 0.7,
             exponent: n,
+            translucency: 0.0,
         };
         Pair {
             r1: 1.0,

@@ -3,7 +3,7 @@
 //! 2-D DDA that visits, in order, every cell of the unbounded tiling a ray's xy path crosses).
 
 use super::intersect::{LocalRay, SegmentShape, Surface};
-use super::yarns::Yarns;
+use super::yarns::{Face, Yarns};
 use crate::vec3::Vec3;
 use crate::weave::Group;
 
@@ -127,6 +127,8 @@ impl Prim {
             }
             Surface::CapLo => (0.0, -1.0, 0.0),
             Surface::CapHi => (0.0, 1.0, 0.0),
+            Surface::Cut if s.face == Face::Back => (0.0, 0.0, 1.0),
+            Surface::Cut => (0.0, 0.0, -1.0),
         };
         if self.warp {
             Vec3::new(nu, nv, nz)
@@ -239,6 +241,7 @@ impl CellIndex {
                             height: s.height,
                             radius: s.radius,
                             extent: s.extent.map(|(lo, hi)| (lo + off_l, hi + off_l)),
+                            face: s.face,
                         },
                         shift,
                     });

@@ -6,6 +6,7 @@
 
 use super::facets::Terms;
 use super::raytracer::RayTracer;
+use super::yarns::Yarns;
 use crate::fabric::Fabric;
 use crate::facet::FacetModel;
 use crate::weave::{Group, Weave};
@@ -19,6 +20,8 @@ pub struct Finish {
     pub specular: f64,
     /// Specular exponent n.
     pub exponent: f64,
+    /// Diffuse transmittance through the yarn, RGB (docs/transmission.md; 0 for opaque yarn).
+    pub transmittance: [f64; 3],
 }
 
 /// One thread of the period, as described (lengths in the fabric's unit).
@@ -56,16 +59,20 @@ impl Description {
             group
                 .threads
                 .iter()
-                .map(|y| Thread {
-                    radius: y.radius,
-                    height: y.height,
-                    spacing: y.spacing,
-                    length: y.segment_length,
-                    finish: Finish {
-                        albedo: y.albedo.unwrap_or(group.material.albedo),
-                        specular: group.material.specular,
-                        exponent: group.material.exponent,
-                    },
+                .map(|y| {
+                    let albedo = y.albedo.unwrap_or(group.material.albedo);
+                    Thread {
+                        radius: y.radius,
+                        height: y.height,
+                        spacing: y.spacing,
+                        length: y.segment_length,
+                        finish: Finish {
+                            albedo,
+                            specular: group.material.specular,
+                            exponent: group.material.exponent,
+                            transmittance: group.material.transmittance(albedo),
+                        },
+                    }
                 })
                 .collect()
         };
@@ -100,5 +107,17 @@ impl RayTracer {
     /// shading with the facet terms named by `facet`.
     pub fn new(fabric: &Fabric, facet: FacetModel) -> RayTracer {
         RayTracer::from_description(&Description::of(fabric), Terms::of(facet))
+    }
+
+    /// The tracer of the fabric's two-faced cloth (docs/transmission.md): its front as
+    /// [`RayTracer::new`] builds it, its back the inverted weave mirrored below z = 0, no
+    /// floor, every surface shaded (caps and the flat undersides included) and translucent
+    /// yarns transmitting.
+    pub fn two_faced(fabric: &Fabric, facet: FacetModel) -> RayTracer {
+        RayTracer::from_yarns(
+            Yarns::build_two_faced(&Description::of(fabric)),
+            Terms::of(facet),
+        )
+        .with_caps(super::raytracer::Caps::Shaded)
     }
 }

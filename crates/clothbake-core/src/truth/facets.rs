@@ -107,6 +107,7 @@ mod tests {
             albedo: [0.4; 3],
             specular,
             exponent,
+            transmittance: [0.0; 3],
         }
     }
 
@@ -194,6 +195,7 @@ mod tests {
                 albedo: f.albedo,
                 specular: f.specular,
                 exponent,
+                translucency: 0.0,
             };
             let mut d = || dir(100.0 * rng.next_f64(), 360.0 * rng.next_f64());
             let (n, l, e) = (d(), d(), d());

@@ -1,6 +1,9 @@
 //! Ray-solid intersection of one yarn segment: the infinite cylinder's interval, the slab
-//! between the end-cap planes, the floor's half-space, and the entry point of their
-//! intersection (which surface a ray enters through).
+//! between the end-cap planes, the half-space the plane z = 0 cuts (the floor's, or a face's
+//! of the two-faced cloth), and the entry point of their intersection (which surface a ray
+//! enters through).
+
+use super::yarns::Face;
 
 /// Which surface of a segment a ray enters through.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -11,6 +14,9 @@ pub enum Surface {
     CapLo,
     /// The end cap at the high end of the extent (outward normal: plus the axis direction).
     CapHi,
+    /// The flat face in the plane z = 0 of a two-faced cloth's segment (outward normal: -Z on
+    /// the front, +Z on the back).
+    Cut,
 }
 
 /// Parameter interval `(t_in, t_out)` in which the line `o + t d` lies inside the infinite
@@ -88,7 +94,8 @@ impl LocalRay {
 }
 
 /// The solid of one segment in its own frame: the cylinder about the axis at u = `axis`, z =
-/// `height`, within `extent` along v (`None`: endless), cut by the floor (z >= 0).
+/// `height`, within `extent` along v (`None`: endless), cut by the plane z = 0 (kept: z >= 0
+/// over the floor and on the front, z <= 0 on the back).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SegmentShape {
     /// Across coordinate of the axis.
@@ -99,13 +106,16 @@ pub struct SegmentShape {
     pub radius: f64,
     /// Extent along the axis, `None` when endless.
     pub extent: Option<(f64, f64)>,
+    /// The side of z = 0 it lies on, and whether that plane is the floor.
+    pub face: Face,
 }
 
 /// The first point where the ray enters the segment's solid with `t_min < t < t_max`, and the
 /// surface it enters through. The solid is the intersection of three convex sets (infinite
 /// cylinder, cap slab, half-space z >= 0), so the ray enters it at the last of their entries
 /// and must do so before the first of their exits. An entry through the floor plane (a ray
-/// coming from below the floor) is the floor's hit, not the yarn's, and gives `None`.
+/// coming from below the floor) is the floor's hit, not the yarn's, and gives `None`; on a
+/// two-faced cloth the plane z = 0 is the segment's flat face, [`Surface::Cut`].
 #[inline]
 pub fn segment_entry(
     ray: &LocalRay,
@@ -141,15 +151,38 @@ pub fn segment_entry(
         }
         t_out = t_out.min(b);
     }
-    // Half-space z >= 0.
-    if dz < 0.0 {
-        t_out = t_out.min(-oz / dz);
-    } else if dz > 0.0 {
-        if -oz / dz > t_in {
-            return None;
+    match s.face {
+        // Half-space z >= 0 over the floor.
+        Face::OverFloor => {
+            if dz < 0.0 {
+                t_out = t_out.min(-oz / dz);
+            } else if dz > 0.0 {
+                if -oz / dz > t_in {
+                    return None;
+                }
+            } else if oz < 0.0 {
+                return None;
+            }
         }
-    } else if oz < 0.0 {
-        return None;
+        // Half-space z >= 0 (front) or z <= 0 (back), entered through its flat face.
+        Face::Front | Face::Back => {
+            let (z, dzs) = if s.face == Face::Front {
+                (oz, dz)
+            } else {
+                (-oz, -dz)
+            };
+            if dzs < 0.0 {
+                t_out = t_out.min(-z / dzs);
+            } else if dzs > 0.0 {
+                let t_cut = -z / dzs;
+                if t_cut > t_in {
+                    t_in = t_cut;
+                    surface = Surface::Cut;
+                }
+            } else if z < 0.0 {
+                return None;
+            }
+        }
     }
     (t_in < t_out && t_in > t_min && t_in < t_max).then_some((t_in, surface))
 }

@@ -14,7 +14,9 @@
 //! * [`estimate`]: the batch ratio estimator and its standard error;
 //! * [`raytracer`]: [`RayTracer`], the direct reflection (eq. 4.11's average);
 //! * [`patches`]: the same estimate resolved per crossing cell of the period;
-//! * [`pathtracer`]: [`PathOptions`], [`PathEstimate`], every bounce order.
+//! * [`pathtracer`]: [`PathOptions`], [`PathEstimate`], every bounce order;
+//! * [`transmission`]: the two-faced cloth (no floor, translucent yarns): openness, where the
+//!   light goes ([`Scattering`]) and f over the whole sphere.
 //!
 //! Imports from the rest of the crate are limited to `crate::vec3`, `crate::rng`,
 //! `crate::weave` (the pattern type), and the plain output types `crate::reflect::Reflection`
@@ -30,6 +32,7 @@ pub mod intersect;
 pub mod patches;
 pub mod pathtracer;
 pub mod raytracer;
+pub mod transmission;
 pub mod yarns;
 
 pub use description::{Description, Finish, Thread};
@@ -38,7 +41,8 @@ pub use facets::{Shading, Terms};
 pub use patches::CellEstimate;
 pub use pathtracer::{PathEstimate, PathOptions};
 pub use raytracer::{Caps, RayTracer};
-pub use yarns::{Cylinder, Yarns};
+pub use transmission::Scattering;
+pub use yarns::{Cylinder, Face, Yarns};
 
 #[cfg(test)]
 mod tests {

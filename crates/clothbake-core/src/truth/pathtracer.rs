@@ -100,7 +100,7 @@ struct Acc {
 }
 
 /// A direction uniform over the hemisphere around `n`.
-fn uniform_hemisphere(n: Vec3, u1: f64, u2: f64) -> Vec3 {
+pub(crate) fn uniform_hemisphere(n: Vec3, u1: f64, u2: f64) -> Vec3 {
     let z = u1;
     let r = (1.0 - z * z).max(0.0).sqrt();
     let phi = 2.0 * PI * u2;
@@ -275,11 +275,7 @@ impl RayTracer {
                 break;
             }
             let pos = at.point;
-            let t_max = if w.z > 0.0 {
-                (self.z_top - pos.z) / w.z
-            } else {
-                pos.z / -w.z
-            };
+            let t_max = self.t_out(pos, w);
             let Some(h) = self.trace(pos, w, 0.0, t_max, false, Some(at.key)) else {
                 break;
             };

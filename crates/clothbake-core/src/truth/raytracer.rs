@@ -85,6 +85,8 @@ pub(crate) struct Contact {
     pub(crate) seg: u32,
     /// Identity of the physical segment copy (to skip it when leaving the surface).
     pub(crate) key: (u32, i64, i64),
+    /// The surface the point lies on.
+    pub(crate) surface: Surface,
 }
 
 /// The exact orthographic ray caster of a fabric's micro-geometry (the ground truth).
@@ -96,6 +98,8 @@ pub struct RayTracer {
     pub(crate) cells: CellIndex,
     /// Height of the plane the primary rays start from, just above the highest yarn.
     pub(crate) z_top: f64,
+    /// The floor z = 0, or on a two-faced cloth a plane just below the lowest yarn.
+    pub(crate) z_bottom: f64,
 }
 
 impl RayTracer {
@@ -110,12 +114,19 @@ impl RayTracer {
         let cells = CellIndex::new(&yarns);
         let top = yarns.top();
         let z_top = top + 1e-6 * top.max(1e-3);
+        let z_bottom = if yarns.two_faced() {
+            let b = -yarns.bottom();
+            -(b + 1e-6 * b.max(1e-3))
+        } else {
+            0.0
+        };
         RayTracer {
             yarns,
             terms,
             caps: Caps::default(),
             cells,
             z_top,
+            z_bottom,
         }
     }
 
@@ -193,6 +204,7 @@ impl RayTracer {
             normal: p.normal(local, h.surface),
             seg: p.seg,
             key: p.copy_key(h.tile.0, h.tile.1),
+            surface: h.surface,
         }
     }
 
@@ -201,17 +213,29 @@ impl RayTracer {
         &self.yarns.cylinders[c.seg as usize]
     }
 
-    /// Whether the ray from the contact toward the light `wi` leaves the top plane unblocked.
+    /// Whether the ray from the contact toward the light `wi` leaves the cloth unblocked
+    /// (through the top plane, or the bottom one on a two-faced cloth lit from below).
     pub(crate) fn lit(&self, c: &Contact, wi: UnitVec3) -> bool {
-        let t_out = (self.z_top - c.point.z) / wi.z;
+        let t_out = self.t_out(c.point, wi.get());
         self.trace(c.point, wi.get(), 0.0, t_out, true, Some(c.key))
             .is_none()
+    }
+
+    /// The ray parameter at which `o + t d` leaves the slab between the bottom plane (the
+    /// floor, or below the two-faced cloth) and the top plane.
+    #[inline]
+    pub(crate) fn t_out(&self, o: Vec3, d: Vec3) -> f64 {
+        if d.z > 0.0 {
+            (self.z_top - o.z) / d.z
+        } else {
+            (o.z - self.z_bottom) / -d.z
+        }
     }
 
     /// The counted yarn hit of a ray from the top plane at `o` along `d`: `None` for the floor
     /// and, with [`Caps::Excluded`], for a cap.
     pub(crate) fn first_contact(&self, o: Vec3, d: Vec3) -> Option<Contact> {
-        let hit = self.trace(o, d, 0.0, o.z / -d.z, false, None)?;
+        let hit = self.trace(o, d, 0.0, self.t_out(o, d), false, None)?;
         if self.caps == Caps::Excluded && hit.surface != Surface::Side {
             return None;
         }
@@ -391,6 +415,7 @@ impl RayTracer {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::truth::Face;
 
     /// Asserts that `got`, channel `c` of `est`, is `want` within four standard errors plus
     /// 0.2% of `want` (the closed forms' own rounding is far below); returns that tolerance.
@@ -549,7 +574,9 @@ mod tests {
                     albedo: [0.4; 3],
                     specular: 0.0,
                     exponent: 10.0,
+                    transmittance: [0.0; 3],
                 },
+                face: Face::OverFloor,
             }],
         };
         let rt = RayTracer::from_yarns(yarns, Terms::Huo).with_caps(Caps::Shaded);
@@ -678,6 +705,7 @@ mod tests {
                 height: s.height,
                 radius: s.radius,
                 extent: s.extent,
+                face: s.face,
             };
             for i in -k..=k {
                 for j in -k..=k {

@@ -10,7 +10,10 @@
 //!   cyclically over the period) is one segment from the surface of crossing thread a-1 to that
 //!   of b+1, `[P_{a-1} + r_{a-1}, P_{b+1} - r_{b+1}]` in unwrapped coordinates, or a given
 //!   length centred in that room; a thread that is never under is one endless cylinder, one that
-//!   is never on top does not appear.
+//!   is never on top does not appear;
+//! * the two-faced cloth (docs/transmission.md) has no floor: its back is built by the same
+//!   rules from the inverted weave (a thread's floats under its crossing threads), mirrored
+//!   below z = 0 (axis at minus the thread's height, cut by z <= 0).
 
 use super::description::{Description, Finish, Thread};
 use crate::weave::Group;
@@ -32,6 +35,20 @@ pub struct Cylinder {
     pub extent: Option<(f64, f64)>,
     /// Facet material.
     pub finish: Finish,
+    /// The face it belongs to, and what the plane z = 0 is to it.
+    pub face: Face,
+}
+
+/// Which side of the plane z = 0 a segment lies on, and what that plane is to it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Face {
+    /// The thesis's cloth: above z = 0, which is the opaque floor.
+    OverFloor,
+    /// The two-faced cloth's front: above z = 0, its flat underside a surface of the yarn.
+    Front,
+    /// The two-faced cloth's back: below z = 0 (the inverted weave mirrored), its flat top a
+    /// surface of the yarn.
+    Back,
 }
 
 /// The segments of one period and the period's size.
@@ -84,49 +101,64 @@ impl<'a> Row<'a> {
 impl Yarns {
     /// The micro-geometry of a description.
     pub fn build(d: &Description) -> Yarns {
+        Yarns::faces(d, &[Face::OverFloor])
+    }
+
+    /// The two-faced cloth of a description: the front by the rules of [`Yarns::build`], the
+    /// back the floats of the inverted weave mirrored below z = 0; no floor.
+    pub fn build_two_faced(d: &Description) -> Yarns {
+        Yarns::faces(d, &[Face::Front, Face::Back])
+    }
+
+    fn faces(d: &Description, faces: &[Face]) -> Yarns {
         let warp = Row::new(&d.warp);
         let weft = Row::new(&d.weft);
         let mut cylinders = Vec::new();
-        for (group, own, crossing) in [(Group::Warp, &warp, &weft), (Group::Weft, &weft, &warp)] {
-            let n = crossing.threads.len();
-            for (t, thread) in own.threads.iter().enumerate() {
-                // on_top[c]: this thread lies over crossing thread c.
-                let on_top: Vec<bool> = (0..n)
+        for &face in faces {
+            let back = face == Face::Back;
+            for (group, own, crossing) in [(Group::Warp, &warp, &weft), (Group::Weft, &weft, &warp)]
+            {
+                let n = crossing.threads.len();
+                for (t, thread) in own.threads.iter().enumerate() {
+                    // on_top[c]: this thread lies over crossing thread c.
+                    let on_top: Vec<bool> = (0..n)
                     .map(|c| match group {
                         Group::Warp => d.weave.warp_over(t, c),
                         Group::Weft => !d.weave.warp_over(c, t),
-                    })
+                    } != back)
                     .collect();
-                let place = |extent| Cylinder {
-                    group,
-                    thread: t,
-                    axis: own.start[t],
-                    radius: thread.radius,
-                    height: thread.height,
-                    extent,
-                    finish: thread.finish,
-                };
-                if on_top.iter().all(|&o| o) {
-                    cylinders.push(place(None));
-                    continue;
-                }
-                for a in 0..n {
-                    // A float begins where the thread comes up from under the previous crossing.
-                    if !on_top[a] || on_top[(a + n - 1) % n] {
+                    let place = |extent| Cylinder {
+                        group,
+                        thread: t,
+                        axis: own.start[t],
+                        radius: thread.radius,
+                        height: if back { -thread.height } else { thread.height },
+                        extent,
+                        finish: thread.finish,
+                        face,
+                    };
+                    if on_top.iter().all(|&o| o) {
+                        cylinders.push(place(None));
                         continue;
                     }
-                    let len = (a..a + n).take_while(|&c| on_top[c % n]).count();
-                    let (before, p_before) = crossing.at(a as i64 - 1);
-                    let (after, p_after) = crossing.at((a + len) as i64);
-                    let (lo, hi) = (p_before + before.radius, p_after - after.radius);
-                    let extent = match thread.length {
-                        Some(l) => {
-                            let mid = 0.5 * (lo + hi);
-                            (mid - 0.5 * l, mid + 0.5 * l)
+                    for a in 0..n {
+                        // A float begins where the thread comes up from under the previous crossing.
+                        if !on_top[a] || on_top[(a + n - 1) % n] {
+                            continue;
                         }
-                        None => (lo, hi),
-                    };
-                    cylinders.push(place(Some(extent)));
+                        let len = (a..a + n).take_while(|&c| on_top[c % n]).count();
+                        let (before, p_before) = crossing.at(a as i64 - 1);
+                        let (after, p_after) = crossing.at((a + len) as i64);
+                        let (lo, hi) = (p_before + before.radius, p_after - after.radius);
+                        let extent = match thread.length {
+                            Some(l) => {
+                                let mid = 0.5 * (lo + hi);
+                                (mid - 0.5 * l, mid + 0.5 * l)
+                            }
+                            None => (lo, hi),
+                        };
+                        cylinders.push(place(Some(extent)));
+                    }
                 }
             }
         }
@@ -143,6 +175,20 @@ impl Yarns {
             .iter()
             .map(|c| c.height + c.radius)
             .fold(0.0, f64::max)
+    }
+
+    /// Lowest point of any yarn (0 over the floor or without yarns below z = 0).
+    pub fn bottom(&self) -> f64 {
+        self.cylinders
+            .iter()
+            .filter(|c| c.face == Face::Back)
+            .map(|c| c.height - c.radius)
+            .fold(0.0, f64::min)
+    }
+
+    /// Whether the cloth has two faces and no floor.
+    pub fn two_faced(&self) -> bool {
+        self.cylinders.iter().any(|c| c.face != Face::OverFloor)
     }
 }
 
