@@ -74,21 +74,21 @@ def room(xml, work, sensors):
         f.write(run(["oconv", rad], env=env, cwd=work))
     runs = 8
     rays = "".join("%g %g %g %g %g %g\n" % tuple(s) for s in sensors) * runs
+    # -u+: uncorrelated sampling, so each repeat of a sensor is an independent estimate.
+    out = run(
+        [
+            "rtrace", "-h", "-I", "-ab", "2", "-ad", "4096", "-aa", "0", "-as", "0",
+            "-lw", "1e-7", "-lr", "-10", "-ss", "64", "-st", "0", "-u+", oct_path,
+        ],
+        input=rays.encode(),
+        env=env,
+        cwd=work,
+    )
     values = []
-    for seed in range(1):
-        out = run(
-            [
-                "rtrace", "-h", "-I", "-ab", "2", "-ad", "4096", "-aa", "0", "-as", "0",
-                "-lw", "1e-7", "-lr", "-10", "-ss", "64", "-st", "0", "-u+", oct_path,
-            ],
-            input=rays.encode(),
-            env=env,
-            cwd=work,
-        )
-        for line in out.decode().split("\n"):
-            if line.strip():
-                r, g, b = map(float, line.split()[:3])
-                values.append((r + g + b) / 3.0)
+    for line in out.decode().split("\n"):
+        if line.strip():
+            r, g, b = map(float, line.split()[:3])
+            values.append((r + g + b) / 3.0)
     n = len(sensors)
     means, spreads = [], []
     for k in range(n):

@@ -293,6 +293,17 @@ impl Klems {
     }
 }
 
+/// The most memory [`evaluate`] and [`write_xml`] hold, in bytes, on `threads` threads: the
+/// four blocks (RGB, f64), the patches' directions and each thread's pairs and values.
+pub fn peak_bytes(threads: usize) -> u64 {
+    let blocks = 4 * (PATCHES * PATCHES * 24) as u64;
+    let k4 = (MAX_SAMPLES as u64).pow(4);
+    let directions = 2 * (PATCHES as u64) * (MAX_SAMPLES as u64).pow(2) * 24;
+    let per_thread = k4 * (48 + 24) + (PATCHES * 24) as u64;
+    let sheet = (DATASHEET_POINTS[0] * DATASHEET_POINTS[1] * (48 + 24)) as u64;
+    blocks * 2 + directions + threads as u64 * per_thread + sheet + (PATCHES * 16) as u64
+}
+
 /// Evaluations of f that [`evaluate`] makes with `samples` points across a patch.
 pub fn evaluations(samples: usize) -> u64 {
     4 * (PATCHES as u64).pow(2) * (samples as u64).pow(4)
