@@ -15,7 +15,7 @@
 //! it); under `CI` it runs and fails without it (`cargo xtask test` installs it).
 
 use clothbake_core::{Bsdf, Rgb, UnitVec3, Vec3};
-use clothbake_export::klems::{self, Block, Description, Patch, PATCHES};
+use clothbake_export::klems::{self, Block, Description, Patch};
 use clothbake_tests::fixtures::{self, succeeded, temp_dir};
 use clothbake_tests::probe::PYRADIANCE;
 use std::f64::consts::PI;
@@ -273,11 +273,10 @@ fn radiance_looks_up_each_block_where_clothbake_put_it() {
         let (x, y) = (want[7 * b + 1], want[7 * b + 2]);
         assert!((x - y).abs() > 0.05 * x, "{:?}: {x} {y}", Block::ALL[b]);
     }
-    let (fr, br) = (want[7 * 1 + 3], want[7 * 3 + 3]);
+    let (fr, br) = (want[7 + 3], want[7 * 3 + 3]);
     assert!((fr - br).abs() > 0.2 * fr, "{fr} {br}");
     assert_eq!(Block::ALL[1], Block::FrontReflection);
     assert_eq!(Block::ALL[3], Block::BackReflection);
     assert_eq!(want.len(), 4 * 7);
-    assert!(PATCHES == 145);
     std::fs::remove_dir_all(&dir).ok();
 }

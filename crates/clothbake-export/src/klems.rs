@@ -430,7 +430,11 @@ fn escape(s: &str) -> String {
 /// then the four blocks for "Visible" and for "Solar"), streamed; returns the bytes written.
 pub fn write_xml<W: Write>(w: &mut W, k: &Klems, d: &Description) -> io::Result<u64> {
     let mut w = Counting { w, n: 0 };
-    let comment = escape(&d.comment).replace("--", "- -");
+    // An XML comment holds no "--" and does not end in "-".
+    let mut comment = escape(&d.comment);
+    while comment.contains("--") {
+        comment = comment.replace("--", "- -");
+    }
     writeln!(w, r#"<?xml version="1.0" encoding="UTF-8"?>"#)?;
     writeln!(
         w,
