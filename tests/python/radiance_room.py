@@ -4,6 +4,7 @@
 Usage:
   python3 tests/python/radiance_room.py room SHADE.xml WORKDIR SENSORS
   python3 tests/python/radiance_room.py query SHADE.xml QUERIES
+  python3 tests/python/radiance_room.py check SHADE.xml
 
 room: a closed room, W x D x H = 4 x 5 x 3 m (Radiance's x across, y into the room, z up),
 whose wall y = 0 is one window filled by a BSDF material with SHADE.xml (its surface normal
@@ -20,6 +21,8 @@ its first direction as the outgoing vector and its second as the incident one): 
 [theta_out, phi_out, theta_in, phi_in] (degrees, in Radiance's BSDF frame: z the surface normal,
 y the up vector; vectors away from the surface) the CIE Y of the BSDF Radiance looks up, 1/sr.
 Prints a JSON list.
+
+check: Radiance's checkBSDF on the file; prints its report as it is.
 """
 
 import json
@@ -111,6 +114,9 @@ def query(xml, queries):
 if __name__ == "__main__":
     if sys.argv[1] == "room":
         room(sys.argv[2], sys.argv[3], json.loads(sys.argv[4]))
+    elif sys.argv[1] == "check":
+        bindir = radiance_bin()
+        sys.stdout.write(run([os.path.join(bindir, "checkBSDF"), sys.argv[2]]).decode())
     elif sys.argv[1] == "query":
         query(sys.argv[2], json.loads(sys.argv[3]))
     else:

@@ -278,5 +278,36 @@ fn radiance_looks_up_each_block_where_clothbake_put_it() {
     assert_eq!(Block::ALL[1], Block::FrontReflection);
     assert_eq!(Block::ALL[3], Block::BackReflection);
     assert_eq!(want.len(), 4 * 7);
+    // Radiance's checkBSDF swaps incident and outgoing vectors through its own reading of the
+    // file: the test cloth is reciprocal (and anisotropic), so with the conventions right each
+    // component's reciprocity error is nil; it names the front "Exterior".
+    let report = succeeded(
+        "radiance_room.py check",
+        &fixtures::python(SCRIPT, &["check", xml.to_str().unwrap()]),
+    );
+    eprintln!("{report}");
+    let errors = report.split("Reciprocity Error").nth(1).unwrap();
+    let mut rows = 0;
+    for line in errors.lines().skip(1).filter(|l| !l.trim().is_empty()) {
+        let cols: Vec<&str> = line.split('\t').collect();
+        let worst: f64 = cols.last().unwrap().trim().parse().unwrap();
+        assert!(worst < 0.5, "checkBSDF: {line}\n{report}");
+        rows += 1;
+    }
+    assert_eq!(rows, 3, "{report}");
+    let exterior = report
+        .lines()
+        .find(|l| l.starts_with("Exterior Refl"))
+        .unwrap();
+    let lambertian: f64 = exterior.split_whitespace().nth(2).unwrap().parse().unwrap();
+    // Radiance's Lambertian part of a matrix is its smallest entry times pi: of the front
+    // reflection 0.45 (1 - 0.3 X_i X_o + 0.3 (X_i + X_o)) at its smallest, well above the back's
+    // 0.25 times the same factor.
+    let interior = report
+        .lines()
+        .find(|l| l.starts_with("Interior Refl"))
+        .unwrap();
+    let back: f64 = interior.split_whitespace().nth(2).unwrap().parse().unwrap();
+    assert!((lambertian / back - 0.45 / 0.25).abs() < 0.01, "{report}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -428,6 +428,7 @@ fn escape(s: &str) -> String {
 
 /// Writes `k` as an LBNL/Radiance BSDF XML file (WindowElement / Optical / Layer: the basis,
 /// then the four blocks for "Visible" and for "Solar"), streamed; returns the bytes written.
+/// A value that is not finite is an `InvalidData` error naming its block and patches.
 pub fn write_xml<W: Write>(w: &mut W, k: &Klems, d: &Description) -> io::Result<u64> {
     let mut w = Counting { w, n: 0 };
     // An XML comment holds no "--" and does not end in "-".
@@ -511,6 +512,16 @@ pub fn write_xml<W: Write>(w: &mut W, k: &Klems, d: &Description) -> io::Result<
                         line.push_str(", ");
                     }
                     let v = band.of(m.get(o, i));
+                    if !v.is_finite() {
+                        return Err(io::Error::new(
+                            io::ErrorKind::InvalidData,
+                            format!(
+                                "the BSDF gave {v} in {} at outgoing patch {o}, incident patch \
+                                 {i}: a Klems file holds finite values only",
+                                b.direction_name()
+                            ),
+                        ));
+                    }
                     if v == 0.0 {
                         line.push('0');
                     } else {

@@ -392,3 +392,16 @@ fn the_xml_holds_the_basis_and_eight_matrices_in_row_order() {
         }
     }
 }
+
+#[test]
+fn a_value_that_is_not_finite_is_refused_with_its_place() {
+    let mut k = evaluate(&sheer(0.0), 1);
+    k.blocks[2].values[3 * PATCHES + 7] = [f64::NAN; 3];
+    let e = write_xml(&mut Vec::new(), &k, &Description::default()).unwrap_err();
+    assert_eq!(e.kind(), io::ErrorKind::InvalidData);
+    let m = e.to_string();
+    assert!(
+        m.contains("Transmission Back") && m.contains("outgoing patch 3, incident patch 7"),
+        "{m}"
+    );
+}
