@@ -1,4 +1,4 @@
-//! Probes the optional dependencies of these tests (Python packages, Mitsuba's llvm variant, SLURM,
+//! Probes the optional dependencies of these tests (Python packages, Mitsuba's llvm variant, Radiance through pyradiance, SLURM,
 //! AVX2 for the direct model's batch, the real renderers of the fitted materials: Blender's bpy,
 //! MaterialX with usd-core, node with Chromium and tests/renderers/node_modules) and sets
 //! `missing_<name>` for each one absent, so that the tests needing it show as ignored, with the
@@ -28,5 +28,6 @@ fn main() {
         SLURM,
         PKG_CONFIG,
         AVX2,
+        PYRADIANCE,
     ]);
 }

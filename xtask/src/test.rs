@@ -1,7 +1,7 @@
 //! `cargo xtask test [ARGS]`: the whole suite on a fresh machine, nothing skipped that pip can
 //! install. Creates the virtual environment `.venv` in the repository root (once, with
-//! `python3 -m venv`), installs numpy, pytest, OpenEXR, mitsuba, bpy, materialx and usd-core
-//! into it and the npm packages of tests/renderers with `npm ci` (the first time takes
+//! `python3 -m venv`), installs numpy, pytest, OpenEXR, mitsuba, bpy, materialx, usd-core and
+//! pyradiance into it and the npm packages of tests/renderers with `npm ci` (the first time takes
 //! minutes), then runs `cargo fmt --all -- --check`, `cargo clippy --workspace --all-targets --
 //! -D warnings` and `cargo test --workspace [ARGS]` with the environment's `bin` first on PATH
 //! and VIRTUAL_ENV set, so that the Python, Mitsuba and OpenEXR tests run, and with
@@ -17,7 +17,8 @@ use std::process::Command;
 /// The Python packages the tests import: (the name pip installs, the name Python imports).
 /// bpy is Blender as a module (its wheels exist for the Python version Blender ships with);
 /// materialx and usd-core check the fitted OpenPBR material.
-const PACKAGES: [(&str, &str); 7] = [
+/// pyradiance (pinned) ships Radiance's binaries for the daylighting export's round trip.
+const PACKAGES: [(&str, &str); 8] = [
     ("numpy", "numpy"),
     ("pytest", "pytest"),
     ("OpenEXR", "OpenEXR"),
@@ -25,6 +26,7 @@ const PACKAGES: [(&str, &str); 7] = [
     ("bpy", "bpy"),
     ("materialx", "MaterialX"),
     ("usd-core", "pxr"),
+    ("pyradiance==1.3.1", "pyradiance"),
 ];
 
 /// Runs `cmd`, printing it first; exits with its status when it fails.

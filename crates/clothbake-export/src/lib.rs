@@ -6,6 +6,8 @@
 //!   the view direction.
 //! * [`spectrum`]: the linear RGB-to-spectrum upsampling of the spectral file, and the CIE
 //!   projection it inverts.
+//! * [`klems`]: the LBNL/Radiance BSDF XML on the Klems basis (front and back reflection and
+//!   transmission) for daylighting tools, and the datasheet figures of a fabric shade.
 //! * [`merl`]: the 90 x 90 x 180 half/difference-angle binary of the MERL database. Isotropic
 //!   only: the cloth's BRDF is averaged over rotations about the normal.
 //!
@@ -15,6 +17,7 @@
 
 pub mod fitted;
 pub mod gltf;
+pub mod klems;
 pub mod merl;
 pub mod openpbr;
 pub mod rgl;

@@ -44,6 +44,17 @@ pub const NUMPY: Dependency = Dependency {
     check: || python_imports("import numpy"),
 };
 
+/// Radiance's binaries and BSDF library as the pyradiance package ships them (the daylighting
+/// export's round trip).
+#[allow(dead_code)]
+pub const PYRADIANCE: Dependency = Dependency {
+    name: "pyradiance",
+    needs: "the pyradiance Python package (Radiance's binaries and BSDF library)",
+    install: "python3 -m pip install pyradiance, or run `cargo xtask test`",
+    uses_path: true,
+    check: || python_imports("import pyradiance.bsdf"),
+};
+
 /// Mitsuba 3 with its scalar_rgb variant, and numpy.
 #[allow(dead_code)]
 pub const MITSUBA: Dependency = Dependency {

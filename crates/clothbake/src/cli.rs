@@ -331,7 +331,8 @@ pub struct InfoArgs {
                   far each is from the averaged BRDF. The MERL format is isotropic and cloth is not: each MERL cell holds f_r \
                   averaged over rotations about the normal (--phi-samples angles) and over \
                   swapping light and eye; the spread lost is printed. The RGL file keeps the \
-                  anisotropy. See docs/export.md."
+                  anisotropy. --klems writes the daylighting file and prints the datasheet \
+                  (docs/daylighting.md). See docs/export.md."
 )]
 pub struct ExportArgs {
     /// Export the analytic model of this fabric (JSON, see docs/fabric-format.md, or a WIF
@@ -356,6 +357,17 @@ pub struct ExportArgs {
     /// Write the 90x90x180 MERL binary (isotropic: averaged over rotations about the normal).
     #[arg(long, value_name = "OUT.binary")]
     pub merl: Option<PathBuf>,
+
+    /// Write an LBNL/Radiance BSDF XML file on the Klems basis (145 x 145: front and back
+    /// reflection and transmission, Visible and Solar) for daylighting tools (Radiance,
+    /// WINDOW), and print the datasheet figures (openness, transmittance, reflectance at
+    /// normal incidence). See docs/daylighting.md.
+    #[arg(long, value_name = "OUT.xml")]
+    pub klems: Option<PathBuf>,
+
+    /// Klems: points across a patch each way (K x K a patch; each entry averages K^4 pairs).
+    #[arg(long, value_name = "K", value_parser = parse_klems_samples, default_value = "3")]
+    pub klems_samples: usize,
 
     /// Write a glTF 2.0 binary (`.glb`): a swatch with the fitted material
     /// (KHR_materials_sheen, KHR_materials_anisotropy, textures over one period).
@@ -458,6 +470,19 @@ pub fn parse_phi_samples(s: &str) -> Result<usize, String> {
         Ok(n) if (1..=4096).contains(&n) => Ok(n),
         _ => Err(format!(
             "`{}` is not a number of rotations from 1 to 4096; give e.g. --phi-samples 16",
+            s.trim()
+        )),
+    }
+}
+
+/// Parses `--klems-samples K`: a whole number from 1 to `klems::MAX_SAMPLES`.
+pub fn parse_klems_samples(s: &str) -> Result<usize, String> {
+    let max = clothbake_export::klems::MAX_SAMPLES;
+    match s.trim().parse::<usize>() {
+        Ok(n) if (1..=max).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "`{}` is not a number of points across a Klems patch from 1 to {max}; give e.g. \
+             --klems-samples 3",
             s.trim()
         )),
     }

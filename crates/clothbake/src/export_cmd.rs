@@ -1,6 +1,7 @@
 //! `clothbake export`: the BRDF of the analytic model (`--weave`) or of a baked table
 //! (`--table`, through the loader's lookup) as an RGL `.bsdf` (RGB for Mitsuba 3, spectral for
-//! pbrt-v4 and Mitsuba's spectral variants), a MERL binary, and/or fitted standard materials
+//! pbrt-v4 and Mitsuba's spectral variants), a MERL binary, a Klems BSDF XML for daylighting
+//! tools (with the datasheet figures), and/or fitted standard materials
 //! (glTF, MaterialX, USD, Blender: `fitted_cmd`), each written atomically.
 //! Formats and conventions: `docs/export.md`.
 
@@ -12,7 +13,7 @@ use clothbake_bake::memory;
 use clothbake_core::symmetry::{symmetries, Symmetry};
 use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel};
 use clothbake_export::fitted::material::{Cells, Source};
-use clothbake_export::{self as export, merl, rgl, spectrum, Bsdf};
+use clothbake_export::{self as export, klems, merl, rgl, spectrum, Bsdf};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -23,6 +24,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
         &args.rgl,
         &args.rgl_spectral,
         &args.merl,
+        &args.klems,
         &args.gltf,
         &args.mtlx,
         &args.usd,
@@ -35,7 +37,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
         return Err(CliError::new(
             "nothing to export",
             "give --rgl OUT.bsdf (Mitsuba 3), --rgl-spectral OUT.bsdf (pbrt-v4, Mitsuba 3 \
-             spectral), --merl OUT.binary, or a fitted material: --gltf OUT.glb (the web), \
+             spectral), --merl OUT.binary, --klems OUT.xml (daylighting: Radiance, WINDOW), or a fitted material: --gltf OUT.glb (the web), \
              --mtlx OUT.mtlx (MaterialX), --usd OUT.usda, --blender OUT.py",
         ));
     }
@@ -176,6 +178,7 @@ fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
         (&args.rgl, "RGL file"),
         (&args.rgl_spectral, "spectral RGL file"),
         (&args.merl, "MERL file"),
+        (&args.klems, "Klems BSDF XML file"),
     ]
     .into_iter()
     .filter_map(|(p, what)| Some((p.as_deref()?, what)))
@@ -284,6 +287,36 @@ fn write_all(
             100.0 * a.max
         );
     }
+    if let Some(out) = &args.klems {
+        let start = Instant::now();
+        let k = pool.install(|| klems::evaluate(brdf, args.klems_samples));
+        let description = klems::Description {
+            name: name.to_string(),
+            comment: format!(
+                "clothbake {}: {source}; Klems entries averaged over {n} x {n} points of each \
+                 patch (docs/daylighting.md)",
+                env!("CARGO_PKG_VERSION"),
+                n = args.klems_samples
+            ),
+        };
+        let mut size = 0;
+        clothbake_loader::write_atomic_as(out, "exported file", args.run.force, |w| {
+            size = klems::write_xml(w, &k, &description)?;
+            Ok(())
+        })?;
+        let sheet = pool.install(|| klems::Datasheet::of(brdf));
+        let _ = writeln!(
+            summary,
+            "wrote {}: LBNL/Radiance BSDF XML, Klems basis 145 x 145, front and back reflection \
+             and transmission, Visible and Solar, {n} x {n} points a patch, {:.1} MB, {:.2} s\n\
+             datasheet: {}",
+            out.display(),
+            size as f64 / 1e6,
+            start.elapsed().as_secs_f64(),
+            sheet.summary(),
+            n = args.klems_samples
+        );
+    }
     Ok(if args.run.quiet {
         String::new()
     } else {
@@ -314,7 +347,11 @@ fn check_memory(
     } else {
         0
     };
-    let need = memory::BASE_BYTES + held + rgl + merl + fitted;
+    let klems = args
+        .klems
+        .as_ref()
+        .map_or(0, |_| klems::peak_bytes(threads));
+    let need = memory::BASE_BYTES + held + rgl + merl + fitted + klems;
     match memory::available_bytes() {
         Some(have) if need > have => Err(CliError::new(
             format!(

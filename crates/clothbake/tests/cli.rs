@@ -525,6 +525,90 @@ fn export_writes_an_rgl_file_and_refuses_bad_requests() {
 }
 
 #[test]
+fn export_writes_a_klems_file_and_its_datasheet() {
+    // A one-faced cloth: the file holds the basis and eight blocks; the printed front
+    // reflectance at normal incidence (the datasheet's own hemispherical integral) agrees with
+    // the file's front-reflection column of the central patch summed with each patch's
+    // projected solid angle (written here from the ring table: pi (sin^2 t1 - sin^2 t0) / n).
+    let w = table("twill");
+    let w = w.to_str().unwrap();
+    let dir = common::fresh_dir("cli", "export-klems");
+    let out = dir.join("twill.xml");
+    let o = out.to_str().unwrap();
+    for bad in ["0", "9", "x"] {
+        refuses(
+            &["export", "--weave", w, "--klems", o, "--klems-samples", bad],
+            &["--klems-samples", "from 1 to 8"],
+        );
+    }
+    refuses(
+        &["export", "--weave", w, "--klems", o, "--rgl", o],
+        &["two outputs name the same file"],
+    );
+    let ok = clothbake(&["export", "--weave", w, "--klems", o, "--klems-samples", "2"]);
+    let said = common::succeeds(&ok);
+    assert!(said.contains("Klems basis 145 x 145"), "{said}");
+    let sheet = said.lines().find(|l| l.starts_with("datasheet:")).unwrap();
+    assert!(sheet.contains("openness factor 0.00%"), "{sheet}");
+    assert!(sheet.contains("visible transmittance 0.00%"), "{sheet}");
+    let front: f64 = sheet
+        .split("reflectance front ")
+        .nth(1)
+        .and_then(|r| r.split('%').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    let xml = std::fs::read_to_string(&out).unwrap();
+    assert!(xml.starts_with("<?xml"), "{}", &xml[..40]);
+    assert!(xml.contains("<AngleBasisName>LBNL/Klems Full</AngleBasisName>"));
+    let rings = [
+        (0.0, 5.0, 1),
+        (5.0, 15.0, 8),
+        (15.0, 25.0, 16),
+        (25.0, 35.0, 20),
+        (35.0, 45.0, 24),
+        (45.0, 55.0, 24),
+        (55.0, 65.0, 24),
+        (65.0, 75.0, 16),
+        (75.0, 90.0, 12),
+    ];
+    let lambda: Vec<f64> = rings
+        .iter()
+        .flat_map(|&(a, b, n): &(f64, f64, usize)| {
+            let s = |d: f64| d.to_radians().sin().powi(2);
+            vec![std::f64::consts::PI * (s(b) - s(a)) / n as f64; n]
+        })
+        .collect();
+    let block = xml
+        .split("<WavelengthDataDirection>Reflection Front</WavelengthDataDirection>")
+        .nth(1)
+        .unwrap()
+        .split("<ScatteringData>\n")
+        .nth(1)
+        .unwrap()
+        .split("\t\t\t</ScatteringData>")
+        .next()
+        .unwrap();
+    let rows: Vec<&str> = block.lines().collect();
+    assert_eq!(rows.len(), 145);
+    let column0: f64 = rows
+        .iter()
+        .zip(&lambda)
+        .map(|(r, l)| r.split(", ").next().unwrap().parse::<f64>().unwrap() * l)
+        .sum();
+    assert!(front > 10.0, "{front}");
+    assert!(
+        (100.0 * column0 - front).abs() < 0.03 * front,
+        "file {column0}, datasheet {front}%"
+    );
+    refuses(
+        &["export", "--weave", w, "--klems", o],
+        &["already exists", "--force"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn export_from_a_table_and_spectral_export() {
     // A small baked table of the plain weave, exported through the loader: the RGL file's
     // description carries the table's fabric file; the model options are refused with a table;

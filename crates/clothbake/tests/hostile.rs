@@ -220,6 +220,14 @@ const CASES: &[(&str, &str)] = &[
         "export --weave TWILL --rgl e.bsdf --rgl-res 100000,100000,100000",
     ),
     (
+        "export --klems-samples past its range",
+        "export --weave TWILL --klems k.xml --klems-samples 1000000",
+    ),
+    (
+        "export --klems onto the fabric",
+        "export --weave TWILL --klems TWILL",
+    ),
+    (
         "plot 20 000 curves",
         "plot --weave TWILL -o p.png --theta-i LIST20000",
     ),
@@ -451,10 +459,10 @@ const WRITERS: &[Writer] = &[
         at: "r.exr",
     },
     Writer {
-        name: "export of three files",
+        name: "export of four files",
         line: "export --weave TWILL --rgl e.bsdf --rgl-spectral s.bsdf --merl m.binary \
-               --rgl-res 8,12,32 --phi-samples 1",
-        outputs: &["e.bsdf", "s.bsdf", "m.binary"],
+               --rgl-res 8,12,32 --phi-samples 1 --klems k.xml --klems-samples 1",
+        outputs: &["e.bsdf", "s.bsdf", "m.binary", "k.xml"],
         at: "m.binary",
     },
     Writer {

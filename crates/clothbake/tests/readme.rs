@@ -182,6 +182,7 @@ doc_test! {
     docs_baking: "docs/baking.md", 5;
     docs_cli: "docs/cli.md", 20;
     docs_cluster: "docs/cluster.md", 4;
+    docs_daylighting: "docs/daylighting.md", 2;
     docs_export: "docs/export.md", 6;
     docs_fabric_format: "docs/fabric-format.md", 1;
     docs_render: "docs/render.md", 9;
@@ -199,6 +200,7 @@ fn every_document_with_shell_blocks_is_run_or_listed() {
         "docs/baking.md",
         "docs/cli.md",
         "docs/cluster.md",
+        "docs/daylighting.md",
         "docs/export.md",
         "docs/fabric-format.md",
         "docs/render.md",
