@@ -10,7 +10,8 @@
 //!   micro-geometry (`RayTracer::render_sphere_rest`) at the nodes of a coarse grid per block
 //!   of directions (front reflection, front-to-back transmission, back reflection,
 //!   back-to-front transmission) and interpolated quadrilinearly in each block's own polar
-//!   angles (from the normal of its side) and azimuths. Each node is a pure function of its
+//!   angles (from the normal of its side; nodes from the normal on, clamped to the last one
+//!   toward the horizon) and azimuths. Each node is a pure function of its
 //!   indices (seeded by its direction pair), computed once, on first use or in parallel by
 //!   [`TwoFaced::prepare`]; with Lewis facets (reciprocal) a node and its reciprocal are one.
 
@@ -24,9 +25,10 @@ use clothbake_core::{
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
-/// Nodes of the rest's grid per direction of a block: polar angles (cell-centred over 0 to 90
-/// degrees from the side's normal) by azimuths (cell-centred over 360 degrees).
-pub const NODES: (u32, u32) = (4, 8);
+/// Nodes of the rest's grid per direction of a block: polar angles (k 90 / n degrees from the
+/// side's normal, k = 0..n: the normal itself, where datasheets are read, is a node) by
+/// azimuths (cell-centred over 360 degrees).
+pub const NODES: (u32, u32) = (5, 8);
 
 /// Eye rays a node traces.
 pub const PATHS: usize = 8192;
@@ -111,7 +113,7 @@ impl Rest {
     /// The direction of node `k` of a block's side (`up`: above the cloth).
     fn direction(&self, k: usize, up: bool) -> UnitVec3 {
         let (t, p) = (k as u32 / self.n_phi, k as u32 % self.n_phi);
-        let theta = (f64::from(t) + 0.5) * 90.0 / f64::from(self.n_theta);
+        let theta = f64::from(t) * 90.0 / f64::from(self.n_theta);
         let phi = (f64::from(p) + 0.5) * 360.0 / f64::from(self.n_phi);
         let w = UnitVec3::from_degrees(theta, phi);
         if up {
@@ -163,7 +165,12 @@ impl Rest {
         let axes = |w: UnitVec3| {
             let (theta, phi) = side_angles(w);
             (
-                neighbours(theta * f64::from(self.n_theta) / 90.0, self.n_theta, false),
+                // Polar nodes at k 90 / n: at the half-integers of `neighbours`' cells.
+                neighbours(
+                    theta * f64::from(self.n_theta) / 90.0 + 0.5,
+                    self.n_theta,
+                    false,
+                ),
                 neighbours(phi * f64::from(self.n_phi) / 360.0, self.n_phi, true),
             )
         };
@@ -345,16 +352,16 @@ mod tests {
         let up = |t, p| dir(t, p);
         let down = |t, p| dir(t, p).mirror_z();
         for (wi, wo, what) in [
-            (up(22.5, 45.0), up(67.5, 225.0), "front reflection"),
+            (up(0.0, 45.0), up(45.0, 225.0), "front reflection"),
             (
-                up(22.5, 45.0),
-                down(22.5, 135.0),
+                up(45.0, 45.0),
+                down(0.0, 135.0),
                 "transmission from the front",
             ),
-            (down(67.5, 315.0), down(22.5, 45.0), "back reflection"),
+            (down(45.0, 315.0), down(0.0, 45.0), "back reflection"),
             (
-                down(22.5, 135.0),
-                up(67.5, 45.0),
+                down(0.0, 135.0),
+                up(45.0, 45.0),
                 "transmission from the back",
             ),
         ] {

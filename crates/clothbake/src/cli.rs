@@ -369,6 +369,12 @@ pub struct ExportArgs {
     #[arg(long, value_name = "K", value_parser = parse_klems_samples, default_value = "3")]
     pub klems_samples: usize,
 
+    /// With --weave: `one` face over the thesis's floor (reflection only), or the `two`-faced
+    /// cloth (no floor: light through the gaps and translucent yarns, the back the inverted
+    /// weave; docs/transmission.md), which only --klems can hold.
+    #[arg(long, value_enum, default_value_t = Faces::One)]
+    pub faces: Faces,
+
     /// Write a glTF 2.0 binary (`.glb`): a swatch with the fitted material
     /// (KHR_materials_sheen, KHR_materials_anisotropy, textures over one period).
     #[arg(long, value_name = "OUT.glb")]

@@ -6,12 +6,13 @@
 //! Formats and conventions: `docs/export.md`.
 
 use crate::bake_cmd::preflight;
-use crate::cli::ExportArgs;
+use crate::cli::{ExportArgs, Faces};
 use crate::error::CliError;
 use crate::eval_cmd::apply_material;
 use clothbake_bake::memory;
+use clothbake_bake::two_faced::TwoFaced;
 use clothbake_core::symmetry::{symmetries, Symmetry};
-use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel};
+use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel, Variant};
 use clothbake_export::fitted::material::{Cells, Source};
 use clothbake_export::{self as export, klems, merl, rgl, spectrum, Bsdf};
 use std::fmt::Write as _;
@@ -59,6 +60,61 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             "give --weave FILE (the analytic model of a fabric) or --table T.exr|T.bin (a baked \
              table)",
         )),
+        (Some(weave), None) if args.faces == Faces::Two => {
+            let reflection_only = [
+                (&args.rgl, "--rgl"),
+                (&args.rgl_spectral, "--rgl-spectral"),
+                (&args.merl, "--merl"),
+                (&args.gltf, "--gltf"),
+                (&args.mtlx, "--mtlx"),
+                (&args.usd, "--usd"),
+                (&args.blender, "--blender"),
+            ];
+            if let Some((_, flag)) = reflection_only.iter().find(|(o, _)| o.is_some()) {
+                return Err(CliError::new(
+                    format!("{flag} holds reflection only, and --faces two transmits"),
+                    format!("export the two-faced cloth with --klems alone, or drop --faces two for {flag}"),
+                ));
+            }
+            let b = &args.bounces;
+            if let Some(flag) = (b.bounces != 1)
+                .then_some("--bounces")
+                .or(b.secondary_flag())
+            {
+                return Err(CliError::new(
+                    format!(
+                        "{flag} does not apply to the two-faced cloth: its f holds every bounce"
+                    ),
+                    format!("drop {flag}"),
+                ));
+            }
+            let fabric = apply_material(
+                crate::fabrics::read(weave, &Default::default())?,
+                &args.material,
+            )?;
+            refuse_existing(args)?;
+            let facet = FacetModel::from(args.facet.unwrap_or(crate::cli::FacetArg::Huo));
+            let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);
+            let tf = TwoFaced::new(&fabric, facet, variant.into()).map_err(|e| {
+                CliError::line(format!(
+                    "{e} (the cloth's back: its weave inverted; docs/transmission.md)"
+                ))
+            })?;
+            let threads = crate::bake_cmd::thread_count(args.run.threads);
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .map_err(|e| CliError::line(format!("cannot start {threads} threads: {e}")))?
+                .install(|| tf.prepare());
+            let source = format!(
+                "fabric {}; the two-faced cloth (docs/transmission.md): analytic direct reflection \
+                 (facet {}, variant {}) and openness, the rest path-traced on a coarse grid",
+                fabric.name(),
+                facet_name(facet),
+                Variant::from(variant).name(),
+            );
+            write_all(args, &tf, None, fabric.name(), &source, false, 0)
+        }
         (Some(weave), None) => {
             let secondary = args.bounces.options()?;
             let secondary = (args.bounces.bounces == 2).then_some(secondary);
@@ -160,6 +216,8 @@ fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
         m.albedo.is_some().then_some("--albedo"),
         m.specular.is_some().then_some("--specular"),
         m.exponent.is_some().then_some("--exponent"),
+        m.translucency.is_some().then_some("--translucency"),
+        (args.faces == Faces::Two).then_some("--faces"),
     ];
     match given.into_iter().flatten().next() {
         Some(flag) => Err(CliError::new(
