@@ -21,6 +21,8 @@
 //!   pictures at six distances, into `docs/validation.md` (see `lod.rs`).
 //! * `error-sources`: the model's error split into masking, shadowing and shading, into
 //!   docs/validation.md.
+//! * `transmission`: the two-faced cloth's model against its ray tracer (both faces,
+//!   transmission, openness) into docs/validation.md (see `transmission.rs`).
 //! * `validate-spatial`: the model per crossing cell against the truth sorted into the same
 //!   cells, written to `docs/validation-spatial.md`.
 //! * `validate`: holds the analytic model against the ray-traced ground truth for every shipped
@@ -48,6 +50,7 @@ mod ir_accuracy;
 mod lod;
 mod spatial;
 mod test;
+mod transmission;
 mod transport;
 
 use clothbake_core::validate::{compare_with, direction_set, Report};
@@ -89,6 +92,7 @@ fn main() {
         "validate" => validate(),
         "validate-spatial" => spatial::run(&root()),
         "error-sources" => error_sources::run(&root()),
+        "transmission" => transmission::run(&root()),
         "lod" => lod::run(&root()),
         "fitted" => fitted::run(&root()),
         "ch5" => ch5::run(&root()),
@@ -249,6 +253,7 @@ fn validate() {
         "spatial-validation",
         "lod-validation",
         "error-sources",
+        "transmission-validation",
     ] {
         let (begin, end) = (
             format!("<!-- {marker}:begin -->"),
