@@ -49,12 +49,43 @@ pub struct Shader {
     bsdf: Box<dyn Bsdf>,
     /// Whether the gaps between the yarns show: the value is scaled by the coverage.
     gaps: bool,
+    /// Whether the BSDF is a two-faced cloth's (docs/transmission.md): lit and seen from
+    /// either side, transmitting, and showing what lies behind it through its openness.
+    two_faced: bool,
 }
 
 impl Shader {
     /// Any BSDF.
     pub fn new(bsdf: Box<dyn Bsdf>) -> Shader {
-        Shader { bsdf, gaps: false }
+        Shader {
+            bsdf,
+            gaps: false,
+            two_faced: false,
+        }
+    }
+
+    /// The two-faced cloth of `fabric` (`render --faces two`; docs/transmission.md): its
+    /// model (`clothbake_bake::two_faced::TwoFaced`, the rest's nodes path-traced now, in
+    /// parallel), lit and seen from either side. An error where the fabric's back is not a
+    /// valid fabric.
+    pub fn two_faced(
+        fabric: &Fabric,
+        facet: FacetModel,
+        variant: Variant,
+    ) -> Result<Shader, String> {
+        let tf = clothbake_bake::two_faced::TwoFaced::new(fabric, facet, variant)
+            .map_err(|e| e.to_string())?;
+        tf.prepare();
+        Ok(Shader::two_sided(Box::new(tf)))
+    }
+
+    /// Any BSDF of a two-faced cloth (f over the whole sphere, `openness`), lit and seen from
+    /// either side.
+    pub fn two_sided(bsdf: Box<dyn Bsdf>) -> Shader {
+        Shader {
+            two_faced: true,
+            ..Shader::new(bsdf)
+        }
     }
 
     /// The same shader showing the gaps between the yarns (`render --gaps`): each value is
@@ -352,6 +383,9 @@ pub fn shade_at(
     up: clothbake_core::Vec3,
     at: Option<Footprint>,
 ) -> ([f64; 3], f64) {
+    if shader.two_faced {
+        return (shade_two_faced(shader, lighting, wi, wo, up), 1.0);
+    }
     let Some(wo) = UnitVec3::new(wo).filter(|w| w.above_horizon()) else {
         return ([0.0; 3], 0.0);
     };
@@ -401,4 +435,125 @@ pub fn shade_at(
         (Some(at), None) => shader.bsdf.coverage_at(at, wo),
     };
     (v, coverage)
+}
+
+/// The pixel value of a point of a two-faced cloth (`render --faces two`): the sun lights the
+/// side it stands over (its share [`sun_share`] of the elevation over that side), the sky lights
+/// the side facing up and the ground the other (each side's share s(N) of module
+/// documentation), each looked up as reflection or transmission by the sides of the light and
+/// the eye; and through the gaps the eye sees what lies behind the cloth along its ray, the
+/// openness O(wo) times the sky's radiance (rho_a; the ground's, [`GROUND`] rho_a) or, within
+/// the sun's disk, the sun's (E over the disk's solid angle) as well.
+fn shade_two_faced(
+    shader: &Shader,
+    lighting: &Lighting,
+    wi: clothbake_core::Vec3,
+    wo: clothbake_core::Vec3,
+    up: clothbake_core::Vec3,
+) -> [f64; 3] {
+    let Some(wo) = UnitVec3::new(wo).filter(|w| w.above_horizon() || w.below_horizon()) else {
+        return [0.0; 3];
+    };
+    let mirror = |v: clothbake_core::Vec3| clothbake_core::Vec3::new(v.x, v.y, -v.z);
+    // The sun over the side it stands on: computed as over the front, mirrored for the back.
+    let sun_side = if wi.z >= 0.0 {
+        sun(wi)
+    } else {
+        sun(mirror(wi)).map(|(d, c)| (d.mirror_z(), c))
+    };
+    // The sky over the side facing up, the ground (and the sky's rest) over the other.
+    let front_sky = sky(lighting.ambient, up);
+    let back_sky = sky(lighting.ambient, mirror(up)).map(|(d, w)| (d.mirror_z(), w));
+    let mut v = [0.0f64; 3];
+    for (dir, weight) in [
+        sun_side.map(|(d, c)| (d, c * lighting.irradiance)),
+        front_sky,
+        back_sky,
+    ]
+    .into_iter()
+    .flatten()
+    {
+        let f = shader.bsdf.f(dir, wo);
+        for k in 0..3 {
+            v[k] += f[k] * weight;
+        }
+    }
+    // Behind the cloth, along the eye's ray.
+    let behind = wo.reverse();
+    let open = shader.bsdf.openness(wo);
+    if open > 0.0 {
+        let mut l = if behind.get().dot(up) > 0.0 {
+            lighting.ambient
+        } else {
+            GROUND * lighting.ambient
+        };
+        let to_sun = UnitVec3::new(wi).map_or(-1.0, |s| s.get().dot(behind.get()));
+        if to_sun >= SUN_RADIUS.cos() {
+            let disk = 2.0 * std::f64::consts::PI * (1.0 - SUN_RADIUS.cos());
+            l += lighting.irradiance / disk;
+        }
+        v = v.map(|x| x + open * l);
+    }
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clothbake_core::{Rgb, Vec3};
+    use std::f64::consts::PI;
+
+    /// A Lambertian sheet: reflects rho / pi on either side, transmits t / pi across, and
+    /// passes `open` straight through.
+    struct Sheet {
+        rho: f64,
+        t: f64,
+        open: f64,
+    }
+
+    impl Bsdf for Sheet {
+        fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb {
+            let sided = |w: UnitVec3| w.above_horizon() || w.below_horizon();
+            if !(sided(wi) && sided(wo)) {
+                return [0.0; 3];
+            }
+            let same = (wi.z > 0.0) == (wo.z > 0.0);
+            [if same { self.rho } else { self.t } / PI; 3]
+        }
+        fn openness(&self, _: UnitVec3) -> f64 {
+            self.open
+        }
+    }
+
+    #[test]
+    fn a_backlit_sheet_shows_its_transmission_and_what_lies_behind() {
+        // A flat sheet facing up, the sun behind it at elevation e below, the eye above: the
+        // sun transmitted, E sin(e) t / pi; the sky on the front, rho_a rho; the ground's light
+        // on the back, transmitted, rho_a GROUND t; through the gaps the ground, O GROUND rho_a.
+        let (rho, t, open) = (0.4, 0.3, 0.2);
+        let shader = Shader::two_sided(Box::new(Sheet { rho, t, open }));
+        let lighting = Lighting {
+            light: Vec3::new(0.0, 0.0, -1.0),
+            irradiance: PI,
+            ambient: 0.3,
+        };
+        let e = 40f64.to_radians();
+        let wi = Vec3::new(e.cos(), 0.0, -e.sin());
+        let up = Vec3::new(0.0, 0.0, 1.0);
+        let wo = UnitVec3::from_degrees(30.0, 200.0).get();
+        let v = shade_at(&shader, &lighting, wi, wo, up, None).0[0];
+        let want = PI * e.sin() * t / PI + 0.3 * rho + 0.3 * GROUND * t + open * GROUND * 0.3;
+        assert!((v - want).abs() < 1e-12, "{v} vs {want}");
+        // The eye looking through the sheet at the sun sees it through the gaps too.
+        let v_sun = shade_at(&shader, &lighting, wi, -wi, up, None).0[0];
+        let disk = 2.0 * PI * (1.0 - SUN_RADIUS.cos());
+        let want_sun = want + open * PI / disk;
+        assert!(
+            (v_sun - want_sun).abs() < 1e-9 * want_sun,
+            "{v_sun} vs {want_sun}"
+        );
+        // A one-faced shader shows nothing of a cloth seen from below (the eye at wi).
+        let opaque = Shader::new(Box::new(Sheet { rho, t, open }));
+        assert_eq!(shade_at(&opaque, &lighting, wi, wi, up, None).0, [0.0; 3]);
+    }
 }

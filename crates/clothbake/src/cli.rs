@@ -1262,6 +1262,12 @@ pub struct RenderArgs {
     #[arg(long)]
     pub truth: bool,
 
+    /// With --weave: the `two`-faced cloth (no floor: light through the gaps and translucent
+    /// yarns, the back the inverted weave; docs/transmission.md), lit and seen from either
+    /// side: a --light below the cloth backlights it, and the gaps show what lies behind.
+    #[arg(long, value_enum, default_value_t = Faces::One)]
+    pub faces: Faces,
+
     /// The sky's strength rho_a: a white Lambertian surface facing up shows rho_a in the sky's
     /// light (the thesis's ambient coefficient; sec. 4.3 uses 0.3); 0: the sun alone.
     #[arg(long, value_name = "RHO_A", value_parser = parse_ambient, default_value = "0.3")]

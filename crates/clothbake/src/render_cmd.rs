@@ -3,7 +3,7 @@
 
 use crate::bake_cmd::{preflight, progress_bar};
 use crate::cli::{
-    BrdfArgs, ComponentArg, Exposure, PlotArgs, PlotKind, RenderArgs, SceneArg, TonemapArg,
+    BrdfArgs, ComponentArg, Exposure, Faces, PlotArgs, PlotKind, RenderArgs, SceneArg, TonemapArg,
 };
 use crate::error::{table_error, CliError};
 use crate::eval_cmd::apply_material;
@@ -75,6 +75,45 @@ fn component_name(c: ComponentArg) -> &'static str {
         ComponentArg::Secondary => "secondary",
         ComponentArg::Iss => "iss",
     }
+}
+
+/// The two-faced cloth's shader of `render --faces two`: the fabric of --weave, whole, averaged
+/// over the period.
+fn two_faced_shader(a: &RenderArgs) -> Result<Shader, CliError> {
+    let Some(weave) = &a.brdf.weave else {
+        return Err(CliError::new(
+            "--faces two draws a fabric's two-faced cloth, and no --weave was given",
+            "give --weave FILE (e.g. tables/basket.json) with --faces two",
+        ));
+    };
+    let b = &a.brdf.bounces;
+    let refused = [
+        ("--table", !a.brdf.table.is_empty()),
+        ("--truth", a.truth),
+        ("--periods", a.periods.is_some()),
+        ("--gaps", a.gaps),
+        ("--bounces", b.bounces != 1),
+        ("--component", a.brdf.component != ComponentArg::Total),
+    ];
+    if let Some((flag, _)) = refused.iter().find(|(_, given)| *given) {
+        return Err(CliError::new(
+            format!(
+                "{flag} does not apply with --faces two: the two-faced cloth is drawn whole \
+                 (every bounce, averaged over the period, its gaps as openness)"
+            ),
+            format!("drop {flag}, or drop --faces two"),
+        ));
+    }
+    let fabric = apply_material(
+        crate::fabrics::read(weave, &Default::default())?,
+        &a.brdf.material,
+    )?;
+    Shader::two_faced(
+        &fabric,
+        FacetModel::from(a.brdf.model.facet),
+        a.brdf.model.variant.into(),
+    )
+    .map_err(|e| CliError::line(format!("{e} (the cloth's back: its weave inverted)")))
 }
 
 /// The ground truth's shader of `render --truth`: the fabric of --weave, one bounce, with
@@ -199,8 +238,12 @@ const RENDER_BAR: &str = "{elapsed_precise} [{wide_bar}] {percent:>3}% {pos}/{le
 
 /// Runs `clothbake render`; returns the summary line.
 pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
-    let mut srcs = sources(&a.brdf, 1)?;
-    let (_, shader) = srcs.pop().expect("one source");
+    let shader = if a.faces == Faces::Two {
+        two_faced_shader(a)?
+    } else {
+        let mut srcs = sources(&a.brdf, 1)?;
+        srcs.pop().expect("one source").1
+    };
     let shader = if a.truth { truth_shader(a)? } else { shader };
     let shader = if a.gaps { shader.with_gaps() } else { shader };
     let mut outputs = vec![(a.output.as_path(), "PNG image")];

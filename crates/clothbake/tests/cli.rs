@@ -947,6 +947,22 @@ fn the_two_faced_cloth_answers_on_the_whole_sphere() {
         &eval(&w, &["--wi", "190,0", "--wo", "150,0", "--faces", "two"]),
         &["--wi", "[0, 180]"],
     );
+    let png = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-two-faced.png");
+    let png = png.to_str().unwrap();
+    let wv = w.to_str().unwrap();
+    for (flag, extra) in [
+        ("--periods", &["--periods", "4"][..]),
+        ("--gaps", &["--gaps"][..]),
+    ] {
+        refuses(
+            &[
+                &["render", "--weave", wv, "--faces", "two", "-o", png][..],
+                extra,
+            ]
+            .concat(),
+            &[flag, "--faces two"],
+        );
+    }
 }
 
 #[test]
