@@ -393,6 +393,19 @@ impl PyFabric {
 
     /// f_r(wi, wo) in 1/sr for one pair of unit vectors given as 3 floats each (fabric frame,
     /// analytic model, direct reflection): the scalar path renderers call per sample.
+    /// The fabric's two-faced cloth (docs/transmission.md): no floor, light through the gaps
+    /// and through translucent yarns (the materials' `translucency`), the back the inverted
+    /// weave; its model's coarse grid is path-traced here (about 25 s on two cores).
+    #[pyo3(signature = (facet="lewis", variant="refined"))]
+    fn two_faced(
+        &self,
+        py: Python<'_>,
+        facet: &str,
+        variant: &str,
+    ) -> PyResult<crate::two_faced::PyTwoFaced> {
+        crate::two_faced::PyTwoFaced::build(py, self, facet, variant)
+    }
+
     #[pyo3(signature = (wi, wo, facet="huo"))]
     fn eval1(&self, wi: [f64; 3], wo: [f64; 3], facet: &str) -> PyResult<(f64, f64, f64)> {
         check_unit("wi", 0, wi)?;

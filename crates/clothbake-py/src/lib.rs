@@ -8,6 +8,7 @@
 mod bake;
 mod fabric;
 mod table;
+mod two_faced;
 mod vectors;
 
 use pyo3::prelude::*;
@@ -31,11 +32,12 @@ pub(crate) fn bench_directions(n: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
     (0..n).map(|_| (dir(), dir())).unzip()
 }
 
-/// The native module: `Fabric`, `Table`, `bake`, `__version__` (the crate's version).
+/// The native module: `Fabric`, `Table`, `TwoFaced`, `bake`, `__version__` (the crate's version).
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<fabric::PyFabric>()?;
     m.add_class::<table::PyTable>()?;
+    m.add_class::<two_faced::PyTwoFaced>()?;
     m.add_function(wrap_pyfunction!(bake::bake, m)?)?;
     m.add("UNIT_TOLERANCE", vectors::UNIT_TOLERANCE)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

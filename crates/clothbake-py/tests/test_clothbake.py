@@ -498,3 +498,42 @@ def test_eval_samples_are_bounded(twill_path):
     wi, wo = dirs([30], [0]), dirs([45], [180])
     with pytest.raises(ValueError, match="from 1 to 16777216"):
         fab.eval(wi, wo, method="raytrace", samples=2**25)
+
+
+def test_the_two_faced_cloth_transmits_and_passes_light_through_its_gaps():
+    # An open plain weave (r/s = 0.25) of translucent yarns (docs/transmission.md).
+    m = {"albedo": 0.5, "specular": 0.1, "exponent": 8, "translucency": 0.8}
+    fab = clothbake.Fabric({
+        "name": "open plain", "pattern": [[1, 0], [0, 1]],
+        "warp": {"radius": 0.5, "spacing": 2, "material": m},
+        "weft": {"radius": 0.5, "spacing": 2, "material": m},
+    })
+    cloth = fab.two_faced()
+    assert "open plain" in repr(cloth)
+    down = np.array([0.0, 0.0, -1.0])
+    up = np.array([0.0, 0.0, 1.0])
+    # Straight through: the geometric open area (1 - d/s)^2, from either side.
+    assert cloth.openness1(up) == pytest.approx(0.25, abs=1e-12)
+    assert float(cloth.openness(down)) == pytest.approx(0.25, abs=1e-12)
+    # Batches answer as single pairs; transmission and reflection on both sides are positive.
+    wi = np.concatenate([dirs([30, 50], [0, 90]), -dirs([20, 40], [45, 200])])
+    wo = np.concatenate([-dirs([35, 10], [180, 30]), dirs([60, 25], [90, 300])])
+    f = cloth.eval(wi, wo)
+    assert f.shape == (4, 3)
+    for k in range(4):
+        np.testing.assert_array_equal(f[k], cloth.eval1(wi[k], wo[k]))
+    assert (f > 0).all()
+    # Energy: what is reflected, transmitted and passed through from overhead is at most what
+    # arrives (a cosine-weighted estimate of each hemisphere's integral of f cos).
+    rng = np.random.default_rng(1)
+    n = 4000
+    r = np.sqrt(rng.uniform(0, 1, n))
+    phi = rng.uniform(0, 2 * math.pi, n)
+    w = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1 - r * r)], axis=-1)
+    light = np.tile(up, (n, 1))
+    refl = math.pi * cloth.eval(light, w)[:, 0].mean()
+    trans = math.pi * cloth.eval(light, w * [1, 1, -1])[:, 0].mean()
+    assert 0.1 < trans and 0.1 < refl
+    assert refl + trans + 0.25 <= 1.0
+    with pytest.raises(ValueError, match="variant"):
+        fab.two_faced(variant="no such")

@@ -5,10 +5,12 @@ toward the eye; directions are unit vectors, arrays of shape (N, 3). f_r is in 1
 
 * :class:`Fabric`: a fabric file (or dict) and its BRDF from the analytic model.
 * :class:`Table`: a baked table with interpolated lookup and importance sampling.
+* :class:`TwoFaced` (``Fabric.two_faced()``): the two-faced cloth, light through the gaps and
+  the yarns: f over the whole sphere and the openness (docs/transmission.md).
 * :func:`bake`: bake a Fabric into a Table in memory, or into a table or shard file (checkpoints, resume).
 * :mod:`clothbake.mitsuba`: a Mitsuba 3 BSDF plugin (``register()``).
 """
 
-from ._native import UNIT_TOLERANCE, Fabric, Table, __version__, bake
+from ._native import UNIT_TOLERANCE, Fabric, Table, TwoFaced, __version__, bake
 
-__all__ = ["Fabric", "Table", "bake", "UNIT_TOLERANCE", "__version__"]
+__all__ = ["Fabric", "Table", "TwoFaced", "bake", "UNIT_TOLERANCE", "__version__"]

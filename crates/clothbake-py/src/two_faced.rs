@@ -1,0 +1,105 @@
+//! `Fabric.two_faced()`: the two-faced cloth (docs/transmission.md) from Python: f over the
+//! whole sphere (reflection off either face, transmission) and the openness, one pair at a time
+//! or in batches.
+
+use crate::fabric::{facet_model, PyFabric};
+use crate::vectors::{check_unit, same_len, to_array, to_array1, unit_rows};
+use clothbake_bake::two_faced::TwoFaced;
+use clothbake_core::{Bsdf, UnitVec3, Variant, Vec3};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+/// The two-faced cloth of a fabric: no floor, light through the gaps and through translucent
+/// yarns, the back the inverted weave (docs/transmission.md). `eval` gives f (1/sr, RGB) for
+/// directions anywhere on the sphere (reflection where `wi` and `wo` are on one side,
+/// transmission across), `openness` the share of the light from a direction that passes
+/// straight through the gaps (a delta toward -wi, not in `eval`).
+#[pyclass(name = "TwoFaced", module = "clothbake", frozen)]
+pub struct PyTwoFaced {
+    cloth: TwoFaced,
+    name: String,
+}
+
+fn unit(w: [f64; 3]) -> UnitVec3 {
+    UnitVec3::new(Vec3::new(w[0], w[1], w[2])).unwrap_or(UnitVec3::Z)
+}
+
+impl PyTwoFaced {
+    /// The cloth of `fabric` with `facet` and `variant`, its path-traced grid computed now
+    /// (without the GIL).
+    pub fn build(py: Python<'_>, fabric: &PyFabric, facet: &str, variant: &str) -> PyResult<Self> {
+        let facet = facet_model(facet)?;
+        let variant = match variant {
+            "refined" => Variant::Refined,
+            "thesis" => Variant::Thesis,
+            "sliced" => Variant::Sliced,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "variant: {other:?} is not one of \"refined\", \"thesis\", \"sliced\"; give one of them"
+                )))
+            }
+        };
+        let cloth = TwoFaced::new(&fabric.fabric, facet, variant).map_err(|e| {
+            PyValueError::new_err(format!("{e} (the cloth's back: its weave inverted)"))
+        })?;
+        py.detach(|| cloth.prepare());
+        Ok(PyTwoFaced {
+            cloth,
+            name: fabric.fabric.name().to_string(),
+        })
+    }
+}
+
+#[pymethods]
+impl PyTwoFaced {
+    /// f(wi, wo) in 1/sr for `(N, 3)` unit vectors `wi` (toward the light) and `wo` (toward
+    /// the eye) anywhere on the sphere: an `(N, 3)` array (or `(3,)` for one pair).
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let wi = unit_rows("wi", wi)?;
+        let wo = unit_rows("wo", wo)?;
+        same_len(("wi", wi.rows.len()), ("wo", wo.rows.len()))?;
+        let f: Vec<[f64; 3]> = py.detach(|| {
+            wi.rows
+                .iter()
+                .zip(&wo.rows)
+                .map(|(&a, &b)| self.cloth.f(unit(a), unit(b)))
+                .collect()
+        });
+        to_array(py, &f, wi.single && wo.single)
+    }
+
+    /// The openness along each of the `(N, 3)` unit vectors `w` (either side): an `(N,)`
+    /// array (or a scalar array for one).
+    fn openness<'py>(&self, py: Python<'py>, w: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let w = unit_rows("w", w)?;
+        let o: Vec<f64> = w
+            .rows
+            .iter()
+            .map(|&a| self.cloth.openness(unit(a)))
+            .collect();
+        to_array1(py, o, w.single)
+    }
+
+    /// f for one pair of unit vectors, as a tuple (the scalar Mitsuba plugin's call).
+    fn eval1(&self, wi: [f64; 3], wo: [f64; 3]) -> PyResult<(f64, f64, f64)> {
+        check_unit("wi", 0, wi)?;
+        check_unit("wo", 0, wo)?;
+        let f = self.cloth.f(unit(wi), unit(wo));
+        Ok((f[0], f[1], f[2]))
+    }
+
+    /// The openness along one unit vector.
+    fn openness1(&self, w: [f64; 3]) -> PyResult<f64> {
+        check_unit("w", 0, w)?;
+        Ok(self.cloth.openness(unit(w)))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("clothbake.TwoFaced({:?})", self.name)
+    }
+}
