@@ -3,8 +3,8 @@
 //! For each outgoing cell `(to, po)` the incident hemisphere is split into the table's incident
 //! cells `(ti, pi)`: `theta` from `ti * 90 / n_theta_i` to `(ti + 1) * 90 / n_theta_i` degrees,
 //! `phi` from `pi * 360 / n_phi_i` to `(pi + 1) * 360 / n_phi_i` (the axes' edges,
-//! [`crate::Axis::edge_rad`]; `wo`'s and `wi`'s cells by [`crate::Axis::cell_of`]). The density is **piecewise
-//! constant per unit solid angle** on those cells. A cell's probability is
+//! [`crate::Axis::edge_rad`]; `wo`'s and `wi`'s cells by [`crate::Axis::cell_of`]). The density
+//! is **piecewise constant per unit solid angle** on those cells. A cell's probability is
 //!
 //! ```text
 //! P(cell) = (1 - e) m(cell) / sum m  +  e Omega(cell) / (2 pi),       e = DEFENSIVE = 0.01

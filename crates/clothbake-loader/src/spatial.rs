@@ -207,6 +207,7 @@ impl Spatial {
     }
 
     /// The cell (warp column, weft row) holding point (u, v) of the period, wrapped.
+    #[inline]
     pub(crate) fn cell_at(&self, u: f64, v: f64) -> (usize, usize) {
         (
             Spatial::locate(&self.u_edges, u),
@@ -215,6 +216,7 @@ impl Spatial {
     }
 
     /// The cell column (or row) of `edges` holding fraction `t` of the period, wrapped.
+    #[inline]
     pub(crate) fn locate(edges: &[f64], t: f64) -> usize {
         let e0 = edges[0];
         let t = if t.is_finite() { t } else { 0.0 };
@@ -230,6 +232,7 @@ impl Spatial {
 
     /// Cells overlapping `[t0, t1]` (fractions, `t1 - t0 < 1`) with the share of each cell's
     /// width the interval covers.
+    #[inline]
     pub(crate) fn overlaps(edges: &[f64], t0: f64, t1: f64, out: &mut Vec<(usize, f64)>) {
         out.clear();
         let n = edges.len() - 1;

@@ -7,6 +7,7 @@
 use crate::angles::{above_horizon, has_value, theta_phi};
 #[cfg(target_arch = "x86_64")]
 use crate::avx2;
+use crate::axis::Span;
 use crate::grid::Grid;
 use crate::nodes::{Lane, MirrorLanes, Nodes, Values};
 use crate::padding::pad4;
@@ -23,10 +24,9 @@ fn angles(w: [f32; 3]) -> Option<(f32, f32)> {
     }
     let (theta, phi) = theta_phi(w);
     let phi = phi.to_degrees();
-    Some((
-        theta.to_degrees(),
-        if phi < 0.0 { phi + 360.0 } else { phi },
-    ))
+    // atan2's (-180, 180] onto the azimuth axes' span, [0, 360).
+    let turn = Span::Turn.degrees_f32();
+    Some((theta.to_degrees(), if phi < 0.0 { phi + turn } else { phi }))
 }
 
 /// The classes' values of a spatial table and its layout, for lookups at a point of the period.
