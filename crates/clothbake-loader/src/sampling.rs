@@ -111,6 +111,8 @@ impl Sampler {
                     (1.0, 0.0)
                 };
                 for ti in 0..nti as usize {
+                    // The uniform density over the incident hemisphere's 2 pi sr (a polar axis
+                    // over the hemisphere, `Span::Hemisphere`; a block of a sphere table keeps it).
                     let uniform = e * omega[ti] / std::f64::consts::TAU;
                     let row = &mut m[ti * npi as usize..(ti + 1) * npi as usize];
                     for x in row.iter_mut() {
