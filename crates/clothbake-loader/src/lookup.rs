@@ -131,7 +131,7 @@ pub struct Brdf {
     /// The sampling CDFs, built from the nodes on the first [`Brdf::sample`] or
     /// [`Brdf::pdf`] (`Brdf::sampler`).
     sampler: OnceLock<Sampler>,
-    /// The classes of a spatially varying table (`crate::spatial`).
+    /// The classes of a spatially varying table (`crate::spatial_lookup`).
     spatial: Option<SpatialLookup>,
     /// The point level, where the table carries its yarns and the options ask for it.
     point: Option<PointLevel>,

@@ -89,7 +89,7 @@ fn poles(
     (pole_i, pole_o, pole_io)
 }
 
-/// [`pad`] of four lanes (a spatial table's two classes a node, `crate::spatial`).
+/// [`pad`] of four lanes (a spatial table's two classes a node, `crate::spatial_lookup`).
 pub(crate) fn pad4(
     g: &Grid,
     value: &(dyn Fn(u32, u32, u32, u32) -> [f32; 4] + Sync),
