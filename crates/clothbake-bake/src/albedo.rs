@@ -8,27 +8,12 @@
 //! `f_r = rho / pi` has albedo rho at any resolution.
 
 use clothbake_loader::{Grid, Table};
-use std::f64::consts::PI;
 
-/// The polar cell (of `n`) whose centre is nearest to `deg` degrees: the one containing it (on
-/// a cell edge, the upper one).
-pub fn nearest_polar(n: u32, deg: f64) -> u32 {
-    let k = (deg * f64::from(n) / 90.0).floor();
-    (k.max(0.0) as u32).min(n - 1)
-}
-
-/// The azimuth cell (of `n`) whose centre is nearest to `deg` degrees: the one containing it
-/// (on a cell edge, the upper one: cell 0, centred on 180 / n degrees, for 0 degrees).
-pub fn nearest_azimuth(n: u32, deg: f64) -> u32 {
-    let k = (deg.rem_euclid(360.0) * f64::from(n) / 360.0).floor();
-    (k.max(0.0) as u32).min(n - 1)
-}
-
-/// `integral of cos(theta) d omega` over outgoing polar cell `to` and one azimuth cell.
+/// `integral of cos(theta) d omega` over outgoing polar cell `to` and one azimuth cell (the
+/// cells' edges: [`clothbake_loader::Axis::edge_rad`]).
 pub fn cell_weight(g: &Grid, to: u32) -> f64 {
-    let dt = PI / 2.0 / f64::from(g.n_theta_o);
-    let (lo, hi) = (f64::from(to) * dt, f64::from(to + 1) * dt);
-    let dphi = 2.0 * PI / f64::from(g.n_phi_o);
+    let (lo, hi) = (g.theta_o().edge_rad(to), g.theta_o().edge_rad(to + 1));
+    let dphi = g.phi_o().width_rad();
     dphi * (hi.sin().powi(2) - lo.sin().powi(2)) / 2.0
 }
 
@@ -65,21 +50,5 @@ mod tests {
         for k in 0..3 {
             assert!((a[k] - f64::from(rho[k])).abs() < 1e-6, "{a:?}");
         }
-    }
-
-    #[test]
-    fn nearest_cells() {
-        assert_eq!(nearest_polar(32, 0.0), 0);
-        assert_eq!(nearest_polar(32, 30.0), 10); // centre 29.53
-        assert_eq!(nearest_polar(32, 60.0), 21); // centre 60.47
-        assert_eq!(nearest_polar(32, 80.0), 28); // centre 80.16
-        assert_eq!(nearest_polar(32, 90.0), 31);
-        assert_eq!(nearest_polar(8, 80.0), 7);
-        assert_eq!(nearest_azimuth(64, 0.0), 0);
-        assert_eq!(nearest_azimuth(64, 359.0), 63);
-        assert_eq!(nearest_azimuth(8, 90.0), 2); // 67.5 and 112.5 tie: the upper
-        assert_eq!(nearest_azimuth(8, 80.0), 1);
-        assert_eq!(nearest_azimuth(8, -10.0), 7);
-        assert_eq!(nearest_azimuth(1, 200.0), 0);
     }
 }

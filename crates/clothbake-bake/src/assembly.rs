@@ -14,8 +14,9 @@
 //! evaluated it; a finished row never changes, so a checkpoint may gather the rows finished
 //! when it starts while others are being written.
 
+use crate::directions::row_cell;
 use crate::shard::{write_rows, Kind, ShardId};
-use crate::sweep::{row_cell, Orbits, Row};
+use crate::sweep::{Orbits, Row};
 use clothbake_loader::spatial::value_index;
 use clothbake_loader::{Metadata, TableError};
 use std::ops::Range;

@@ -6,8 +6,9 @@
 //! assembly is the single bake's own ([`Assembly`]), so the table is bit-identical.
 
 use crate::assembly::Assembly;
+use crate::orbit::usable_symmetries;
 use crate::shard::{describe_rows, shard_rows, Kind, Part, PartError, ShardId};
-use crate::sweep::{symmetry_name, tool_name, usable_symmetries, Orbits};
+use crate::sweep::{symmetry_name, tool_name, Orbits};
 use clothbake_core::Fabric;
 use clothbake_loader::{Metadata, Table};
 use std::collections::BTreeMap;

@@ -13,8 +13,9 @@
 //! (rows in increasing order, each [`Row`] in cell order, RGB): exactly the f32 values the
 //! single-process bake computes, so a merge is bit-identical to it.
 
+use crate::directions::row_cell;
 use crate::settings::Naming;
-use crate::sweep::{row_cell, Orbits, Row};
+use crate::sweep::{Orbits, Row};
 use clothbake_loader::container::{read_container, write_container_counted, ContainerKind};
 use clothbake_loader::{Grid, Metadata, TableError};
 use serde::{Deserialize, Serialize};

@@ -7,7 +7,7 @@ use clothbake_core::{AnalyticModel, ClassTerms};
 use clothbake_loader::spatial::MAX_SPATIAL_CELLS;
 use clothbake_loader::{Grid, Spatial};
 
-use crate::sweep::direction;
+use crate::directions::direction;
 
 /// Entries of a row per grid cell in a spatial bake whose classes hold `class_values` values
 /// per grid cell (2 K, or 6 K with the second bounce): the averaged RGB and those, three to an

@@ -4,7 +4,8 @@
 //!
 //! * The part varies slowly with direction, so it is estimated on a coarse cell-centred grid
 //!   ([`coarse_grid`], at most [`COARSE`]) and interpolated quadrilinearly in (theta_i, phi_i,
-//!   theta_o, phi_o) (azimuths periodic, polar angles clamped to the outer centres). What is
+//!   theta_o, phi_o) (azimuths periodic, polar angles clamped to the outer centres: each axis's
+//!   [`clothbake_loader::Axis::coarse_taps_deg`]). What is
 //!   interpolated is the residual relative to the analytic direct term I_1 (per channel), which
 //!   a cell multiplies by its own I_1: its noise stays a fixed fraction of I_1 toward the
 //!   horizon, where I_1 falls faster than between two nodes.
@@ -14,7 +15,8 @@
 //!   are computed in parallel before the rows ([`Multiple::prepare`]), each once; so the table
 //!   is bit-identical for any thread count, shard split and resume.
 
-use crate::sweep::{direction, representative, usable_symmetries};
+use crate::directions::{direction, row_cell};
+use crate::orbit::{representative, usable_symmetries};
 use clothbake_core::symmetry::Symmetry;
 use clothbake_core::transport::{bounces_name, max_order, Transport};
 use clothbake_core::{
@@ -86,24 +88,6 @@ pub struct Multiple {
     syms: Vec<Symmetry>,
     /// Per node: the residual over I_1, RGB, and its channel mean's standard error over I_1.
     nodes: Vec<OnceLock<[f64; 4]>>,
-}
-
-/// One axis's two neighbouring node indices and the weight of the second.
-fn polar(theta_deg: f64, n: u32) -> [(u32, f64); 2] {
-    let x = (theta_deg * f64::from(n) / 90.0 - 0.5).clamp(0.0, f64::from(n - 1));
-    let k = (x.floor() as u32).min(n.saturating_sub(2));
-    let t = x - f64::from(k);
-    if n == 1 {
-        return [(0, 1.0), (0, 0.0)];
-    }
-    [(k, 1.0 - t), (k + 1, t)]
-}
-
-fn azimuth(phi_deg: f64, n: u32) -> [(u32, f64); 2] {
-    let x = (phi_deg.rem_euclid(360.0) * f64::from(n) / 360.0 - 0.5).rem_euclid(f64::from(n));
-    let k = (x.floor() as u32).min(n - 1);
-    let t = x - f64::from(k);
-    [(k, 1.0 - t), ((k + 1) % n, t)]
 }
 
 fn angles(w: UnitVec3) -> (f64, f64) {
@@ -224,11 +208,11 @@ impl Multiple {
         let mut need = vec![false; self.grid.len()];
         let g = self.grid;
         for &row in rows {
-            let (ti, pi) = crate::sweep::row_cell(table, row);
-            let th = Grid::polar_centre_deg(ti, table.n_theta_i);
-            let ph = Grid::azimuth_centre_deg(pi, table.n_phi_i);
-            for (a, _) in polar(th, g.n_theta_i) {
-                for (b, _) in azimuth(ph, g.n_phi_i) {
+            let (ti, pi) = row_cell(table, row);
+            let th = table.theta_i().centre_deg(ti);
+            let ph = table.phi_i().centre_deg(pi);
+            for (a, _) in g.theta_i().coarse_taps_deg(th) {
+                for (b, _) in g.phi_i().coarse_taps_deg(ph) {
                     for to in 0..g.n_theta_o {
                         for po in 0..g.n_phi_o {
                             need[self.canonical(a, b, to, po)] = true;
@@ -280,10 +264,10 @@ impl Multiple {
         let g = self.grid;
         let ((ti, pi), (to, po)) = (angles(wi), angles(wo));
         let mut v = [0.0; 3];
-        for (a, wa) in polar(ti, g.n_theta_i) {
-            for (b, wb) in azimuth(pi, g.n_phi_i) {
-                for (c, wc) in polar(to, g.n_theta_o) {
-                    for (d, wd) in azimuth(po, g.n_phi_o) {
+        for (a, wa) in g.theta_i().coarse_taps_deg(ti) {
+            for (b, wb) in g.phi_i().coarse_taps_deg(pi) {
+                for (c, wc) in g.theta_o().coarse_taps_deg(to) {
+                    for (d, wd) in g.phi_o().coarse_taps_deg(po) {
                         let w = wa * wb * wc * wd;
                         if w == 0.0 {
                             continue;
@@ -346,30 +330,5 @@ impl Bsdf for FullTransport {
     fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb {
         let (d, r) = (self.model.f(wi, wo), self.multiple.f(wi, wo));
         std::array::from_fn(|k| d[k] + r[k])
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn axis_weights_interpolate_between_centres_and_wrap() {
-        // 8 polar cells: centres at 5.625 + 11.25 k.
-        let [(a, wa), (b, wb)] = polar(5.625, 8);
-        assert_eq!((a, b), (0, 1));
-        assert!((wa - 1.0).abs() < 1e-12 && wb.abs() < 1e-12);
-        let [(a, wa), (_, wb)] = polar(89.0, 8);
-        assert_eq!(a, 6);
-        assert!(wa.abs() < 1e-12 && (wb - 1.0).abs() < 1e-12, "clamped");
-        let [(a, wa), (b, wb)] = polar(0.0, 8);
-        assert_eq!((a, b, wa, wb), (0, 1, 1.0, 0.0));
-        // 16 azimuth cells: centres at 11.25 + 22.5 k; 0 degrees lies between 15 and 0.
-        let [(a, wa), (b, wb)] = azimuth(0.0, 16);
-        assert_eq!((a, b), (15, 0));
-        assert!((wa - 0.5).abs() < 1e-12 && (wb - 0.5).abs() < 1e-12);
-        let [(a, _), (b, wb)] = azimuth(-11.25 + 360.0 * 3.0, 16);
-        assert_eq!((a, b), (15, 0));
-        assert!(wb.abs() < 1e-9);
     }
 }

@@ -8,13 +8,24 @@
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
-/// Directions with `cos theta` at or below this are on or below the horizon: zero.
-pub const HORIZON_COS: f32 = 1e-9;
+/// Directions with `cos theta` at or below this are on or below the horizon: zero. The one
+/// horizon of every reflectance, [`clothbake_bsdf::HORIZON_COS`], in the f32 the lookups
+/// compare their f32 directions with (1e-9 rounded to f32 once: widening each `z` to compare
+/// it in f64 would move the horizon by the difference of the two roundings, about 3e-17, and
+/// cost a conversion per direction on the render path).
+pub const HORIZON_COS: f32 = clothbake_bsdf::HORIZON_COS as f32;
 
 /// True when a unit vector is above the horizon (`z > 1e-9`); false for NaN.
 #[inline(always)]
 pub fn above_horizon(w: [f32; 3]) -> bool {
     w[2] > HORIZON_COS
+}
+
+/// True when a pair has a value: both directions above the horizon, no component NaN.
+#[inline(always)]
+pub(crate) fn has_value(wi: [f32; 3], wo: [f32; 3]) -> bool {
+    let nan = wi.iter().chain(&wo).any(|x| x.is_nan());
+    !nan && above_horizon(wi) && above_horizon(wo)
 }
 
 /// Coefficients `c_j` of `atan(a) ~ a * sum_j c_j a^(2j)` on `0 <= a <= 1`.
@@ -75,6 +86,13 @@ pub fn direction(theta: f32, phi: f32) -> [f32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_horizon_is_the_bsdf_crates_rounded_to_f32() {
+        assert_eq!(HORIZON_COS.to_bits(), 1e-9f32.to_bits());
+        assert_eq!(f64::from(HORIZON_COS) as f32, HORIZON_COS);
+        assert!((f64::from(HORIZON_COS) - clothbake_bsdf::HORIZON_COS).abs() < 1e-16);
+    }
 
     #[test]
     fn atan2_is_within_2e6_rad_of_the_standard_library_everywhere() {

@@ -217,8 +217,8 @@ struct Corner {
 #[inline]
 #[target_feature(enable = "avx2,fma,f16c")]
 unsafe fn corner(nodes: &Nodes, pos: __m128) -> Corner {
-    // As nodes::polar_axis (lanes 0, 2) and nodes::azimuth_axis (lanes 1, 3): the positions
-    // clamped to [0, cap] (NaN -> 0) with cap = n (hold the last ring) or 2n (the azimuth's
+    // As Axis::lookup_node of the polar (lanes 0, 2) and azimuth axes (lanes 1, 3), in the
+    // form of Axis::lookup_lines: the positions clamped to [0, cap] (NaN -> 0) with cap = n (hold the last ring) or 2n (the azimuth's
     // range).
     let k = &nodes.lanes;
     let s = _mm_min_ps(
@@ -552,23 +552,12 @@ pub(crate) unsafe fn batch<V: Lane>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::table::Grid;
+    use crate::axis::Span;
+    use crate::grid::Grid;
 
     /// The probes of the build script, to fail with its message when run without AVX2.
     mod probe {
         include!("../build/probe.rs");
-    }
-
-    /// The documented position in cells (as `nodes::polar_axis`/`azimuth_axis` before
-    /// clamping) of an angle in f64 on axis `k` of `n` cells.
-    fn position(k: usize, n: u32, angle: f64) -> f64 {
-        let n = f64::from(n);
-        if k.is_multiple_of(2) {
-            let c = angle * n / std::f64::consts::FRAC_PI_2;
-            (2.0 * c).min(c + 0.5)
-        } else {
-            angle * n / std::f64::consts::TAU + n - 0.5
-        }
     }
 
     #[test]
@@ -582,7 +571,8 @@ mod tests {
         let g = Grid::new(32, 64, 90, 360);
         // The positions need the lookup's constants only.
         let nodes = Nodes::empty(&g);
-        let n = [g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o];
+        // The documented position in cells of an angle on each axis, in f64.
+        let axes = g.axes();
         // A grid over the hemisphere (and lengths other than 1: only directions matter),
         // with the axes, the pole and the horizon.
         let mut dirs = vec![
@@ -593,7 +583,7 @@ mod tests {
         ];
         for i in 0..=300 {
             for j in 0..300 {
-                let theta = std::f64::consts::FRAC_PI_2 * f64::from(i) / 300.0;
+                let theta = Span::Hemisphere.radians() * f64::from(i) / 300.0;
                 let phi = std::f64::consts::TAU * f64::from(j) / 300.0 - 3.0;
                 let len = 1.0 + f64::from((i * j) % 3);
                 dirs.push([
@@ -624,10 +614,10 @@ mod tests {
                 if k % 2 == 1 && v[0] == 0.0 && v[1] == 0.0 {
                     continue; // no azimuth at the pole (std gives pi for x = -0, the kernel 0)
                 }
-                let e = (f64::from(got[k]) - position(k, n[k], want[k])).abs();
+                let e = (f64::from(got[k]) - axes[k].lookup_position(want[k])).abs();
                 // Azimuths: modulo a turn (f64 gives -pi for y = -0, the kernel +pi).
                 let e = if k % 2 == 1 {
-                    e.min((e - f64::from(n[k])).abs())
+                    e.min((e - f64::from(axes[k].count())).abs())
                 } else {
                     e
                 };
@@ -651,7 +641,7 @@ mod tests {
             let mut got = [0f32; 4];
             unsafe { _mm_storeu_ps(got.as_mut_ptr(), pos) };
             assert!(
-                (f64::from(got[1]) - position(1, n[1], phi)).abs() < 1e-4,
+                (f64::from(got[1]) - axes[1].lookup_position(phi)).abs() < 1e-4,
                 "{w:?} {got:?}"
             );
         }

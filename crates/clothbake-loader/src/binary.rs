@@ -162,7 +162,7 @@ mod legacy {
     struct HeaderV1 {
         format_version: u32,
         tool: String,
-        grid: crate::table::Grid,
+        grid: crate::grid::Grid,
         centring: String,
         quantity: String,
         units: String,

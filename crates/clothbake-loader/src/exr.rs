@@ -8,9 +8,10 @@ use std::path::Path;
 use crate::atomic::write_atomic_as;
 use crate::bytes::{hex, CHUNK_VALUES};
 use crate::error::TableError;
+use crate::grid::Grid;
 use crate::spatial::value_index;
 use crate::stored::{Samples, StoredTable};
-use crate::table::{check_format_version, Grid, Metadata, Precision, Table, FORMAT_VERSION};
+use crate::table::{check_format_version, Metadata, Precision, Table, FORMAT_VERSION};
 
 /// The 4 magic bytes that open every OpenEXR file.
 pub const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
@@ -51,15 +52,17 @@ pub fn layout_text(g: &Grid) -> String {
     )
 }
 
-/// The cell centres and direction conventions in words, with the grid's numbers (the formulas
-/// of [`Grid::polar_centre_deg`] and [`Grid::azimuth_centre_deg`]).
+/// The cell centres and direction conventions in words, with the grid's numbers (each axis's
+/// [`crate::Axis::centre_text`]).
 pub fn directions_text(g: &Grid) -> String {
     format!(
-        "cell centres in degrees: theta_i = (ti + 0.5) * 90 / {}, phi_i = (pi + 0.5) * 360 / {}, \
-         theta_o = (to + 0.5) * 90 / {}, phi_o = (po + 0.5) * 360 / {}; theta from the macro \
-         normal +Z, phi from +X (the weft) toward +Y (the warp); i toward the light, o toward \
-         the eye",
-        g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o
+        "cell centres in degrees: theta_i = {}, phi_i = {}, theta_o = {}, phi_o = {}; theta \
+         from the macro normal +Z, phi from +X (the weft) toward +Y (the warp); i toward the \
+         light, o toward the eye",
+        g.theta_i().centre_text("ti"),
+        g.phi_i().centre_text("pi"),
+        g.theta_o().centre_text("to"),
+        g.phi_o().centre_text("po"),
     )
 }
 
@@ -1010,7 +1013,7 @@ mod exr_io {
     /// The lookup's node table of an averaged half-float table straight from the file's
     /// lines ([`HalfBlocks`]): no samples in the table's order, no second pass for the
     /// checksum. `None` for any other table (spatial, float samples, tiles), which the caller
-    /// reads as stored. The nodes are those of `lookup::pad` of the stored samples, lane for
+    /// reads as stored. The nodes are those of `padding::pad` of the stored samples, lane for
     /// lane; the values are checked as they pass (the first unphysical one in the table's
     /// order is reported as [`StoredTable::new`] reports it).
     pub(super) fn half_nodes(c: &Checked<'_>) -> Result<Option<crate::nodes::Nodes>, TableError> {
@@ -1083,7 +1086,7 @@ mod exr_io {
             }
 
             /// The mean of lane `k` over `cells`, in f64 in their order, as an f32 rounded
-            /// to half (as `lookup::poles` and the lane conversion make it).
+            /// to half (as `padding::poles` and the lane conversion make it).
             fn mean(&self, cells: impl Iterator<Item = (usize, usize, usize)>) -> [f16; 4] {
                 let (mut sum, mut n) = ([0f64; 4], 0f64);
                 for (pi, to, po) in cells {

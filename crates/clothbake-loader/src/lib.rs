@@ -13,21 +13,27 @@ pub mod angles;
 mod atomic;
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+mod axis;
 mod binary;
 mod bsdf;
 mod bytes;
 pub mod container;
 mod error;
 pub mod exr;
+mod grid;
 pub mod lookup;
 mod nodes;
+mod padding;
 mod read;
 pub mod sampling;
+mod simd;
 pub mod spatial;
+mod spatial_lookup;
 pub mod stored;
 mod table;
 
 pub use atomic::{abandon_temporaries, bake_owned, check_target, write_atomic_as, Batch};
+pub use axis::{Axis, Span};
 pub use binary::{read_binary, write_binary};
 pub use clothbake_bsdf::{Bsdf, BsdfSample, UnitVec3};
 pub use container::{
@@ -36,9 +42,11 @@ pub use container::{
 };
 pub use error::TableError;
 pub use exr::{read_exr, read_exr_stored, write_exr, EXR_MAGIC};
+pub use grid::{Grid, MAX_CELLS};
 pub use half::f16;
 pub use lookup::{Brdf, LengthMismatch, Memory, Options, Sample, SimdPath, HORIZON_COS};
 pub use read::{read_table, read_table_stored};
-pub use spatial::{Spatial, SpatialLookup};
+pub use spatial::Spatial;
+pub use spatial_lookup::SpatialLookup;
 pub use stored::{Samples, StoredTable};
-pub use table::{Grid, Metadata, Precision, Table, FORMAT_VERSION, MAX_CELLS, MAX_VALUE};
+pub use table::{Metadata, Precision, Table, FORMAT_VERSION, MAX_VALUE};

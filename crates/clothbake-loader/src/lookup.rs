@@ -28,25 +28,22 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 pub use crate::angles::{above_horizon, HORIZON_COS};
+pub use crate::simd::SimdPath;
 
-use crate::angles::{direction, theta_phi};
+use crate::angles::{direction, has_value, theta_phi};
 #[cfg(target_arch = "x86_64")]
 use crate::avx2;
+use crate::axis::Span;
 use crate::error::TableError;
+use crate::grid::Grid;
 use crate::nodes::{self, Lane, Nodes, Values};
+use crate::padding::pad;
 use crate::sampling::Sampler;
-use crate::spatial::SpatialLookup;
+use crate::spatial_lookup::SpatialLookup;
 use crate::stored::{Samples, StoredTable};
-use crate::table::{Grid, Metadata, Precision, Table};
+use crate::table::{Metadata, Precision, Table};
 use clothbake_bsdf::{Footprint, Level, Local};
 use half::f16;
-
-/// True when a pair has a value: both directions above the horizon, no component NaN.
-#[inline(always)]
-pub(crate) fn has_value(wi: [f32; 3], wo: [f32; 3]) -> bool {
-    let nan = wi.iter().chain(&wo).any(|x| x.is_nan());
-    !nan && above_horizon(wi) && above_horizon(wo)
-}
 
 /// How values are held in memory.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -122,41 +119,6 @@ impl fmt::Display for LengthMismatch {
 
 impl std::error::Error for LengthMismatch {}
 
-/// The code path (kernel) that runs the lookups, chosen once when a [`Brdf`] is built.
-///
-/// Both follow the same rules with the same operations in each lane; the AVX2 kernel fuses
-/// multiply-adds and sums in another order, so the two agree to about 1e-5 relative (tested),
-/// not bit for bit. Each is deterministic: the same lookup gives the same bits every time.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SimdPath {
-    /// Plain Rust (SSE2 on x86-64; any target).
-    Portable,
-    /// x86-64 with AVX2, FMA and F16C, detected at run time.
-    Avx2,
-}
-
-impl SimdPath {
-    /// True when this processor can run the kernel.
-    pub fn is_available(self) -> bool {
-        match self {
-            SimdPath::Portable => true,
-            #[cfg(target_arch = "x86_64")]
-            SimdPath::Avx2 => avx2::available(),
-            #[cfg(not(target_arch = "x86_64"))]
-            SimdPath::Avx2 => false,
-        }
-    }
-
-    /// The fastest kernel this processor runs (the default of every [`Brdf`]).
-    pub fn best() -> SimdPath {
-        if SimdPath::Avx2.is_available() {
-            SimdPath::Avx2
-        } else {
-            SimdPath::Portable
-        }
-    }
-}
-
 /// A baked table ready for render-time lookups and importance sampling.
 #[derive(Clone, Debug)]
 pub struct Brdf {
@@ -169,7 +131,7 @@ pub struct Brdf {
     /// The sampling CDFs, built from the nodes on the first [`Brdf::sample`] or
     /// [`Brdf::pdf`] (`Brdf::sampler`).
     sampler: OnceLock<Sampler>,
-    /// The classes of a spatially varying table (`crate::spatial`).
+    /// The classes of a spatially varying table (`crate::spatial_lookup`).
     spatial: Option<SpatialLookup>,
     /// The point level, where the table carries its yarns and the options ask for it.
     point: Option<PointLevel>,
@@ -533,19 +495,21 @@ impl Brdf {
     }
 
     /// `f_r` at polar angles and azimuths in degrees (theta from +Z, phi from +X toward +Y),
-    /// as the tables use; 0 unless `0 <= theta < 90` for both directions.
+    /// as the tables use; 0 unless `0 <= theta < 90` (the polar axes' span) for both
+    /// directions.
     pub fn eval_deg(&self, theta_i: f32, phi_i: f32, theta_o: f32, phi_o: f32) -> [f32; 3] {
+        let g = self.grid();
         // Every f32 below 90 has cos(theta) > HORIZON_COS (tested), so no cosine is needed.
-        let ok = |t: f32| (0.0..90.0).contains(&t);
-        if !(ok(theta_i) && ok(theta_o)) {
+        if !(g.theta_i().holds_deg(theta_i) && g.theta_o().holds_deg(theta_o)) {
             return [0.0; 3];
         }
         let r = f32::to_radians;
+        let turn = Span::Turn.degrees_f32();
         let wrap = |phi: f32| {
-            if (0.0..360.0).contains(&phi) {
+            if (0.0..turn).contains(&phi) {
                 phi
             } else if phi.is_finite() {
-                phi.rem_euclid(360.0)
+                phi.rem_euclid(turn)
             } else {
                 0.0
             }
@@ -668,112 +632,17 @@ impl Brdf {
     }
 }
 
-/// The padded node table ([`Nodes`]) of an averaged table's values, where polar row 0 is
-/// the pole node (the mean over the azimuths of the first ring) and row `k + 1` is cell `k`;
-/// half floats when `f16` and the samples are half. The same lanes as [`pad4`] of the
-/// widened values (a half's bits are copied, which is what rounding its widened value gives),
-/// filled a row at a time from the samples.
-fn pad(g: &Grid, samples: &Samples, f16: bool) -> Nodes {
-    let widen = |h: f16| crate::stored::f16_to_f32(h.to_bits());
-    let values = match samples {
-        Samples::F16(s) if f16 => Values::F16(pad_rows(g, s, widen, |h| h, f16::from_f32)),
-        Samples::F16(s) => Values::F32(pad_rows(g, s, widen, widen, |x| x)),
-        Samples::F32(s) => Values::F32(pad_rows(g, s, |x| x, |x| x, |x| x)),
-    };
-    Nodes::with_values(g, values)
-}
-
-/// The tiles of [`pad`] from samples `s` (interleaved RGB in cell order): `widen` gives a
-/// sample's f32 value, `copy` its lane, `lane` the lane of an f32 (the pole means, 0).
-fn pad_rows<S: Copy + Sync, V: Copy + Default + Send + Sync>(
-    g: &Grid,
-    s: &[S],
-    widen: impl Fn(S) -> f32 + Sync,
-    copy: impl Fn(S) -> V + Sync,
-    lane: impl Fn(f32) -> V + Sync,
-) -> nodes::Tiles<V> {
-    let (npi, npo) = (g.n_phi_i as usize, g.n_phi_o as usize);
-    let value = |ti: u32, pi: u32, to: u32, po: u32| -> [f32; 4] {
-        let c = 3 * g.index(ti, pi, to, po);
-        [widen(s[c]), widen(s[c + 1]), widen(s[c + 2]), 0.0]
-    };
-    let (pole_i, pole_o, pole_io) = poles(g, &value);
-    let zero = lane(0.0);
-    let pole_i: Vec<[V; 4]> = pole_i.iter().map(|x| x.map(&lane)).collect();
-    let pole_o: Vec<[V; 4]> = pole_o.iter().map(|x| x.map(&lane)).collect();
-    let pole_io = pole_io.map(&lane);
-    nodes::Tiles::from_rows(g, &|ri, pi, ro, row: &mut [[V; 4]]| match (ri, ro) {
-        (0, 0) => row.fill(pole_io),
-        (0, _) => row.copy_from_slice(&pole_i[(ro as usize - 1) * npo..ro as usize * npo]),
-        (_, 0) => row.fill(pole_o[(ri as usize - 1) * npi + pi as usize]),
-        _ => {
-            let c = 3 * g.index(ri - 1, pi, ro - 1, 0);
-            for (x, v) in row.iter_mut().zip(s[c..c + 3 * npo].chunks_exact(3)) {
-                *x = [copy(v[0]), copy(v[1]), copy(v[2]), zero];
-            }
-        }
-    })
-}
-
-/// The pole nodes of `value` (cell `(ti, pi, to, po)`, four lanes): at the incident pole, per
-/// outgoing cell `(to, po)`, the mean over `phi_i` of the first incident ring; at the
-/// outgoing pole, per incident cell, the mean over `phi_o`; at both, the mean of both first
-/// rings. Means in f64, in a fixed order.
-#[allow(clippy::type_complexity)]
-fn poles(
-    g: &Grid,
-    value: &dyn Fn(u32, u32, u32, u32) -> [f32; 4],
-) -> (Vec<[f32; 4]>, Vec<[f32; 4]>, [f32; 4]) {
-    let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
-    // Mean of `value` over the listed azimuth pairs, in f64, in a fixed order.
-    let mean = |pairs: &mut dyn Iterator<Item = [f32; 4]>| -> [f32; 4] {
-        let (mut sum, mut n) = ([0f64; 4], 0f64);
-        for x in pairs {
-            for k in 0..4 {
-                sum[k] += f64::from(x[k]);
-            }
-            n += 1.0;
-        }
-        sum.map(|s| (s / n) as f32)
-    };
-    let pole_i: Vec<[f32; 4]> = (0..nto)
-        .flat_map(|to| (0..npo).map(move |po| (to, po)))
-        .map(|(to, po)| mean(&mut (0..npi).map(|pi| value(0, pi, to, po))))
-        .collect();
-    let pole_o: Vec<[f32; 4]> = (0..nti)
-        .flat_map(|ti| (0..npi).map(move |pi| (ti, pi)))
-        .map(|(ti, pi)| mean(&mut (0..npo).map(|po| value(ti, pi, 0, po))))
-        .collect();
-    let pole_io = mean(&mut (0..npi).flat_map(|pi| (0..npo).map(move |po| value(0, pi, 0, po))));
-    (pole_i, pole_o, pole_io)
-}
-
-/// [`pad`] of four lanes (a spatial table's two classes a node, `crate::spatial`).
-pub(crate) fn pad4(
-    g: &Grid,
-    value: &(dyn Fn(u32, u32, u32, u32) -> [f32; 4] + Sync),
-    f16: bool,
-) -> Nodes {
-    let npo = g.n_phi_o;
-    let npi = g.n_phi_i;
-    let (pole_i, pole_o, pole_io) = poles(g, value);
-    let node = |ri: u32, pi: u32, ro: u32, po: u32| match (ri, ro) {
-        (0, 0) => pole_io,
-        (0, _) => pole_i[((ro - 1) * npo + po) as usize],
-        (_, 0) => pole_o[((ri - 1) * npi + pi) as usize],
-        _ => value(ri - 1, pi, ro - 1, po),
-    };
-    Nodes::new4(g, &node, f16)
-}
-
 #[cfg(test)]
 mod tests {
     use super::HORIZON_COS;
+    use crate::axis::Span;
 
     #[test]
     fn every_f32_polar_angle_below_90_degrees_is_above_the_horizon() {
-        // The 100 000 largest f32 below 90; below those cos exceeds 0.008.
-        let mut t = 90f32;
+        // The 100 000 largest f32 below 90 (the polar span, which `eval_deg` holds angles
+        // to); below those cos exceeds 0.008.
+        let mut t = Span::Hemisphere.degrees_f32();
+        assert_eq!(t, 90.0);
         for _ in 0..100_000 {
             t = f32::from_bits(t.to_bits() - 1);
             assert!(t.to_radians().cos() > HORIZON_COS, "{t}");

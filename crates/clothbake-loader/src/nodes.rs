@@ -36,8 +36,9 @@ use std::arch::x86_64::{__m128i, __m256, _mm256_cvtph_ps, _mm256_loadu_ps, _mm_l
 use half::f16;
 
 use crate::angles::{atan2, ATAN_COEFFS};
+use crate::axis::Axis;
+use crate::grid::Grid;
 use crate::stored::f16_to_f32;
-use crate::table::Grid;
 
 /// Lanes per node: R, G, B and a zero pad.
 pub(crate) const LANES: usize = 4;
@@ -362,7 +363,8 @@ pub(crate) struct Nodes {
     /// `s_ti + TILE_ROW + 8`: lanes from the start of a lookup's first run at one `phi_i`
     /// column to the end of its last.
     extent: usize,
-    /// Cells per radian of the four axes (theta_i, phi_i, theta_o, phi_o).
+    /// Cells per radian of the four axes (theta_i, phi_i, theta_o, phi_o):
+    /// [`Axis::cells_per_radian`].
     pub(crate) scale: [f32; 4],
     /// Cells on the four axes.
     pub(crate) n: [u32; 4],
@@ -371,13 +373,12 @@ pub(crate) struct Nodes {
 }
 
 /// Constants of the spans of the four axes, one lane each (theta_i, phi_i, theta_o, phi_o):
-/// the AVX2 kernel's form of [`polar_axis`] and [`azimuth_axis`].
+/// the AVX2 kernel's form of the axes' [`Axis::lookup_node`] ([`Axis::lookup_lines`]).
 #[derive(Clone, Debug)]
 #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))] // read by the AVX2 kernel only
 pub(crate) struct SpanLanes {
-    /// Position in cells of an angle `a`: `min(a k1 + b1, a k2 + b2)` per lane. Polar lanes:
-    /// `k1 = 2 scale, b1 = 0` and `k2 = scale, b2 = 1/2` (the `2c` or `c + 1/2` of
-    /// [`polar_axis`]); azimuth lanes: `k1 = k2 = scale`, `b1 = b2 = n - 1/2`.
+    /// Position in cells of an angle `a`: `min(a k1 + b1, a k2 + b2)` per lane (see
+    /// [`Axis::lookup_lines`]).
     pub(crate) k1: [f32; 4],
     /// See [`SpanLanes::k1`].
     pub(crate) b1: [f32; 4],
@@ -402,39 +403,23 @@ pub(crate) struct SpanLanes {
 }
 
 impl SpanLanes {
-    /// The constants of axes of `n` cells (theta_i, phi_i, theta_o, phi_o) and `scale` cells
-    /// per radian.
-    fn new(n: [u32; 4], scale: [f32; 4]) -> SpanLanes {
-        let polar = |k: usize| k.is_multiple_of(2);
-        let lanes = |f: &dyn Fn(usize) -> f32| -> [f32; 4] { std::array::from_fn(f) };
-        let k1 = lanes(&|k| if polar(k) { 2.0 * scale[k] } else { scale[k] });
-        let k2 = scale;
-        let b1 = lanes(&|k| if polar(k) { 0.0 } else { n[k] as f32 - 0.5 });
-        let b2 = lanes(&|k| if polar(k) { 0.5 } else { n[k] as f32 - 0.5 });
+    /// The constants of the four axes (theta_i, phi_i, theta_o, phi_o).
+    fn new(axes: [Axis; 4]) -> SpanLanes {
+        let lines = axes.map(Axis::lookup_lines);
+        let k1 = lines.map(|l| l.k1);
+        let k2 = lines.map(|l| l.k2);
         let coef = |m: [f32; 4]| std::array::from_fn(|j| m.map(|m| ATAN_COEFFS[j] * m));
         SpanLanes {
             k1,
-            b1,
+            b1: lines.map(|l| l.b1),
             k2,
-            b2,
+            b2: lines.map(|l| l.b2),
             c1: coef(k1),
             c2: coef(k2),
-            cap: lanes(&|k| {
-                if polar(k) {
-                    n[k] as f32
-                } else {
-                    2.0 * n[k] as f32
-                }
-            }),
-            top: std::array::from_fn(|k| {
-                if polar(k) {
-                    n[k] as i32 - 1
-                } else {
-                    2 * n[k] as i32 - 1
-                }
-            }),
-            n: n.map(|n| n as i32),
-            exact: n.iter().all(|&n| n <= 1 << 22),
+            cap: lines.map(|l| l.cap),
+            top: lines.map(|l| l.top),
+            n: axes.map(|a| a.count() as i32),
+            exact: axes.iter().all(|a| a.count() <= 1 << 22),
         }
     }
 }
@@ -519,16 +504,15 @@ impl Nodes {
         let s_to = TILE * tiles_per_row(npo);
         let s_pi = s_to * nto as usize;
         let s_ti = s_pi * npi as usize;
-        let polar = |n: u32| n as f32 / std::f32::consts::FRAC_PI_2;
-        let azimuth = |n: u32| n as f32 / std::f32::consts::TAU;
-        let scale = [polar(nti), azimuth(npi), polar(nto), azimuth(npo)];
+        let axes = g.axes();
+        let scale = axes.map(Axis::cells_per_radian);
         Nodes {
             values: Values::F32(Tiles { tiles: Vec::new() }),
             strides: [s_ti, s_pi, s_to],
             extent: s_ti + TILE_ROW + 2 * LANES,
             scale,
             n: [nti, npi, nto, npo],
-            lanes: SpanLanes::new([nti, npi, nto, npo], scale),
+            lanes: SpanLanes::new(axes),
         }
     }
 
@@ -607,15 +591,29 @@ impl Nodes {
         }
     }
 
+    /// The four axes of the lookups, theta_i, phi_i, theta_o, phi_o (their spans known here,
+    /// so that each axis's rule is inlined without a branch on it).
+    #[inline(always)]
+    pub(crate) fn axes(&self) -> [Axis; 4] {
+        let n = self.n;
+        [
+            Axis::polar(n[0]),
+            Axis::azimuth(n[1]),
+            Axis::polar(n[2]),
+            Axis::azimuth(n[3]),
+        ]
+    }
+
     /// The corner of a lookup at angles `[theta_i, phi_i, theta_o, phi_o]`, radians (phi in
-    /// `[-pi, 2 pi)`), with the rules of the lookup module: see [`polar_axis`] and
-    /// [`azimuth_axis`].
+    /// `[-pi, 2 pi)`), with the rules of the lookup module: each axis's
+    /// [`Axis::lookup_node`] (the polar ones padded with the pole node).
     #[inline(always)]
     pub(crate) fn corner(&self, ang: [f32; 4]) -> Corner {
-        let (lo_a, ta) = polar_axis(ang[0] * self.scale[0], self.n[0]);
-        let (lo_b, tb) = azimuth_axis(ang[1] * self.scale[1], self.n[1]);
-        let (lo_c, tc) = polar_axis(ang[2] * self.scale[2], self.n[2]);
-        let (lo_d, td) = azimuth_axis(ang[3] * self.scale[3], self.n[3]);
+        let [a, b, c, d] = self.axes();
+        let (lo_a, ta) = a.lookup_node(ang[0] * self.scale[0]);
+        let (lo_b, tb) = b.lookup_node(ang[1] * self.scale[1]);
+        let (lo_c, tc) = c.lookup_node(ang[2] * self.scale[2]);
+        let (lo_d, td) = d.lookup_node(ang[3] * self.scale[3]);
         let [s_ti, s_pi, s_to] = self.strides;
         let common = lo_a as usize * s_ti + lo_c as usize * s_to + column_offset(lo_d as usize);
         let base = [
@@ -663,31 +661,6 @@ impl Nodes {
             acc[3] * u + acc[7] * t,
         ]
     }
-}
-
-/// The polar axis at `c` = angle in cells (cell `k`'s centre at `k + 0.5`) of `n` cells: the
-/// padded row `lo <= n - 1` and the weight of row `lo + 1`. Below the first centre the blend
-/// is with the pole row 0; beyond the last centre the last row is held; NaN gives row 0.
-#[inline(always)]
-pub(crate) fn polar_axis(c: f32, n: u32) -> (u32, f32) {
-    let s = if c < 0.5 { 2.0 * c } else { c + 0.5 };
-    let s = s.max(0.0).min(n as f32); // NaN -> 0
-    let lo = (s as u32).min(n - 1);
-    (lo, s - lo as f32)
-}
-
-/// The azimuth axis at `c` = angle in cells of `n` cells, `c` in `[-n/2, n)`: the column
-/// `lo <= n - 1` and the weight of column `lo + 1` (column `n` repeats column 0: between the
-/// last centre and the first, cells `n - 1` and 0 are blended). No division: shifted by `n`
-/// to be positive, truncated, one conditional wrap; NaN gives column 0 and anything outside
-/// the range some column of the table.
-#[inline(always)]
-pub(crate) fn azimuth_axis(c: f32, n: u32) -> (u32, f32) {
-    let s = (c + (n as f32 - 0.5)).max(0.0); // NaN -> 0
-    let lo = s as u32; // s >= 0: truncation is floor; saturates
-    let t = (s - lo as f32).min(1.0);
-    let lo = if lo >= n { lo - n } else { lo };
-    (lo.min(n - 1), t)
 }
 
 /// The `phi_i` column after `lo` of `n`, periodic.
@@ -905,10 +878,10 @@ mod tests {
                         Values::F16(v) => nodes.blend4(v, ang),
                         Values::F32(v) => nodes.blend4(v, ang),
                     };
-                    let (a, ta) = polar_axis(ang[0] * nodes.scale[0], n[0]);
-                    let (b, tb) = azimuth_axis(ang[1] * nodes.scale[1], n[1]);
-                    let (c, tc) = polar_axis(ang[2] * nodes.scale[2], n[2]);
-                    let (d, td) = azimuth_axis(ang[3] * nodes.scale[3], n[3]);
+                    let (a, ta) = g.theta_i().lookup_node(ang[0] * nodes.scale[0]);
+                    let (b, tb) = g.phi_i().lookup_node(ang[1] * nodes.scale[1]);
+                    let (c, tc) = g.theta_o().lookup_node(ang[2] * nodes.scale[2]);
+                    let (d, td) = g.phi_o().lookup_node(ang[3] * nodes.scale[3]);
                     let bs = [b, next_column(b, n[1])];
                     let (wa, wb, wc) = ([1.0 - ta, ta], [1.0 - tb, tb], [1.0 - tc, tc]);
                     let mut acc = [0f32; 8];

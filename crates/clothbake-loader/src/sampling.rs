@@ -2,8 +2,9 @@
 //!
 //! For each outgoing cell `(to, po)` the incident hemisphere is split into the table's incident
 //! cells `(ti, pi)`: `theta` from `ti * 90 / n_theta_i` to `(ti + 1) * 90 / n_theta_i` degrees,
-//! `phi` from `pi * 360 / n_phi_i` to `(pi + 1) * 360 / n_phi_i`. The density is **piecewise
-//! constant per unit solid angle** on those cells. A cell's probability is
+//! `phi` from `pi * 360 / n_phi_i` to `(pi + 1) * 360 / n_phi_i` (the axes' edges,
+//! [`crate::Axis::edge_rad`]; `wo`'s and `wi`'s cells by [`crate::Axis::cell_of`]). The density
+//! is **piecewise constant per unit solid angle** on those cells. A cell's probability is
 //!
 //! ```text
 //! P(cell) = (1 - e) m(cell) / sum m  +  e Omega(cell) / (2 pi),       e = DEFENSIVE = 0.01
@@ -21,7 +22,7 @@
 //! row's conditional CDF; the remainders of both, rescaled to [0, 1), place the direction
 //! uniformly in solid angle inside the cell (`cos theta` and `phi` uniform).
 
-use crate::table::Grid;
+use crate::grid::Grid;
 
 /// Weight of the uniform part of the sampling density (see the module documentation).
 pub const DEFENSIVE: f64 = 0.01;
@@ -80,9 +81,8 @@ impl Sampler {
     /// CDFs of the table `value(ti, pi, to, po)` (RGB f_r at cell centres) on grid `g`.
     pub(crate) fn new(g: &Grid, value: impl Fn(u32, u32, u32, u32) -> [f32; 3]) -> Sampler {
         let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
-        let d_theta = std::f64::consts::FRAC_PI_2 / f64::from(nti);
-        let d_phi = std::f64::consts::TAU / f64::from(npi);
-        let edges: Vec<f64> = (0..=nti).map(|k| f64::from(k) * d_theta).collect();
+        let d_phi = g.phi_i().width_rad();
+        let edges: Vec<f64> = (0..=nti).map(|k| g.theta_i().edge_rad(k)).collect();
         // Solid angle and integral of cos theta of a cell in each row.
         let omega: Vec<f64> = (0..nti as usize)
             .map(|k| d_phi * (edges[k].cos() - edges[k + 1].cos()))
@@ -111,6 +111,8 @@ impl Sampler {
                     (1.0, 0.0)
                 };
                 for ti in 0..nti as usize {
+                    // The uniform density over the incident hemisphere's 2 pi sr (a polar axis
+                    // over the hemisphere, `Span::Hemisphere`; a block of a sphere table keeps it).
                     let uniform = e * omega[ti] / std::f64::consts::TAU;
                     let row = &mut m[ti * npi as usize..(ti + 1) * npi as usize];
                     for x in row.iter_mut() {
@@ -141,8 +143,8 @@ impl Sampler {
     #[inline]
     fn outgoing_cell(&self, theta: f32, phi: f32) -> usize {
         let g = &self.grid;
-        let to = polar_cell(theta, g.n_theta_o);
-        let po = azimuth_cell(phi, g.n_phi_o);
+        let to = g.theta_o().cell_of(theta);
+        let po = g.phi_o().cell_of(phi);
         to * g.n_phi_o as usize + po
     }
 
@@ -158,7 +160,7 @@ impl Sampler {
         let (c_lo, c_hi) = (self.cos_edges[ti], self.cos_edges[ti + 1]);
         let mu = c_lo + r1 * (c_hi - c_lo);
         let theta = mu.clamp(0.0, 1.0).acos();
-        let phi = (pi as f32 + r2) * std::f32::consts::TAU / npi as f32;
+        let phi = g.phi_i().angle_at(pi as f32 + r2);
         (theta, phi)
     }
 
@@ -168,8 +170,8 @@ impl Sampler {
         let g = &self.grid;
         let (nti, npi) = (g.n_theta_i as usize, g.n_phi_i as usize);
         let oc = self.outgoing_cell(theta_o, phi_o);
-        let ti = polar_cell(theta_i, g.n_theta_i);
-        let pi = azimuth_cell(phi_i, g.n_phi_i);
+        let ti = g.theta_i().cell_of(theta_i);
+        let pi = g.phi_i().cell_of(phi_i);
         let row = (oc * nti + ti) * npi;
         let p = mass(&self.marginal[oc * nti..(oc + 1) * nti], ti)
             * mass(&self.conditional[row..row + npi], pi);
@@ -185,19 +187,4 @@ fn clamp_unit(u: f32) -> f32 {
     } else {
         0.0
     }
-}
-
-/// The polar cell of `n` (over 90 degrees) holding `theta` radians, clamped into the grid.
-#[inline]
-fn polar_cell(theta: f32, n: u32) -> usize {
-    let c = theta * (n as f32 / std::f32::consts::FRAC_PI_2);
-    (c.max(0.0) as usize).min(n as usize - 1)
-}
-
-/// The azimuth cell of `n` (over 360 degrees) holding `phi` radians, any value (periodic).
-#[inline]
-fn azimuth_cell(phi: f32, n: u32) -> usize {
-    let c = (phi * (n as f32 / std::f32::consts::TAU)).floor();
-    let c = if c.is_finite() { c as i64 } else { 0 };
-    c.rem_euclid(i64::from(n)) as usize
 }

@@ -1,20 +1,16 @@
-//! The table in memory: its [`Grid`] of directions, its [`Metadata`] and its values
+//! The table in memory: its [`Metadata`] (with its [`Grid`] of directions) and its values
 //! ([`Table`]), and the rules every table obeys ([`Table::new`]).
-
-use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
 use crate::error::TableError;
+use crate::grid::Grid;
 use crate::spatial::Spatial;
 
 /// Version of the table description: the [`Metadata`] record, the grid layout and the OpenEXR
 /// format (`docs/table-format.md`). Readers reject any other version. The binary container
 /// has a version of its own, [`crate::CONTAINER_VERSION`].
 pub const FORMAT_VERSION: u32 = 1;
-
-/// Largest number of cells a grid may have (2^31).
-pub const MAX_CELLS: u64 = 1 << 31;
 
 /// Largest value a table may hold, in 1/sr (10^30). Far beyond any physical BRDF (a mirror
 /// tabulated in cells of 0.01 degrees stays below 10^8), and small enough that every sum and
@@ -43,146 +39,6 @@ pub(crate) fn first_unphysical(values: &[f32]) -> Option<usize> {
                 .position(|&v| !is_physical(v))
                 .expect("the failing block holds the value")
         })
-}
-
-/// The 4-D grid of incident and outgoing directions, cell-centred, in degrees.
-///
-/// Polar angles cover [0, 90] degrees from +Z, azimuths [0, 360) degrees from +X toward +Y.
-/// Cell `k` of a polar axis with `n` cells is centred on `(k + 0.5) * 90 / n` degrees; cell `k`
-/// of an azimuth axis on `(k + 0.5) * 360 / n` degrees. Cells are ordered theta_i, phi_i,
-/// theta_o, phi_o, the last varying fastest (see [`Grid::index`]).
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Grid {
-    /// Number of cells of the incident polar angle.
-    pub n_theta_i: u32,
-    /// Number of cells of the incident azimuth.
-    pub n_phi_i: u32,
-    /// Number of cells of the outgoing polar angle.
-    pub n_theta_o: u32,
-    /// Number of cells of the outgoing azimuth.
-    pub n_phi_o: u32,
-}
-
-impl Grid {
-    /// The grid of `n_theta_i x n_phi_i x n_theta_o x n_phi_o` cells, unchecked (as a struct
-    /// literal; [`Grid::validate`] checks).
-    pub const fn new(n_theta_i: u32, n_phi_i: u32, n_theta_o: u32, n_phi_o: u32) -> Grid {
-        Grid {
-            n_theta_i,
-            n_phi_i,
-            n_theta_o,
-            n_phi_o,
-        }
-    }
-
-    /// Number of cells. Saturates at `usize::MAX` for absurd grids that [`Grid::validate`]
-    /// rejects.
-    pub fn len(&self) -> usize {
-        usize::try_from(self.cells()).unwrap_or(usize::MAX)
-    }
-
-    /// True when the grid has no cells (an invalid grid).
-    pub fn is_empty(&self) -> bool {
-        self.cells() == 0
-    }
-
-    /// Number of cells as `u64`, saturating.
-    fn cells(&self) -> u64 {
-        [self.n_theta_i, self.n_phi_i, self.n_theta_o, self.n_phi_o]
-            .iter()
-            .fold(1u64, |acc, &n| acc.saturating_mul(u64::from(n)))
-    }
-
-    /// Index of a cell: `((ti * n_phi_i + pi) * n_theta_o + to) * n_phi_o + po`.
-    pub fn index(&self, ti: u32, pi: u32, to: u32, po: u32) -> usize {
-        debug_assert!(ti < self.n_theta_i && pi < self.n_phi_i);
-        debug_assert!(to < self.n_theta_o && po < self.n_phi_o);
-        let (ti, pi, to, po) = (ti as usize, pi as usize, to as usize, po as usize);
-        ((ti * self.n_phi_i as usize + pi) * self.n_theta_o as usize + to) * self.n_phi_o as usize
-            + po
-    }
-
-    /// Centre of incident polar cell `k`, degrees from +Z.
-    pub fn theta_i_deg(&self, k: u32) -> f64 {
-        Grid::polar_centre_deg(k, self.n_theta_i)
-    }
-
-    /// Centre of incident azimuth cell `k`, degrees from +X toward +Y.
-    pub fn phi_i_deg(&self, k: u32) -> f64 {
-        Grid::azimuth_centre_deg(k, self.n_phi_i)
-    }
-
-    /// Centre of outgoing polar cell `k`, degrees from +Z.
-    pub fn theta_o_deg(&self, k: u32) -> f64 {
-        Grid::polar_centre_deg(k, self.n_theta_o)
-    }
-
-    /// Centre of outgoing azimuth cell `k`, degrees from +X toward +Y.
-    pub fn phi_o_deg(&self, k: u32) -> f64 {
-        Grid::azimuth_centre_deg(k, self.n_phi_o)
-    }
-
-    /// Width of the EXR image: `n_phi_i * n_phi_o`.
-    pub fn exr_width(&self) -> u64 {
-        u64::from(self.n_phi_i) * u64::from(self.n_phi_o)
-    }
-
-    /// Height of the EXR image: `n_theta_i * n_theta_o`.
-    pub fn exr_height(&self) -> u64 {
-        u64::from(self.n_theta_i) * u64::from(self.n_theta_o)
-    }
-
-    /// Checks that every axis has cells and that the grid has at most [`MAX_CELLS`] cells.
-    pub fn validate(&self) -> Result<(), TableError> {
-        let axes = [
-            ("n_theta_i", self.n_theta_i),
-            ("n_phi_i", self.n_phi_i),
-            ("n_theta_o", self.n_theta_o),
-            ("n_phi_o", self.n_phi_o),
-        ];
-        for (name, n) in axes {
-            if n == 0 {
-                return Err(TableError::InvalidTable {
-                    reason: format!("grid {self}: {name} is 0; every axis needs at least 1 cell"),
-                });
-            }
-        }
-        if self.cells() > MAX_CELLS {
-            return Err(TableError::InvalidTable {
-                reason: format!(
-                    "grid {self}: {} cells is more than the limit of {MAX_CELLS} (2^31); use a coarser grid",
-                    // The exact count (a u128 holds any product of four u32).
-                    [self.n_theta_i, self.n_phi_i, self.n_theta_o, self.n_phi_o]
-                        .iter()
-                        .map(|&n| u128::from(n))
-                        .product::<u128>()
-                ),
-            });
-        }
-        Ok(())
-    }
-
-    /// Centre of cell `k` of a polar axis of `n` cells, degrees from +Z:
-    /// `(k + 0.5) * 90 / n`.
-    pub fn polar_centre_deg(k: u32, n: u32) -> f64 {
-        (f64::from(k) + 0.5) * 90.0 / f64::from(n)
-    }
-
-    /// Centre of cell `k` of an azimuth axis of `n` cells, degrees from +X toward +Y:
-    /// `(k + 0.5) * 360 / n`.
-    pub fn azimuth_centre_deg(k: u32, n: u32) -> f64 {
-        (f64::from(k) + 0.5) * 360.0 / f64::from(n)
-    }
-}
-
-impl fmt::Display for Grid {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "theta_i {} phi_i {} theta_o {} phi_o {}",
-            self.n_theta_i, self.n_phi_i, self.n_theta_o, self.n_phi_o
-        )
-    }
 }
 
 /// What a table holds and how it was made. Stored in both formats.

@@ -21,7 +21,7 @@
 use crate::shade::Shader;
 use crate::typeset::Typeset;
 use clothbake_core::UnitVec3;
-use clothbake_loader::Grid;
+use clothbake_loader::Axis;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::ReverseCoordTranslate;
 use plotters::coord::Shift;
@@ -161,8 +161,8 @@ pub fn hemisphere(s: &Shader, theta_i: f64, phi_i: f64) -> Vec<f64> {
 
 fn cell_centre(r: usize, p: usize) -> (f64, f64) {
     (
-        Grid::polar_centre_deg(r as u32, RINGS as u32),
-        Grid::azimuth_centre_deg(p as u32, SECTORS as u32),
+        Axis::polar(RINGS as u32).centre_deg(r as u32),
+        Axis::azimuth(SECTORS as u32).centre_deg(p as u32),
     )
 }
 

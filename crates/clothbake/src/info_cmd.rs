@@ -2,7 +2,7 @@
 
 use crate::cli::InfoArgs;
 use crate::error::CliError;
-use clothbake_bake::albedo::{directional_albedo, nearest_azimuth, nearest_polar};
+use clothbake_bake::albedo::directional_albedo;
 use clothbake_loader::{read_table, Table};
 use std::fmt::Write as _;
 use std::io::Read;
@@ -134,7 +134,7 @@ pub fn run(args: &InfoArgs) -> Result<String, CliError> {
             v[0], v[1], v[2]
         );
     }
-    let pi = nearest_azimuth(g.n_phi_i, 0.0);
+    let pi = g.phi_i().cell_of_deg(0.0);
     let _ = writeln!(
         s,
         "directional albedo (sum over the outgoing cells of f_r times the cell's integral of \
@@ -147,7 +147,7 @@ pub fn run(args: &InfoArgs) -> Result<String, CliError> {
         "theta_i asked -> row used", "R", "G", "B"
     );
     for want in ALBEDO_THETAS {
-        let ti = nearest_polar(g.n_theta_i, want);
+        let ti = g.theta_i().cell_of_deg(want);
         let a = directional_albedo(&t, ti, pi);
         let _ = writeln!(
             s,
