@@ -22,6 +22,7 @@ use clothbake_core::{
     AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FabricError, FacetModel, RayTracer, Rgb, UnitVec3,
     Variant,
 };
+use clothbake_loader::Axis;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -68,26 +69,6 @@ fn side_angles(w: UnitVec3) -> (f64, f64) {
     (theta, w.y.atan2(w.x).to_degrees())
 }
 
-/// One cell-centred axis: the two neighbouring nodes of `x` (in cells, centres at k + 1/2)
-/// and the second's weight; `periodic` wraps, otherwise clamps to the outer centres.
-fn neighbours(x: f64, n: u32, periodic: bool) -> [(u32, f64); 2] {
-    if n == 1 {
-        return [(0, 1.0), (0, 0.0)];
-    }
-    let c = x - 0.5;
-    if periodic {
-        let c = c.rem_euclid(f64::from(n));
-        let k = (c.floor() as u32).min(n - 1);
-        let t = c - f64::from(k);
-        [(k, 1.0 - t), ((k + 1) % n, t)]
-    } else {
-        let c = c.clamp(0.0, f64::from(n - 1));
-        let k = (c.floor() as u32).min(n - 2);
-        let t = c - f64::from(k);
-        [(k, 1.0 - t), (k + 1, t)]
-    }
-}
-
 impl Rest {
     fn new(
         tracer: RayTracer,
@@ -113,8 +94,8 @@ impl Rest {
     /// The direction of node `k` of a block's side (`up`: above the cloth).
     fn direction(&self, k: usize, up: bool) -> UnitVec3 {
         let (t, p) = (k as u32 / self.n_phi, k as u32 % self.n_phi);
-        let theta = f64::from(t) * 90.0 / f64::from(self.n_theta);
-        let phi = (f64::from(p) + 0.5) * 360.0 / f64::from(self.n_phi);
+        let theta = Axis::polar(self.n_theta).start_node_deg(t);
+        let phi = Axis::azimuth(self.n_phi).centre_deg(p);
         let w = UnitVec3::from_degrees(theta, phi);
         if up {
             w
@@ -165,13 +146,8 @@ impl Rest {
         let axes = |w: UnitVec3| {
             let (theta, phi) = side_angles(w);
             (
-                // Polar nodes at k 90 / n: at the half-integers of `neighbours`' cells.
-                neighbours(
-                    theta * f64::from(self.n_theta) / 90.0 + 0.5,
-                    self.n_theta,
-                    false,
-                ),
-                neighbours(phi * f64::from(self.n_phi) / 360.0, self.n_phi, true),
+                Axis::polar(self.n_theta).start_taps_deg(theta),
+                Axis::azimuth(self.n_phi).coarse_taps_deg(phi),
             )
         };
         let ((ti, pi), (to, po)) = (axes(wi), axes(wo));
@@ -324,15 +300,6 @@ mod tests {
 
     fn dir(theta: f64, phi: f64) -> UnitVec3 {
         UnitVec3::from_degrees(theta, phi)
-    }
-
-    #[test]
-    fn interpolation_weights_are_cell_centred() {
-        assert_eq!(neighbours(0.5, 4, false), [(0, 1.0), (1, 0.0)]);
-        assert_eq!(neighbours(4.0, 4, false), [(2, 0.0), (3, 1.0)]);
-        assert_eq!(neighbours(0.0, 8, true), [(7, 0.5), (0, 0.5)]);
-        assert_eq!(neighbours(1.25, 8, true), [(0, 0.25), (1, 0.75)]);
-        assert_eq!(neighbours(3.0, 1, true), [(0, 1.0), (0, 0.0)]);
     }
 
     #[test]

@@ -342,11 +342,45 @@ impl Axis {
             }
         }
     }
+
+    /// The node of rank `k` of a grid whose first node stands at the axis's start (the pole of
+    /// a polar axis), degrees: `k * span / count` (f64). The two-faced cloth's coarse grid
+    /// (`clothbake_bake::two_faced`), whose datasheet figures are read at the normal.
+    #[inline]
+    pub fn start_node_deg(self, k: u32) -> f64 {
+        f64::from(k) * self.span.degrees() / f64::from(self.count)
+    }
+
+    /// The two nodes of [`Axis::start_node_deg`]'s grid at `angle` (degrees, f64), with their
+    /// weights: linear between nodes, clamped to the last node beyond it (a polar angle toward
+    /// the horizon), wrapped over a turn.
+    pub fn start_taps_deg(self, angle: f64) -> [(u32, f64); 2] {
+        // The same clamp and wrap as the cell-centred grid, half a cell earlier.
+        self.coarse_taps_deg(angle + 0.5 * self.span.degrees() / f64::from(self.count))
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn start_nodes_begin_at_the_pole_and_clamp_at_the_last() {
+        let a = Axis::polar(5);
+        assert_eq!([0, 1, 4].map(|k| a.start_node_deg(k)), [0.0, 18.0, 72.0]);
+        assert_eq!(a.start_taps_deg(0.0), [(0, 1.0), (1, 0.0)]);
+        let [(k, w0), (k1, w1)] = a.start_taps_deg(27.0);
+        assert_eq!((k, k1), (1, 2));
+        assert!((w0 - 0.5).abs() < 1e-12 && (w1 - 0.5).abs() < 1e-12);
+        let [(_, w0), (k1, w1)] = a.start_taps_deg(85.0);
+        assert_eq!(k1, 4);
+        assert!(w0.abs() < 1e-12 && (w1 - 1.0).abs() < 1e-12, "clamped");
+        let t = Axis::azimuth(8);
+        assert_eq!(t.start_node_deg(1), 45.0);
+        let [(k, w0), (k1, _)] = t.start_taps_deg(350.0);
+        assert_eq!((k, k1), (7, 0));
+        assert!((w0 - (360.0 - 350.0) / 45.0).abs() < 1e-12);
+    }
 
     #[test]
     fn spans_are_the_same_angle_in_every_unit() {
