@@ -395,15 +395,19 @@ impl PyFabric {
     /// analytic model, direct reflection): the scalar path renderers call per sample.
     /// The fabric's two-faced cloth (docs/transmission.md): no floor, light through the gaps
     /// and through translucent yarns (the materials' `translucency`), the back the inverted
-    /// weave; its model's coarse grid is path-traced here (about 25 s on two cores).
-    #[pyo3(signature = (facet="lewis", variant="refined"))]
+    /// weave; its model's coarse grid is path-traced here (about 25 s on two cores at the
+    /// default `nodes=(5, 8)` polar angles by azimuths a direction and `paths=8192` eye rays a
+    /// node; fewer for a quick look).
+    #[pyo3(signature = (facet="lewis", variant="refined", nodes=(5, 8), paths=8192))]
     fn two_faced(
         &self,
         py: Python<'_>,
         facet: &str,
         variant: &str,
+        nodes: (u32, u32),
+        paths: usize,
     ) -> PyResult<crate::two_faced::PyTwoFaced> {
-        crate::two_faced::PyTwoFaced::build(py, self, facet, variant)
+        crate::two_faced::PyTwoFaced::build(py, self, facet, variant, nodes, paths)
     }
 
     #[pyo3(signature = (wi, wo, facet="huo"))]

@@ -27,7 +27,24 @@ fn unit(w: [f64; 3]) -> UnitVec3 {
 impl PyTwoFaced {
     /// The cloth of `fabric` with `facet` and `variant`, its path-traced grid computed now
     /// (without the GIL).
-    pub fn build(py: Python<'_>, fabric: &PyFabric, facet: &str, variant: &str) -> PyResult<Self> {
+    pub fn build(
+        py: Python<'_>,
+        fabric: &PyFabric,
+        facet: &str,
+        variant: &str,
+        nodes: (u32, u32),
+        paths: usize,
+    ) -> PyResult<Self> {
+        if !(1..=64).contains(&nodes.0) || !(1..=128).contains(&nodes.1) {
+            return Err(PyValueError::new_err(format!(
+                "nodes: {nodes:?}; give (polar, azimuth) node counts from 1 to 64 and 1 to 128"
+            )));
+        }
+        if !(1..=1 << 20).contains(&paths) {
+            return Err(PyValueError::new_err(format!(
+                "paths: {paths}; give eye rays a node from 1 to 2^20"
+            )));
+        }
         let facet = facet_model(facet)?;
         let variant = match variant {
             "refined" => Variant::Refined,
@@ -39,9 +56,10 @@ impl PyTwoFaced {
                 )))
             }
         };
-        let cloth = TwoFaced::new(&fabric.fabric, facet, variant).map_err(|e| {
-            PyValueError::new_err(format!("{e} (the cloth's back: its weave inverted)"))
-        })?;
+        let cloth =
+            TwoFaced::with_grid(&fabric.fabric, facet, variant, nodes, paths).map_err(|e| {
+                PyValueError::new_err(format!("{e} (the cloth's back: its weave inverted)"))
+            })?;
         py.detach(|| cloth.prepare());
         Ok(PyTwoFaced {
             cloth,

@@ -202,3 +202,15 @@ def test_llvm_plugin_matches_measured_under_a_sky(tables, tmp_path):
           f"image means differ by {np.abs(means).max():.4f}")
     assert e < 2 * noise + 0.03
     assert np.abs(means).max() < 0.03
+
+
+def test_the_two_faced_cloth_in_wavefronts(tmp_path):
+    """The scalar test's backlit and sky scenes (test_mitsuba.two_faced_checks), a wavefront
+    at a time."""
+    from test_mitsuba import two_faced_checks
+
+    use("llvm_ad_rgb")
+    try:
+        two_faced_checks(tmp_path)
+    finally:
+        use("scalar_rgb")

@@ -44,9 +44,19 @@ class Fabric:
         "secondary" with bounces=2)."""
     def eval1(self, wi: Vec3, wo: Vec3, facet: str = "huo") -> Vec3:
         """f_r of one pair (analytic, direct reflection), 1/sr."""
+    def two_faced(self, facet: str = "lewis", variant: str = "refined",
+                  nodes: Tuple[int, int] = (5, 8), paths: int = 8192) -> "TwoFaced":
+        """The two-faced cloth (docs/transmission.md); its coarse grid path-traced now."""
     def eval1_at(self, wi: Vec3, wo: Vec3, u: float, v: float, width: float = 0.0,
                  facet: str = "huo") -> Tuple[Vec3, float]:
         """(f_r, coverage) of one pair through a footprint at (u, v), every level of detail."""
+
+class TwoFaced:
+    """The two-faced cloth: f over the whole sphere and the openness (docs/transmission.md)."""
+    def eval(self, wi: npt.ArrayLike, wo: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
+    def openness(self, w: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
+    def eval1(self, wi: Vec3, wo: Vec3) -> Vec3: ...
+    def openness1(self, w: Vec3) -> float: ...
 
 class Table:
     """A baked f_r table (1/sr, RGB) with interpolated lookup and importance sampling."""

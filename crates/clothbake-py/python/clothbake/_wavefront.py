@@ -7,7 +7,9 @@ cosine and the masks applied lazily (fused into the integrator's next kernel).
 
 The conventions are those of the scalar plugin (``clothbake.mitsuba``): the cloth frame is
 (dp_du made orthogonal to the shading normal, n x s, n); seen from the back a two-sided cloth
-is its front mirrored through the cloth's plane; light and eye on opposite sides give zero.
+is its front mirrored through the cloth's plane; light and eye on opposite sides give zero. With
+``faces="two"`` the two-faced cloth: reflection off either face, transmission, and the null lobe
+of the openness (``_two_*``).
 """
 
 import numpy as np
@@ -157,19 +159,92 @@ def wavefront_class(mi, dr, Cloth):
                 pdf = light_z / np.pi
             return dr.select(ok, pdf, 0.0)
 
+        # -- the two-faced cloth ---------------------------------------------------------
+        def _two_pair(self, si, wo, active):
+            """(ok, frame, eye, eye_rows, light_rows, |light_z|): the pair in the cloth frame on
+            either side, invalid lanes (at the horizon) holding the normal."""
+            check()
+            frame = self._frame(si)
+
+            def cloth(v):
+                return frame.to_local(si.sh_frame.to_world(v))
+
+            eye = cloth(si.wi)
+            ok = mi.Bool(active) & (dr.abs(eye.z) > 1e-9)
+            light = None
+            if wo is not None:
+                light = cloth(wo)
+                ok &= dr.abs(light.z) > 1e-9
+            eye = dr.normalize(dr.select(ok, eye, up()))
+            flat = [dr.ravel(eye)]
+            lz = None
+            if light is not None:
+                light = dr.normalize(dr.select(ok, light, up()))
+                flat.append(dr.ravel(light))
+                lz = dr.abs(light.z)
+            dr.eval(ok, eye, lz, *flat)  # one kernel
+            rows = [np.asarray(f).reshape(-1, 3) for f in flat]
+            return ok, frame, eye, rows[0], rows[1] if light is not None else None, lz
+
+        def _two_value(self, ok, eye_rows, light_rows, lz):
+            f = color(self._cloth.cloth.eval(light_rows, eye_rows))
+            return dr.select(ok, f * lz, 0.0)
+
+        def _two_density(self, ok, eye_rows, lz):
+            o = mi.Float(np.asarray(self._cloth.cloth.openness(eye_rows), dtype=np.float32))
+            return dr.select(ok, (1.0 - o) * lz / (2.0 * np.pi), 0.0)
+
+        def _two_sample(self, si, sample1, sample2, active):
+            ok, frame, eye, eye_rows, _, _ = self._two_pair(si, None, active)
+            n = eye_rows.shape[0]
+            o = mi.Float(np.asarray(self._cloth.cloth.openness(eye_rows), dtype=np.float32))
+            null = ok & (sample1 < o)
+            same = (sample1 - o) < 0.5 * (1.0 - o)
+            w = mi.warp.square_to_cosine_hemisphere(sample2)
+            z = dr.select(same == (eye.z > 0.0), w.z, -w.z)
+            pdf = (1.0 - o) * w.z / (2.0 * np.pi)
+            glossy = ok & ~null & (pdf > 0.0)
+            light = dr.normalize(dr.select(glossy, mi.Vector3f(w.x, w.y, z), up()))
+            dr.eval(light)
+            f = color(self._cloth.cloth.eval(rows3(light), eye_rows))
+            weight = dr.select(glossy, f * w.z / dr.select(glossy, pdf, 1.0), 0.0)
+            weight = dr.select(null, 1.0, weight)
+            bs = dr.zeros(mi.BSDFSample3f, n)
+            bs.wo = dr.select(null, -si.wi, si.sh_frame.to_local(frame.to_world(light)))
+            bs.pdf = dr.select(null, o, dr.select(glossy, pdf, 0.0))
+            bs.eta = 1.0
+            bs.sampled_type = dr.select(
+                null, mi.UInt32(+mi.BSDFFlags.Null),
+                dr.select(same, mi.UInt32(+mi.BSDFFlags.GlossyReflection),
+                          mi.UInt32(+mi.BSDFFlags.GlossyTransmission)))
+            bs.sampled_component = mi.UInt32(0)
+            return bs, weight
+
+        # -- the BSDF interface --------------------------------------------------------
         def eval(self, ctx, si, wo, active=True):
+            if self._cloth.cloth is not None:
+                ok, _, _, eye, light, lz = self._two_pair(si, wo, active)
+                return self._two_value(ok, eye, light, lz)
             ok, _, _, eye, light, lz, _ = self._pair(si, wo, active)
             return self._value(si, ok, eye, light, lz)
 
         def pdf(self, ctx, si, wo, active=True):
+            if self._cloth.cloth is not None:
+                ok, _, _, eye, _, lz = self._two_pair(si, wo, active)
+                return self._two_density(ok, eye, lz)
             ok, _, _, eye, light, lz, _ = self._pair(si, wo, active)
             return self._density(ok, eye, light, lz)
 
         def eval_pdf(self, ctx, si, wo, active=True):
+            if self._cloth.cloth is not None:
+                ok, _, _, eye, light, lz = self._two_pair(si, wo, active)
+                return self._two_value(ok, eye, light, lz), self._two_density(ok, eye, lz)
             ok, _, _, eye, light, lz, _ = self._pair(si, wo, active)
             return self._value(si, ok, eye, light, lz), self._density(ok, eye, light, lz)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
+            if self._cloth.cloth is not None:
+                return self._two_sample(si, sample1, sample2, active)
             table = self._cloth.table is not None
             ok, flip, frame, eye, _, _, u = self._pair(si, None, active,
                                                        sample2 if table else None)

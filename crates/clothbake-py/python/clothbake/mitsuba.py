@@ -27,6 +27,16 @@ evaluated as its front mirrored through the cloth's plane (z negated for both di
 the same weave, seen from the other side. With ``two_sided=False`` the back is black. Light
 and eye on opposite sides give zero (no transmission).
 
+Two faces and transmission: ``faces="two"`` with ``weave=`` draws the two-faced cloth
+(docs/transmission.md: no floor, light through the gaps and through translucent yarns, the back
+the inverted weave): ``eval`` gives reflection off either face and transmission across, and a
+null lobe passes the ray straight through with the openness O along the eye's direction (a
+delta, as Mitsuba's null-scattering BSDFs do: sampled with probability O, weight 1). The
+other lobes are sampled cos-weighted on either side with even odds. Its facet default is
+``lewis`` (reciprocal and energy conserving); ``periods`` and ``two_sided=False`` do not apply.
+Building it path-traces the model's coarse grid (about 25 s on two cores; ``nodes="P,A"`` polar
+angles by azimuths a direction, default "5,8", and ``paths`` eye rays a node, default 8192).
+
 Variants: ``scalar_rgb`` (the plugin calls the native module once per lookup, on Python
 floats) and ``llvm_ad_rgb`` (whole wavefronts: each method converts the lanes Mitsuba hands
 it to numpy and makes one batch call, ``Table.eval``, ``Table.eval_at``, ``Table.sample``,
@@ -66,9 +76,31 @@ class Cloth:
                 "clothbake BSDF: periods= is the weave periods per UV unit, a finite number > 0"
             )
         self.source = str(props["table"] if has_table else props["weave"])
+        faces = str(props.get("faces", "one"))
+        if faces not in ("one", "two"):
+            raise ValueError(
+                f"clothbake BSDF: faces={faces!r}; use \"one\" (over the thesis's floor) or "
+                "\"two\" (the two-faced cloth: transmission and openness)"
+            )
+        self.cloth = None
+        if faces == "two":
+            if self.fabric is None or self.periods is not None or not self.two_sided:
+                raise ValueError(
+                    "clothbake BSDF: faces=\"two\" needs weave= (a fabric file), without periods= "
+                    "or two_sided=False (the two-faced cloth is drawn whole from either side)"
+                )
+            self.facet = str(props.get("facet", "lewis"))
+            grid = str(props.get("nodes", "5,8")).split(",")
+            self.cloth = self.fabric.two_faced(
+                facet=self.facet, nodes=(int(grid[0]), int(grid[1])),
+                paths=int(props.get("paths", 8192)))
 
     def flags(self, mi):
-        """Glossy reflection, front side (and back side when two-sided)."""
+        """Glossy reflection, front side (and back side when two-sided); with two faces also
+        glossy transmission and the null lobe of the openness."""
+        if self.cloth is not None:
+            return (mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.GlossyTransmission
+                    | mi.BSDFFlags.Null | mi.BSDFFlags.FrontSide | mi.BSDFFlags.BackSide)
         flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
         if self.two_sided:
             flags = flags | mi.BSDFFlags.BackSide
@@ -118,6 +150,7 @@ def register():
             c = Cloth(props)
             self._table, self._fabric, self._facet = c.table, c.fabric, c.facet
             self._two_sided, self._periods, self._source = c.two_sided, c.periods, c.source
+            self._cloth = c.cloth
             self.m_components = [c.flags(mi)]
             self.m_flags = c.flags(mi)
 
@@ -183,8 +216,60 @@ def register():
                 return self._table.pdf1(eye, light)
             return light[2] / math.pi
 
+        # -- the two-faced cloth ---------------------------------------------------------
+        def _two(self, si, wo):
+            """(light, eye, frame) in the cloth frame, either side; None at the horizon."""
+            frame = self._cloth_frame(si)
+            eye = _unit(self._to_cloth(si, frame, si.wi))
+            light = _unit(self._to_cloth(si, frame, wo)) if wo is not None else None
+            if abs(eye[2]) <= 1e-9 or (light is not None and abs(light[2]) <= 1e-9):
+                return None
+            return light, eye, frame
+
+        def _two_eval(self, si, wo):
+            d = self._two(si, wo)
+            if d is None:
+                return mi.Color3f(0.0), 0.0
+            light, eye, _ = d
+            f = self._cloth.eval1(light, eye)
+            c = abs(light[2])
+            pdf = (1.0 - self._cloth.openness1(eye)) * c / (2.0 * math.pi)
+            return mi.Color3f(f[0], f[1], f[2]) * c, pdf
+
+        def _two_sample(self, si, sample1, sample2):
+            bs = mi.BSDFSample3f()
+            d = self._two(si, None)
+            if d is None:
+                return bs, mi.Color3f(0.0)
+            _, eye, frame = d
+            p_null = self._cloth.openness1(eye)
+            bs.eta = 1.0
+            bs.sampled_component = 0
+            if sample1 < p_null:
+                # Straight through the gaps: a delta of weight O, drawn with probability O.
+                bs.wo = -si.wi
+                bs.pdf = p_null
+                bs.sampled_type = int(mi.BSDFFlags.Null)
+                return bs, mi.Color3f(1.0)
+            same = (sample1 - p_null) / (1.0 - p_null) < 0.5
+            w = mi.warp.square_to_cosine_hemisphere(sample2)
+            z = float(w[2]) if same == (eye[2] > 0.0) else -float(w[2])
+            light = _unit([float(w[0]), float(w[1]), z])
+            pdf = (1.0 - p_null) * abs(z) / (2.0 * math.pi)
+            if pdf <= 0.0:
+                return bs, mi.Color3f(0.0)
+            f = self._cloth.eval1(light, eye)
+            bs.wo = self._from_cloth(si, frame, light)
+            bs.pdf = pdf
+            bs.sampled_type = int(mi.BSDFFlags.GlossyReflection if same
+                                  else mi.BSDFFlags.GlossyTransmission)
+            k = abs(z) / pdf
+            return bs, mi.Color3f(f[0] * k, f[1] * k, f[2] * k)
+
         # -- the BSDF interface --------------------------------------------------------
         def eval(self, ctx, si, wo, active=True):
+            if self._cloth is not None:
+                return self._two_eval(si, wo)[0]
             d = self._directions(si, wo)
             if d is None:
                 return mi.Color3f(0.0)
@@ -194,6 +279,8 @@ def register():
             return mi.Color3f(f[0], f[1], f[2]) * light[2]
 
         def pdf(self, ctx, si, wo, active=True):
+            if self._cloth is not None:
+                return self._two_eval(si, wo)[1]
             d = self._directions(si, wo)
             if d is None:
                 return 0.0
@@ -204,6 +291,8 @@ def register():
             return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
+            if self._cloth is not None:
+                return self._two_sample(si, float(sample1), sample2)
             bs = mi.BSDFSample3f()
             d = self._directions(si, None)
             if d is None:
