@@ -518,7 +518,7 @@ impl Fabric {
             self.weave.inverted(),
             self.warp.clone(),
             self.weft.clone(),
-            &PlainNaming("the fabric's back"),
+            &PlainNaming("the fabric's back (its weave inverted; docs/transmission.md)"),
         )
         .map(|f| f.with_notes(self.notes.clone()))
     }

@@ -56,10 +56,8 @@ impl PyTwoFaced {
                 )))
             }
         };
-        let cloth =
-            TwoFaced::with_grid(&fabric.fabric, facet, variant, nodes, paths).map_err(|e| {
-                PyValueError::new_err(format!("{e} (the cloth's back: its weave inverted)"))
-            })?;
+        let cloth = TwoFaced::with_grid(&fabric.fabric, facet, variant, nodes, paths)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
         py.detach(|| cloth.prepare());
         Ok(PyTwoFaced {
             cloth,

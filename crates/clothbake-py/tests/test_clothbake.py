@@ -502,12 +502,9 @@ def test_eval_samples_are_bounded(twill_path):
 
 def test_the_two_faced_cloth_transmits_and_passes_light_through_its_gaps():
     # An open plain weave (r/s = 0.25) of translucent yarns (docs/transmission.md).
-    m = {"albedo": 0.5, "specular": 0.1, "exponent": 8, "translucency": 0.8}
-    fab = clothbake.Fabric({
-        "name": "open plain", "pattern": [[1, 0], [0, 1]],
-        "warp": {"radius": 0.5, "spacing": 2, "material": m},
-        "weft": {"radius": 0.5, "spacing": 2, "material": m},
-    })
+    from conftest import OPEN_PLAIN
+
+    fab = clothbake.Fabric(OPEN_PLAIN)
     cloth = fab.two_faced()
     assert "open plain" in repr(cloth)
     down = np.array([0.0, 0.0, -1.0])

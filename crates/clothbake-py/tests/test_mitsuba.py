@@ -19,6 +19,7 @@ mi = pytest.importorskip(
 
 import clothbake  # noqa: E402
 import clothbake.mitsuba as cbm  # noqa: E402
+from conftest import OPEN_PLAIN  # noqa: E402
 
 RES = 48
 LIGHT_TO = np.array([0.45, 0.75, 0.5])  # toward the light
@@ -274,14 +275,6 @@ def test_the_readme_snippet_renders_the_twill(tmp_path, monkeypatch):
     sky = img[:8, :8, :3].mean()
     assert ball > sky + 20, (ball, sky)
 
-
-OPEN_PLAIN = {
-    "name": "open plain", "pattern": [[1, 0], [0, 1]],
-    "warp": {"radius": 0.5, "spacing": 2,
-             "material": {"albedo": 0.5, "specular": 0.1, "exponent": 8, "translucency": 0.8}},
-    "weft": {"radius": 0.5, "spacing": 2,
-             "material": {"albedo": 0.5, "specular": 0.1, "exponent": 8, "translucency": 0.8}},
-}
 
 
 def two_faced_scene(weave, eye_dir, emitter, integrator, spp, res=16):

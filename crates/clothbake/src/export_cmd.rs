@@ -88,18 +88,8 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
                     format!("drop {flag}"),
                 ));
             }
-            let fabric = apply_material(
-                crate::fabrics::read(weave, &Default::default())?,
-                &args.material,
-            )?;
-            refuse_existing(args)?;
-            let facet = FacetModel::from(args.facet.unwrap_or(crate::cli::FacetArg::Huo));
-            let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);
-            let tf = TwoFaced::new(&fabric, facet, variant.into()).map_err(|e| {
-                CliError::line(format!(
-                    "{e} (the cloth's back: its weave inverted; docs/transmission.md)"
-                ))
-            })?;
+            let (fabric, facet, variant) = model_of(args, weave)?;
+            let tf = TwoFaced::new(&fabric, facet, variant.into())?;
             let threads = crate::bake_cmd::thread_count(args.run.threads);
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -118,13 +108,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
         (Some(weave), None) => {
             let secondary = args.bounces.options()?;
             let secondary = (args.bounces.bounces == 2).then_some(secondary);
-            let fabric = apply_material(
-                crate::fabrics::read(weave, &Default::default())?,
-                &args.material,
-            )?;
-            refuse_existing(args)?;
-            let facet = FacetModel::from(args.facet.unwrap_or(crate::cli::FacetArg::Huo));
-            let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);
+            let (fabric, facet, variant) = model_of(args, weave)?;
             let model = AnalyticModel::with_variant(&fabric, facet, variant.into());
             let variant_name = model.variant().name();
             let analytic = AnalyticBsdf::new(model, secondary);
@@ -205,6 +189,25 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
 }
 
 /// An error for each model option given with --table (a table holds what it was baked with).
+/// The fabric of --weave with the material options, its outputs checked, and the model's
+/// facet and variant.
+fn model_of(
+    args: &ExportArgs,
+    weave: &std::path::Path,
+) -> Result<(Fabric, FacetModel, crate::cli::VariantArg), CliError> {
+    let fabric = apply_material(
+        crate::fabrics::read(weave, &Default::default())?,
+        &args.material,
+    )?;
+    refuse_existing(args)?;
+    let facet = FacetModel::from(args.facet.unwrap_or(crate::cli::FacetArg::Huo));
+    Ok((
+        fabric,
+        facet,
+        args.variant.unwrap_or(crate::cli::VariantArg::Refined),
+    ))
+}
+
 fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
     let m = &args.material;
     let b = &args.bounces;

@@ -113,7 +113,7 @@ fn two_faced_shader(a: &RenderArgs) -> Result<Shader, CliError> {
         FacetModel::from(a.brdf.model.facet),
         a.brdf.model.variant.into(),
     )
-    .map_err(|e| CliError::line(format!("{e} (the cloth's back: its weave inverted)")))
+    .map_err(CliError::line)
 }
 
 /// The ground truth's shader of `render --truth`: the fabric of --weave, one bounce, with

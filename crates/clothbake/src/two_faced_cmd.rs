@@ -52,11 +52,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     let facet = FacetModel::from(args.model.facet);
     let (f, std_err, openness, how) = match args.method {
         Method::Analytic => {
-            let tf = TwoFaced::new(&fabric, facet, args.model.variant.into()).map_err(|e| {
-                CliError::line(format!(
-                    "{e} (the cloth's back: its weave inverted; docs/transmission.md)"
-                ))
-            })?;
+            let tf = TwoFaced::new(&fabric, facet, args.model.variant.into())?;
             (
                 tf.f(wi, wo),
                 None,

@@ -869,6 +869,18 @@ fn succeeds_text(out: &Output) -> String {
     common::succeeds(out)
 }
 
+/// An open plain weave (r/s = 0.25) of translucent yarns, written as the fabric file `name`.
+fn open_plain(name: &str) -> PathBuf {
+    let m = r#""material": {"albedo": 0.5, "specular": 0.2, "exponent": 8, "translucency": 0.8}"#;
+    temp_fabric(
+        name,
+        &format!(
+            r#"{{"pattern": [[1,0],[0,1]], "warp": {{"radius": 0.5, "spacing": 2, {m}}},
+                "weft": {{"radius": 0.5, "spacing": 2, {m}}}}}"#
+        ),
+    )
+}
+
 #[test]
 fn the_two_faced_cloth_answers_on_the_whole_sphere() {
     // An open plain weave with translucent yarns (docs/transmission.md): the model (analytic
@@ -876,14 +888,7 @@ fn the_two_faced_cloth_answers_on_the_whole_sphere() {
     // tracer of the two-faced micro-geometry, at nodes of the rest's grid (polar angles 18 k
     // from each side's normal, azimuths 22.5 + 45 k; straight through is one), and the
     // openness against the closed form's geometry.
-    let m = r#""material": {"albedo": 0.5, "specular": 0.2, "exponent": 8, "translucency": 0.8}"#;
-    let w = temp_fabric(
-        "two-faced",
-        &format!(
-            r#"{{"pattern": [[1,0],[0,1]], "warp": {{"radius": 0.5, "spacing": 2, {m}}},
-                "weft": {{"radius": 0.5, "spacing": 2, {m}}}}}"#
-        ),
-    );
+    let w = open_plain("two-faced");
     for (wi, wo, kind) in [
         ("0,0", "180,0", "transmission, light on the front"),
         ("36,22.5", "162,112.5", "transmission, light on the front"),
@@ -971,14 +976,7 @@ fn export_writes_the_two_faced_cloth_to_a_klems_file() {
     // the normal patch (the straight-through share over that patch's projected solid angle,
     // pi sin^2(5 degrees)) and diffuse transmission everywhere else; the datasheet reads the
     // open area of the weave.
-    let m = r#""material": {"albedo": 0.5, "specular": 0.2, "exponent": 8, "translucency": 0.8}"#;
-    let w = temp_fabric(
-        "two-faced-klems",
-        &format!(
-            r#"{{"pattern": [[1,0],[0,1]], "warp": {{"radius": 0.5, "spacing": 2, {m}}},
-                "weft": {{"radius": 0.5, "spacing": 2, {m}}}}}"#
-        ),
-    );
+    let w = open_plain("two-faced-klems");
     let w = w.to_str().unwrap();
     let dir = common::fresh_dir("cli", "export-klems-two-faced");
     let out = dir.join("open.xml");
