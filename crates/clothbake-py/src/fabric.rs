@@ -395,10 +395,11 @@ impl PyFabric {
     /// analytic model, direct reflection): the scalar path renderers call per sample.
     /// The fabric's two-faced cloth (docs/transmission.md): no floor, light through the gaps
     /// and through translucent yarns (the materials' `translucency`), the back the inverted
-    /// weave; its model's coarse grid is path-traced here (about 25 s on two cores at the
+    /// weave (facet "huo" by default, as everywhere; "lewis" conserves energy, which light
+    /// through the cloth makes worth having); its model's coarse grid is path-traced here (about 25 s on two cores at the
     /// default `nodes=(5, 8)` polar angles by azimuths a direction and `paths=8192` eye rays a
     /// node; fewer for a quick look).
-    #[pyo3(signature = (facet="lewis", variant="refined", nodes=(5, 8), paths=8192))]
+    #[pyo3(signature = (facet="huo", variant="refined", nodes=(5, 8), paths=8192))]
     fn two_faced(
         &self,
         py: Python<'_>,

@@ -505,7 +505,7 @@ def test_the_two_faced_cloth_transmits_and_passes_light_through_its_gaps():
     from conftest import OPEN_PLAIN
 
     fab = clothbake.Fabric(OPEN_PLAIN)
-    cloth = fab.two_faced()
+    cloth = fab.two_faced(facet="lewis")
     assert "open plain" in repr(cloth)
     down = np.array([0.0, 0.0, -1.0])
     up = np.array([0.0, 0.0, 1.0])

@@ -297,7 +297,7 @@ def two_faced_scene(weave, eye_dir, emitter, integrator, spp, res=16):
         },
         "shape": {"type": "rectangle", "to_world": mi.ScalarTransform4f().scale([20, 20, 1]),
                   "bsdf": {"type": "clothbake", "weave": str(weave), "faces": "two",
-                           "nodes": "3,6", "paths": 2048}},
+                           "facet": "lewis", "nodes": "3,6", "paths": 2048}},
         "light": emitter,
     })
 
@@ -312,7 +312,7 @@ def two_faced_checks(tmp_path):
 
     weave = tmp_path / "open.json"
     weave.write_text(json.dumps(OPEN_PLAIN))
-    cloth = clothbake.Fabric(OPEN_PLAIN).two_faced(nodes=(3, 6), paths=2048)
+    cloth = clothbake.Fabric(OPEN_PLAIN).two_faced(facet="lewis", nodes=(3, 6), paths=2048)
     eye = np.array([0.3, -0.4, 0.866])
     eye = eye / np.linalg.norm(eye)
     travel = np.array([0.2, 0.3, 1.0])  # the sunlight travels up: the sun is behind the cloth

@@ -44,7 +44,7 @@ class Fabric:
         "secondary" with bounces=2)."""
     def eval1(self, wi: Vec3, wo: Vec3, facet: str = "huo") -> Vec3:
         """f_r of one pair (analytic, direct reflection), 1/sr."""
-    def two_faced(self, facet: str = "lewis", variant: str = "refined",
+    def two_faced(self, facet: str = "huo", variant: str = "refined",
                   nodes: Tuple[int, int] = (5, 8), paths: int = 8192) -> "TwoFaced":
         """The two-faced cloth (docs/transmission.md); its coarse grid path-traced now."""
     def eval1_at(self, wi: Vec3, wo: Vec3, u: float, v: float, width: float = 0.0,

@@ -32,8 +32,9 @@ Two faces and transmission: ``faces="two"`` with ``weave=`` draws the two-faced 
 the inverted weave): ``eval`` gives reflection off either face and transmission across, and a
 null lobe passes the ray straight through with the openness O along the eye's direction (a
 delta, as Mitsuba's null-scattering BSDFs do: sampled with probability O, weight 1). The
-other lobes are sampled cos-weighted on either side with even odds. Its facet default is
-``lewis`` (reciprocal and energy conserving); ``periods`` and ``two_sided=False`` do not apply.
+other lobes are sampled cos-weighted on either side with even odds. ``facet="lewis"`` is
+worth giving (reciprocal and energy conserving; the default stays ``huo``, as everywhere);
+``periods`` and ``two_sided=False`` do not apply.
 Building it path-traces the model's coarse grid (about 25 s on two cores; ``nodes="P,A"`` polar
 angles by azimuths a direction, default "5,8", and ``paths`` eye rays a node, default 8192).
 
@@ -89,7 +90,6 @@ class Cloth:
                     "clothbake BSDF: faces=\"two\" needs weave= (a fabric file), without periods= "
                     "or two_sided=False (the two-faced cloth is drawn whole from either side)"
                 )
-            self.facet = str(props.get("facet", "lewis"))
             grid = str(props.get("nodes", "5,8")).split(",")
             self.cloth = self.fabric.two_faced(
                 facet=self.facet, nodes=(int(grid[0]), int(grid[1])),
