@@ -203,6 +203,36 @@ fn up_close(root: &Path, dir: &Path, width: u32, height: u32) {
     eprintln!("up-close: {:.1} s", start.elapsed().as_secs_f64());
 }
 
+/// The two-faced cloth (docs/transmission.md) draped, lit from the front and backlit (the sun
+/// behind the cloth, the eye in front): an open plain weave, the thesis's plain weave and the
+/// gingham, Lewis facets with translucency 0.5 (`transmission::translucent`).
+fn backlit(root: &Path, dir: &Path, width: u32, height: u32) {
+    let start = Instant::now();
+    let scene = Scene::by_name("drape").expect("drape");
+    let eye = Vec3::new(0.0, -55.0, 45.0);
+    let cam = Camera::new(eye, Vec3::default(), 62.0, width, height).expect("valid camera");
+    let open = Fabric::from_json_str(OPEN_PLAIN, "open plain").unwrap();
+    let plain = Fabric::from_path(&root.join("tables/plain.json")).unwrap();
+    let gingham = Fabric::from_path(&root.join("tables/gingham.wif")).unwrap();
+    let mut images = Vec::new();
+    for f in [open, plain, gingham] {
+        let f = crate::transmission::translucent(&f);
+        let s = Shader::two_faced(&f, FacetModel::Lewis, Variant::default()).expect("two faces");
+        for light in [Vec3::new(0.3, -0.5, 0.81), Vec3::new(0.3, 0.5, -0.81)] {
+            let lighting = Lighting {
+                light: unit(light),
+                irradiance: std::f64::consts::PI,
+                ambient: 0.3,
+            };
+            let never = AtomicBool::new(false);
+            let img = render(&scene, &cam, &lighting, &s, 2, &|_| {}, &never);
+            images.push(img.expect("not cancelled"));
+        }
+    }
+    save(&dir.join("backlit.png"), &montage(&images, 2), 1.0);
+    eprintln!("backlit: {:.1} s", start.elapsed().as_secs_f64());
+}
+
 /// An open plain weave: thinner yarns than the thesis's at its spacing, gaps between them.
 const OPEN_PLAIN: &str = r#"{"name": "open plain", "pattern": [[1, 0], [0, 1]],
   "warp": {"radius": 1.0, "spacing": 3.1, "material": {"albedo": [0.55, 0.45, 0.3], "specular": 0.3, "exponent": 10}},
@@ -483,7 +513,7 @@ fn plots(root: &Path, dir: &Path) {
 }
 
 /// Renders the figures named in `only` (`fig4-5`, `disks` for figs 5.10-5.11, `fig5-17`,
-/// `up-close`, `plots`), or
+/// `up-close`, `plots`, `backlit`), or
 /// every figure when `only` is empty, into `docs/figures/`.
 pub fn run(root: &Path, only: &[String]) {
     let dir = root.join("docs/figures");
@@ -503,6 +533,9 @@ pub fn run(root: &Path, only: &[String]) {
     }
     if wanted("plots") {
         plots(root, &dir);
+    }
+    if wanted("backlit") {
+        backlit(root, &dir, 320, 200);
     }
     if wanted("yarns") {
         let tl = only

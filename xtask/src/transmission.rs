@@ -26,7 +26,7 @@ fn mean(x: [f64; 3]) -> f64 {
 
 /// The fabric of `tables/<name>.json` with Lewis-ready materials: its own albedos and specular
 /// share, scaled so that rho_d + rho_s <= 1, and translucency [`TAU`].
-fn translucent(f: &Fabric) -> Fabric {
+pub(crate) fn translucent(f: &Fabric) -> Fabric {
     f.with_groups(
         |_, g| {
             let m: Material = g.material;
