@@ -7,7 +7,7 @@ use clothbake_export::klems::Datasheet;
 
 fn open_plain(tau: f64, h: f64) -> Fabric {
     let m = format!(
-        r#""material": {{"albedo": [0.6, 0.45, 0.3], "specular": 0.1, "exponent": 8, "translucency": {tau}}}"#
+        r#""material": {{"albedo": [0.5, 0.4, 0.3], "specular": 0.1, "exponent": 8, "translucency": {tau}}}"#
     );
     Fabric::from_json_str(
         &format!(

@@ -286,7 +286,7 @@ mod tests {
 
     fn open_plain(tau: f64) -> Fabric {
         let m = format!(
-            r#""material": {{"albedo": 0.5, "specular": 0.2, "exponent": 8, "translucency": {tau}}}"#
+            r#""material": {{"albedo": 0.4, "specular": 0.2, "exponent": 8, "translucency": {tau}}}"#
         );
         Fabric::from_json_str(
             &format!(

@@ -661,8 +661,34 @@ impl Fabric {
             return Err(err(
                 naming.field(g, Field::Translucency, 0),
                 format!("is {}, outside [0, 1]", m.translucency),
-                "give a translucency between 0 (opaque yarn) and 1 (no absorption)",
+                "give a translucency between 0 (opaque yarn) and 1",
             ));
+        }
+        // What a translucent facet reflects and transmits: rho_d (1 + tau) + rho_s <= 1.
+        if m.translucency > 0.0 {
+            let darkest_fit = (1.0 - m.specular) / (1.0 + m.translucency);
+            let brightest = (0..threads.len())
+                .map(|t| group.albedo(t))
+                .chain([m.albedo])
+                .flatten()
+                .fold(0.0f64, f64::max);
+            if brightest > darkest_fit + 1e-12 {
+                return Err(err(
+                    naming.field(g, Field::Translucency, 0),
+                    format!(
+                        "is {} with an albedo up to {brightest} and specular {}: the yarn would \
+                         give back more light than it gets (rho_d (1 + tau) + rho_s = {:.3} > 1)",
+                        m.translucency,
+                        m.specular,
+                        brightest * (1.0 + m.translucency) + m.specular
+                    ),
+                    &format!(
+                        "lower the translucency to at most {:.3}, or the albedo to at most {:.3}",
+                        ((1.0 - m.specular) / brightest - 1.0).max(0.0),
+                        darkest_fit
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -926,6 +952,26 @@ mod tests {
         );
         let e = err(&OK.replace("\"albedo\"", "\"exponent\": -1, \"albedo\""));
         assert_eq!(e.field, "weft.material.exponent");
+        // Translucent yarn may not give back more than it gets: weft albedo 0.5 and the
+        // default specular 0.3 allow tau up to 0.4.
+        let ok = OK.replace("\"albedo\"", "\"translucency\": 0.4, \"albedo\"");
+        assert_eq!(
+            Fabric::from_json_str(&ok, "t.json")
+                .unwrap()
+                .weft()
+                .material
+                .translucency,
+            0.4
+        );
+        let e = err(&OK.replace("\"albedo\"", "\"translucency\": 0.5, \"albedo\""));
+        assert_eq!(e.field, "weft.material.translucency");
+        assert!(
+            e.problem.contains("rho_d (1 + tau) + rho_s = 1.050 > 1"),
+            "{e}"
+        );
+        assert!(e.fix.contains("at most 0.400"), "{e}");
+        let e = err(&OK.replace("\"albedo\"", "\"translucency\": 1.5, \"albedo\""));
+        assert!(e.problem.contains("outside [0, 1]"), "{e}");
         let e = err(&OK.replace("\"radius\": 1.5,", "\"radius\": 1.5, \"colour\": 1,"));
         assert_eq!(e.field, "warp.colour");
         assert!(e.problem.contains("unknown field `colour`"), "{e}");

@@ -27,22 +27,25 @@ pub struct Material {
     pub specular: f64,
     /// Specular exponent n >= 0.
     pub exponent: f64,
-    /// Translucency tau in [0, 1]: the share of the light a facet does not reflect
-    /// (1 - rho_d - rho_s) that passes through the yarn ([`Material::transmittance`]); the
-    /// rest is absorbed. 0, the thesis's, absorbs it all. Only the two-faced cloth (no floor,
-    /// docs/transmission.md) shows it.
+    /// Translucency tau in [0, 1]: what a yarn lets through its far side, as a share of what
+    /// it gives back diffusely on the near side, in the same colour (the dye absorbs alike on
+    /// both ways): t = tau rho_d ([`Material::transmittance`]). 0, the thesis's, lets nothing
+    /// through. With tau > 0 the fabric must keep rho_d (1 + tau) + rho_s <= 1 in every
+    /// channel. Only the two-faced cloth (docs/transmission.md) shows it.
     pub translucency: f64,
 }
 
 impl Material {
-    /// The diffuse transmittance t of a facet per RGB channel: the share of the light that
-    /// enters the yarn at a point and leaves it diffusely (Lambertian) from the other end of the
-    /// chord through the yarn's axis, t = tau (1 - rho_d - rho_s) (clamped at 0) with tau the
-    /// [`Material::translucency`]. With Lewis facets the reflected share is at most
-    /// rho_d + rho_s, so R + t <= 1 at every incident direction, and the absorbed share
-    /// (1 - tau)(1 - rho_d - rho_s) goes to 0 as tau goes to 1 (docs/transmission.md).
+    /// The diffuse transmittance t of a facet per RGB channel: the share of the light arriving
+    /// at a point that leaves the yarn diffusely (Lambertian) from the far end of the chord
+    /// through the cross-section's middle, t = tau rho_d with tau the
+    /// [`Material::translucency`] and rho_d the facet's diffuse albedo (`albedo`): the
+    /// transmitted light has the reflected light's colour. With Lewis facets the reflected
+    /// share is at most rho_d + rho_s, so R + t <= rho_d (1 + tau) + rho_s <= 1 (checked on
+    /// the fabric) at every incident direction, and the absorbed share goes to 0 as that sum
+    /// goes to 1 (docs/transmission.md).
     pub fn transmittance(&self, albedo: [f64; 3]) -> [f64; 3] {
-        albedo.map(|a| self.translucency * (1.0 - a - self.specular).max(0.0))
+        albedo.map(|a| self.translucency * a)
     }
 }
 

@@ -612,8 +612,9 @@ pub struct MaterialArgs {
     #[arg(long, value_name = "N", value_parser = parse_exponent, allow_hyphen_values = true)]
     pub exponent: Option<f64>,
 
-    /// Translucency tau in [0, 1]: the share of the light a facet does not reflect that passes
-    /// through the yarn; only the two-faced cloth shows it (docs/transmission.md).
+    /// Translucency tau in [0, 1]: the yarn's diffuse transmittance as a share of its diffuse
+    /// albedo (t = tau rho_d, with rho_d (1 + tau) + rho_s <= 1); only the two-faced cloth shows
+    /// it (docs/transmission.md).
     #[arg(long, value_name = "X", value_parser = parse_translucency, allow_hyphen_values = true)]
     pub translucency: Option<f64>,
 }

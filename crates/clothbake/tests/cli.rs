@@ -871,7 +871,7 @@ fn succeeds_text(out: &Output) -> String {
 
 /// An open plain weave (r/s = 0.25) of translucent yarns, written as the fabric file `name`.
 fn open_plain(name: &str) -> PathBuf {
-    let m = r#""material": {"albedo": 0.5, "specular": 0.2, "exponent": 8, "translucency": 0.8}"#;
+    let m = r#""material": {"albedo": 0.4, "specular": 0.2, "exponent": 8, "translucency": 0.8}"#;
     temp_fabric(
         name,
         &format!(
