@@ -524,6 +524,31 @@ fn export_writes_an_rgl_file_and_refuses_bad_requests() {
     std::fs::remove_file(&out).unwrap();
 }
 
+/// The rows of the block `name` ("Reflection Front", ...) of a Klems BSDF XML file's
+/// ScatteringData, as numbers.
+fn klems_block(xml: &str, name: &str) -> Vec<Vec<f64>> {
+    xml.split(&format!(
+        "<WavelengthDataDirection>{name}</WavelengthDataDirection>"
+    ))
+    .nth(1)
+    .unwrap()
+    .split("<ScatteringData>\n")
+    .nth(1)
+    .unwrap()
+    .split("\t\t\t</ScatteringData>")
+    .next()
+    .unwrap()
+    .lines()
+    .map(|r| {
+        r.trim()
+            .trim_end_matches(',')
+            .split(", ")
+            .map(|x| x.trim().parse().unwrap())
+            .collect()
+    })
+    .collect()
+}
+
 #[test]
 fn export_writes_a_klems_file_and_its_datasheet() {
     // A one-faced cloth: the file holds the basis and eight blocks; the printed front
@@ -579,23 +604,9 @@ fn export_writes_a_klems_file_and_its_datasheet() {
             vec![std::f64::consts::PI * (s(b) - s(a)) / n as f64; n]
         })
         .collect();
-    let block = xml
-        .split("<WavelengthDataDirection>Reflection Front</WavelengthDataDirection>")
-        .nth(1)
-        .unwrap()
-        .split("<ScatteringData>\n")
-        .nth(1)
-        .unwrap()
-        .split("\t\t\t</ScatteringData>")
-        .next()
-        .unwrap();
-    let rows: Vec<&str> = block.lines().collect();
+    let rows = klems_block(&xml, "Reflection Front");
     assert_eq!(rows.len(), 145);
-    let column0: f64 = rows
-        .iter()
-        .zip(&lambda)
-        .map(|(r, l)| r.split(", ").next().unwrap().parse::<f64>().unwrap() * l)
-        .sum();
+    let column0: f64 = rows.iter().zip(&lambda).map(|(r, l)| r[0] * l).sum();
     assert!(front > 10.0, "{front}");
     assert!(
         (100.0 * column0 - front).abs() < 0.03 * front,
@@ -1027,29 +1038,7 @@ fn export_writes_the_two_faced_cloth_to_a_klems_file() {
     let sheet = said.lines().find(|l| l.starts_with("datasheet:")).unwrap();
     assert!(sheet.contains("openness factor 25.00%"), "{sheet}");
     let xml = std::fs::read_to_string(&out).unwrap();
-    let block = |name: &str| -> Vec<Vec<f64>> {
-        xml.split(&format!(
-            "<WavelengthDataDirection>{name}</WavelengthDataDirection>"
-        ))
-        .nth(1)
-        .unwrap()
-        .split("<ScatteringData>\n")
-        .nth(1)
-        .unwrap()
-        .split("\t\t\t</ScatteringData>")
-        .next()
-        .unwrap()
-        .lines()
-        .map(|r| {
-            r.trim()
-                .trim_end_matches(',')
-                .split(", ")
-                .map(|x| x.trim().parse().unwrap())
-                .collect()
-        })
-        .collect()
-    };
-    let t = block("Transmission Front");
+    let t = klems_block(&xml, "Transmission Front");
     assert_eq!(t.len(), 145);
     let normal_patch = std::f64::consts::PI * 5f64.to_radians().sin().powi(2);
     // The diagonal entry holds the openness (0.25) over the patch's projected solid angle,
@@ -1064,6 +1053,6 @@ fn export_writes_the_two_faced_cloth_to_a_klems_file() {
         "diffuse transmission {}",
         t[100][0]
     );
-    let tb = block("Transmission Back");
+    let tb = klems_block(&xml, "Transmission Back");
     assert!((tb[0][0] * normal_patch - 0.25).abs() < 0.01);
 }
