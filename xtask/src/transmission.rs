@@ -2,14 +2,19 @@
 //! truth: the model (`clothbake_bake::two_faced::TwoFaced`) and the ray tracer of the two-faced
 //! micro-geometry on the four blocks of direction pairs (front and back reflection, transmission
 //! from either side) and the openness, for the plain weave, the twill, satin5 and an open plain
-//! weave, into docs/validation.md between the `transmission-validation` markers.
+//! weave, and the two-faced table baked from the model on the default grid (looked up through
+//! `clothbake_loader::TwoFacedBrdf`) against the same truth, into docs/validation.md between the
+//! `transmission-validation` markers.
 
+use clothbake_bake::sweep::{bake, BakeOptions, DEFAULT_GRID};
 use clothbake_bake::two_faced::{TwoFaced, MAX_BOUNCES};
 use clothbake_core::validate::direction_set;
 use clothbake_core::{Bsdf, Fabric, FacetModel, Material, RayTracer, UnitVec3, Variant};
+use clothbake_loader::{Options, TwoFacedBrdf};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 
 /// Rays a truth estimate traces.
 const SAMPLES: usize = 100_000;
@@ -84,7 +89,10 @@ pub fn run(root: &Path) {
          coarse nodes and interpolated). Each cell: the mean and worst of |model / truth - 1|, \
          then the truth's own mean relative standard error. Openness: the closed form against \
          the truth's (the same rays), largest absolute difference over the {PAIRS} light \
-         directions.\n\n\
+         directions. Each fabric's second row, *table*: the two-faced table baked from the model \
+         on the default grid ({DEFAULT_GRID} a side, `clothbake --faces two`) and looked up \
+         through the loader (`TwoFacedBrdf`: the four blocks interpolated, the openness between \
+         the incident cells) against the same truth.\n\n\
          | fabric | front reflection | transmission from the front | back reflection | \
          transmission from the back | openness |\n|---|---|---|---|---|---|"
     )
@@ -94,42 +102,67 @@ pub fn run(root: &Path) {
         let model = TwoFaced::new(&fabric, FacetModel::Lewis, Variant::default()).unwrap();
         model.prepare();
         let truth = RayTracer::two_faced(&fabric, FacetModel::Lewis);
-        let mut cells = Vec::new();
+        let opts = BakeOptions {
+            grid: DEFAULT_GRID.two_faced(),
+            facet: FacetModel::Lewis,
+            ..BakeOptions::default()
+        };
+        let baked = bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false)).unwrap();
+        let table = TwoFacedBrdf::from_table(baked.table, Options::default()).unwrap();
+        let (mut cells, mut table_cells) = (Vec::new(), Vec::new());
         for &(_, up_i, up_o) in &blocks {
             let side = |w: UnitVec3, up: bool| if up { w } else { w.mirror_z() };
-            let rows: Vec<(f64, f64)> = pairs
+            let rows: Vec<(f64, f64, f64)> = pairs
                 .par_iter()
                 .enumerate()
                 .map(|(k, &(wi, wo))| {
                     let (wi, wo) = (side(wi, up_i), side(wo, up_o));
                     let (t, e) = truth.render_sphere(wi, wo, SAMPLES, k as u64 + 1, MAX_BOUNCES);
                     let m = mean(model.f(wi, wo));
+                    let b = mean(table.f(wi, wo));
                     let t = mean(t);
-                    ((m / t - 1.0).abs(), mean(e) / t)
+                    ((m / t - 1.0).abs(), mean(e) / t, (b / t - 1.0).abs())
                 })
                 .collect();
             let n = rows.len() as f64;
-            let avg = rows.iter().map(|r| r.0).sum::<f64>() / n;
-            let worst = rows.iter().fold(0.0f64, |a, r| a.max(r.0));
             let noise = rows.iter().map(|r| r.1).sum::<f64>() / n;
-            cells.push(format!(
-                "{:.2}% / {:.2}% ({:.2}%)",
-                100.0 * avg,
-                100.0 * worst,
-                100.0 * noise
-            ));
-            eprintln!(
-                "{name}: {:.2}% mean, {:.2}% worst",
-                100.0 * avg,
-                100.0 * worst
-            );
+            for (out, err) in [
+                (&mut cells, rows.iter().map(|r| r.0).collect::<Vec<_>>()),
+                (&mut table_cells, rows.iter().map(|r| r.2).collect()),
+            ] {
+                let avg = err.iter().sum::<f64>() / n;
+                let worst = err.iter().fold(0.0f64, |a, &r| a.max(r));
+                out.push(format!(
+                    "{:.2}% / {:.2}% ({:.2}%)",
+                    100.0 * avg,
+                    100.0 * worst,
+                    100.0 * noise
+                ));
+                eprintln!(
+                    "{name}: {:.2}% mean, {:.2}% worst",
+                    100.0 * avg,
+                    100.0 * worst
+                );
+            }
         }
-        let open = pairs
+        let (open, table_open) = pairs
             .par_iter()
             .enumerate()
-            .map(|(k, &(wi, _))| (model.openness(wi) - truth.openness(wi, SAMPLES, k as u64)).abs())
-            .reduce(|| 0.0, f64::max);
+            .map(|(k, &(wi, _))| {
+                let t = truth.openness(wi, SAMPLES, k as u64);
+                (
+                    (model.openness(wi) - t).abs(),
+                    (Bsdf::openness(&table, wi) - t).abs(),
+                )
+            })
+            .reduce(|| (0.0, 0.0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
         writeln!(out, "| {name} | {} | {open:.4} |", cells.join(" | ")).unwrap();
+        writeln!(
+            out,
+            "| *table* | {} | {table_open:.4} |",
+            table_cells.join(" | ")
+        )
+        .unwrap();
     }
     out.push_str("<!-- transmission-validation:end -->");
     let path = root.join("docs/validation.md");

@@ -5,7 +5,7 @@
 use crate::sweep::{check_options, BakeOptions, Method, DEFAULT_GRID};
 use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
 use clothbake_core::{Caps, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, Variant};
-use clothbake_loader::Grid;
+use clothbake_loader::{Faces, Grid};
 
 /// The most worker threads a command starts (`--threads`): far more than cores gains nothing
 /// (the work is CPU-bound) and a pool of 100 000 threads takes minutes to start, during which
@@ -146,6 +146,11 @@ pub struct Settings {
     pub bounces: Bounces,
     /// A spatially varying table (docs/spatial.md).
     pub spatial: bool,
+    /// The two-faced cloth over the sphere (docs/transmission.md): the grid's polar counts
+    /// are per side.
+    pub faces: Faces,
+    /// A two-faced bake's eye rays per node of its path-traced rest.
+    pub paths: Option<usize>,
 }
 
 /// The bounces and the secondary reflection's settings as given.
@@ -302,6 +307,28 @@ impl Settings {
                 n.number("bounces", "1")
             ));
         }
+        if self.faces == Faces::Two {
+            let given = [
+                (self.raytrace, n.word("method", "raytrace")),
+                (self.bounces.bounces != 1, f("bounces")),
+                (self.spatial, f("spatial")),
+            ];
+            if let Some((_, name)) = given.into_iter().find(|g| g.0) {
+                return Err(format!(
+                    "{} bakes the two-faced cloth's model (docs/transmission.md): the analytic \
+                     direct reflection with every other bounce path-traced, averaged over the \
+                     period; drop {name}",
+                    n.word("faces", "two")
+                ));
+            }
+        }
+        if self.faces == Faces::One && self.paths.is_some() {
+            return Err(format!(
+                "{} sets the two-faced cloth's path-traced rest; add {} or drop it",
+                f("paths"),
+                n.word("faces", "two")
+            ));
+        }
         if let Some(k) = self.samples.filter(|&k| k == 0 || k > MAX_SAMPLES) {
             return Err(format!(
                 "{} is out of range; give a whole number from 1 to {MAX_SAMPLES} (2^24)",
@@ -319,13 +346,18 @@ impl Settings {
                 variant: self.variant.unwrap_or(Variant::Refined),
             }
         };
+        let grid = self.grid.unwrap_or(DEFAULT_GRID);
         let options = BakeOptions {
-            grid: self.grid.unwrap_or(DEFAULT_GRID),
+            grid: match self.faces {
+                Faces::One => grid,
+                Faces::Two => grid.two_faced(),
+            },
             facet: self.facet,
             method,
             bounces: self.bounces.bounces,
             secondary,
             spatial: self.spatial,
+            paths: self.paths.unwrap_or(crate::two_faced::PATHS),
         };
         check_options(&options).map_err(|e| e.to_string())?;
         Ok(options)

@@ -11,9 +11,10 @@
 //! * Deterministic: every cell is a pure function of the inputs; the parallel sweep collects in
 //!   cell order, so the table is bit-identical for any number of threads.
 
-pub use crate::directions::{direction, row_cell};
+pub use crate::directions::{direction, incident, outgoing, row_cell};
 pub use crate::orbit::{representative, usable_symmetries};
 use crate::transport::Multiple;
+use crate::two_faced::TwoFaced;
 use clothbake_core::interreflection::{Orders, Ranges, Sampling};
 use clothbake_core::symmetry::Symmetry;
 use clothbake_core::{
@@ -21,11 +22,14 @@ use clothbake_core::{
     SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
 };
 use clothbake_loader::spatial::value_index;
-use clothbake_loader::{Grid, Metadata, Table, FORMAT_VERSION};
+use clothbake_loader::{Faces, Grid, Metadata, Table};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
+
+/// The most eye rays per node of a two-faced bake's rest (`--paths`): 2^24.
+pub const MAX_PATHS: usize = 1 << 24;
 
 /// The default grid: 32 x 64 x 32 x 64 cells (2.8 degrees in theta, 5.6 in phi).
 pub const DEFAULT_GRID: Grid = Grid::new(32, 64, 32, 64);
@@ -68,6 +72,9 @@ pub struct BakeOptions {
     /// A spatially varying table (docs/spatial.md): the classes of the period's cells beside
     /// the average. Analytic model, one or two bounces.
     pub spatial: bool,
+    /// A two-faced bake's eye rays per node of its path-traced rest
+    /// ([`crate::two_faced::PATHS`] by default); unused by one-faced bakes.
+    pub paths: usize,
 }
 
 impl Default for BakeOptions {
@@ -81,6 +88,7 @@ impl Default for BakeOptions {
             bounces: 1,
             secondary: SecondaryOptions::default(),
             spatial: false,
+            paths: crate::two_faced::PATHS,
         }
     }
 }
@@ -152,6 +160,9 @@ impl BakeOptions {
         if self.spatial {
             v["spatial"] = json!(true);
         }
+        if self.grid.faces == Faces::Two {
+            v["two_faced"] = crate::two_faced::describe(self.paths);
+        }
         v
     }
 }
@@ -193,6 +204,22 @@ pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
     opts.grid
         .validate()
         .map_err(|e| BakeError::Invalid(e.to_string()))?;
+    if opts.grid.faces == Faces::Two
+        && (opts.spatial || opts.bounces != 1 || !matches!(opts.method, Method::Analytic { .. }))
+    {
+        return Err(BakeError::Invalid(
+            "--faces two bakes the two-faced cloth's model (docs/transmission.md): the analytic \
+             direct reflection with every other bounce path-traced, averaged over the period; \
+             drop --spatial, --bounces and --method raytrace"
+                .into(),
+        ));
+    }
+    if opts.grid.faces == Faces::Two && !(1..=MAX_PATHS).contains(&opts.paths) {
+        return Err(BakeError::Invalid(format!(
+            "--paths {} is out of range; give a whole number from 1 to {MAX_PATHS} (2^24)",
+            opts.paths
+        )));
+    }
     if opts.spatial && (opts.bounces > 2 || !matches!(opts.method, Method::Analytic { .. })) {
         return Err(BakeError::Invalid(
             "--spatial bakes the analytic model's direct and secondary reflection; give \
@@ -449,6 +476,8 @@ pub struct Baker {
     meta: Metadata,
     /// With more than two bounces: the path-traced part's coarse nodes.
     multiple: Option<Arc<Multiple>>,
+    /// A two-faced bake's model, whose path-traced nodes [`Baker::sweep`] prepares first.
+    two_faced: Option<Arc<TwoFaced>>,
 }
 
 impl Baker {
@@ -461,7 +490,29 @@ impl Baker {
         let mut spatial = None;
         let multiple = (opts.bounces > 2)
             .then(|| Arc::new(Multiple::new(fabric, opts.facet, &g, opts.bounces)));
+        let two_faced = match (g.faces, opts.method) {
+            (Faces::Two, Method::Analytic { variant }) => Some(Arc::new(
+                TwoFaced::with_grid(
+                    fabric,
+                    opts.facet,
+                    variant,
+                    crate::two_faced::NODES,
+                    opts.paths,
+                )
+                .map_err(|e| BakeError::Invalid(e.to_string()))?,
+            )),
+            _ => None,
+        };
         let eval: CellFn = match (opts.method, multiple.clone()) {
+            _ if two_faced.is_some() => {
+                let tf = two_faced.clone().expect("matched");
+                Box::new(move |wi, cells, out| {
+                    let pairs: Vec<_> = cells.iter().map(|&(_, wo)| (wi, wo)).collect();
+                    let mut f = vec![[0.0; 3]; pairs.len()];
+                    tf.f_batch(&pairs, &mut f);
+                    out.extend(f.iter().map(|f| f.map(|x| x as f32)));
+                })
+            }
             (Method::Analytic { variant }, None) if opts.spatial => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
                 let layout = crate::spatial::layout(&m, &g, secondary.is_some())
@@ -530,7 +581,7 @@ impl Baker {
             }
         };
         let meta = Metadata {
-            format_version: FORMAT_VERSION,
+            format_version: clothbake_loader::version_for(g.faces),
             tool: tool_name(),
             grid: g,
             centring: "cell".into(),
@@ -541,6 +592,12 @@ impl Baker {
             symmetry: symmetry_name(&syms),
             spatial: None,
             yarns: None,
+            openness: two_faced.as_ref().map(|tf| {
+                (0..g.n_theta_i)
+                    .flat_map(|ti| (0..g.n_phi_i).map(move |pi| (ti, pi)))
+                    .map(|(ti, pi)| tf.openness(incident(&g, ti, pi)) as f32)
+                    .collect()
+            }),
         };
         let orbits = match &spatial {
             Some(l) => Orbits::spatial(&g, l.classes as usize, l.lanes()),
@@ -562,6 +619,7 @@ impl Baker {
             eval,
             meta,
             multiple,
+            two_faced,
         })
     }
 
@@ -583,14 +641,14 @@ impl Baker {
     /// Evaluates the canonical cells of `row`; `None` when `cancel` was raised meanwhile.
     pub fn eval_row(&self, row: usize, cancel: &AtomicBool) -> Option<Row> {
         let g = self.orbits.grid;
-        let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
+        let (nto, npo) = (g.n_theta_o, g.n_phi_o);
         let (ti, pi) = row_cell(&g, row);
-        let wi = direction(ti, nti, pi, npi);
+        let wi = incident(&g, ti, pi);
         let mut out = Vec::with_capacity(self.orbits.row_evaluations(row));
         let mut canonical = (0..nto)
             .flat_map(|to| (0..npo).map(move |po| (to, po)))
             .filter(|&(_, po)| self.orbits.canonical(pi as usize, po as usize))
-            .map(|(to, po)| (g.index(ti, pi, to, po), direction(to, nto, po, npo)));
+            .map(|(to, po)| (g.index(ti, pi, to, po), outgoing(&g, to, po)));
         let mut cells = Vec::with_capacity(CELLS_AT_ONCE);
         loop {
             cells.clear();
@@ -619,6 +677,11 @@ impl Baker {
     ) -> Result<(), BakeError> {
         if let Some(m) = &self.multiple {
             if !m.prepare(&self.orbits.grid, rows, cancel) {
+                return Err(BakeError::Cancelled);
+            }
+        }
+        if let Some(tf) = &self.two_faced {
+            if !tf.prepare_or_cancel(cancel) {
                 return Err(BakeError::Cancelled);
             }
         }

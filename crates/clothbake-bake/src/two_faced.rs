@@ -17,14 +17,31 @@
 
 use clothbake_core::openness::openness;
 use clothbake_core::transport::pair_seed;
-use clothbake_core::{cosine_sample, BsdfSample};
+use clothbake_core::{two_sided_pdf, two_sided_sample, BsdfSample};
 use clothbake_core::{
     AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FabricError, FacetModel, RayTracer, Rgb, UnitVec3,
     Variant,
 };
 use clothbake_loader::Axis;
 use rayon::prelude::*;
+use serde_json::{json, Value};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::OnceLock;
+
+/// The two-faced model's settings as a table's `options_json` holds them (`two_faced`): the
+/// rest's grid, `paths` rays per node, events per path and seed.
+pub fn describe(paths: usize) -> Value {
+    json!({
+        "direct": "analytic, per face, times its coverage",
+        "openness": "closed form",
+        "rest": {
+            "nodes": [NODES.0, NODES.1],
+            "paths": paths,
+            "max_bounces": MAX_BOUNCES,
+            "seed": SEED,
+        },
+    })
+}
 
 /// Nodes of the rest's grid per direction of a block: polar angles (k 90 / n degrees from the
 /// side's normal, k = 0..n: the normal itself, where datasheets are read, is a node) by
@@ -130,15 +147,17 @@ impl Rest {
         })
     }
 
-    /// Computes every node (each once; their values do not depend on the order).
-    fn prepare(&self) {
+    /// Computes every node (each once; their values do not depend on the order); false when
+    /// `cancel` was raised meanwhile (checked between nodes).
+    fn prepare(&self, cancel: &AtomicBool) -> bool {
         let d = self.dirs();
         (0..4 * d * d).into_par_iter().for_each(|k| {
             let (b, i, o) = (k / (d * d), (k / d) % d, k % d);
-            if self.canonical(b, i, o) == (b, i, o) {
+            if !cancel.load(Ordering::Relaxed) && self.canonical(b, i, o) == (b, i, o) {
                 self.node(b, i, o);
             }
         });
+        !cancel.load(Ordering::Relaxed)
     }
 
     fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb {
@@ -218,7 +237,13 @@ impl TwoFaced {
 
     /// Path-traces every node of the rest now, in parallel (otherwise each on first use).
     pub fn prepare(&self) {
-        self.rest.prepare();
+        self.rest.prepare(&AtomicBool::new(false));
+    }
+
+    /// [`TwoFaced::prepare`], stopping when `cancel` is raised (then false: nodes computed so
+    /// far are kept, the others computed on first use).
+    pub fn prepare_or_cancel(&self, cancel: &AtomicBool) -> bool {
+        self.rest.prepare(cancel)
     }
 
     /// The analytic direct reflection off the face both directions are on, per unit area of
@@ -248,40 +273,22 @@ impl Bsdf for TwoFaced {
         openness(&self.fabric, wi)
     }
 
-    /// Draws `wi` cos-weighted on `wo`'s side or on the other, with even odds
-    /// (`u[0] < 1/2`: `wo`'s side), so that reflection and transmission are both sampled.
+    /// [`clothbake_core::two_sided_sample`]: cos-weighted on either side with even odds, so
+    /// that reflection and transmission are both sampled.
     fn sample(&self, wo: UnitVec3, u: [f64; 2]) -> Option<BsdfSample> {
-        if !(wo.above_horizon() || wo.below_horizon()) {
-            return None;
-        }
-        let same = u[0] < 0.5;
-        let w = cosine_sample([if same { 2.0 * u[0] } else { 2.0 * u[0] - 1.0 }, u[1]]);
-        let wi = if same == (wo.z > 0.0) {
-            w
-        } else {
-            w.mirror_z()
-        };
-        let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| BsdfSample {
-            wi,
-            f: self.f(wi, wo),
-            pdf,
-        })
+        two_sided_sample(self, wo, u)
     }
 
     /// |cos(theta_i)| / (2 pi) on either side.
     fn pdf(&self, wo: UnitVec3, wi: UnitVec3) -> f64 {
-        let sided = |w: UnitVec3| w.above_horizon() || w.below_horizon();
-        if !(sided(wi) && sided(wo)) {
-            return 0.0;
-        }
-        wi.cos_theta().abs() / (2.0 * std::f64::consts::PI)
+        two_sided_pdf(wo, wi)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use clothbake_core::cosine_sample;
     use clothbake_core::rng::Rng;
 
     fn open_plain(tau: f64) -> Fabric {

@@ -264,6 +264,38 @@ pub fn default_pdf(wo: UnitVec3, wi: UnitVec3) -> f64 {
     wi.cos_theta() / PI
 }
 
+/// The cosine sampling of a BSDF over the whole sphere (reflection and transmission): `wi`
+/// drawn cos-weighted on `wo`'s side or on the other with even odds (`u[0] < 1/2`: `wo`'s
+/// side), f from `b`, density [`two_sided_pdf`]; `None` for `wo` in the cloth's plane.
+pub fn two_sided_sample<B: Bsdf + ?Sized>(b: &B, wo: UnitVec3, u: [f64; 2]) -> Option<BsdfSample> {
+    if !(wo.above_horizon() || wo.below_horizon()) {
+        return None;
+    }
+    let same = u[0] < 0.5;
+    let w = cosine_sample([if same { 2.0 * u[0] } else { 2.0 * u[0] - 1.0 }, u[1]]);
+    let wi = if same == (wo.z > 0.0) {
+        w
+    } else {
+        w.mirror_z()
+    };
+    let pdf = two_sided_pdf(wo, wi);
+    (pdf > 0.0).then(|| BsdfSample {
+        wi,
+        f: b.f(wi, wo),
+        pdf,
+    })
+}
+
+/// The density of [`two_sided_sample`]: |cos(theta_i)| / (2 pi) on either side, 0 for a
+/// direction in the plane.
+pub fn two_sided_pdf(wo: UnitVec3, wi: UnitVec3) -> f64 {
+    let sided = |w: UnitVec3| w.above_horizon() || w.below_horizon();
+    if !(sided(wi) && sided(wo)) {
+        return 0.0;
+    }
+    wi.cos_theta().abs() / (2.0 * PI)
+}
+
 /// A direction of the upper hemisphere with density cos(theta) / pi, from `u` in [0, 1)^2
 /// (Malley's method: a uniform point of the unit disc lifted to the hemisphere).
 pub fn cosine_sample(u: [f64; 2]) -> UnitVec3 {

@@ -40,7 +40,8 @@ pub use analytic::{
 pub use brdf::{AnalyticBsdf, Component};
 pub use cells::{Cell, CellGrid, PeriodPoint};
 pub use clothbake_bsdf::{
-    cosine_sample, vec3, Bsdf, BsdfSample, Footprint, FromFn, Level, Local, Rgb,
+    cosine_sample, two_sided_pdf, two_sided_sample, vec3, Bsdf, BsdfSample, Footprint, FromFn,
+    Level, Local, Rgb,
 };
 pub use fabric::{Fabric, FabricError, Field, Naming, PlainNaming};
 pub use facet::{Facet, FacetIntensity, FacetModel};

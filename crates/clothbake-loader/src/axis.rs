@@ -4,9 +4,11 @@
 //!
 //! A grid ([`crate::Grid`]) has four axes: the polar angles of the incident and the outgoing
 //! direction ([`Span::Hemisphere`], 90 degrees from +Z, not periodic) and their azimuths
-//! ([`Span::Turn`], 360 degrees from +X toward +Y, periodic). The span is the axis's, not a
-//! constant of the code: a table over the whole sphere, or one block of it per side, adds a
-//! variant here and its rules, and every user of an axis follows.
+//! ([`Span::Turn`], 360 degrees from +X toward +Y, periodic). A two-faced table's polar axes
+//! cover the whole sphere ([`Span::Sphere`], 180 degrees from +Z to -Z); it is baked, stored,
+//! sharded and compared on those axes, and looked up per side, in four hemisphere blocks
+//! (`crate::two_faced`), so the lookup's rules ([`Axis::lookup_node`], [`Axis::lookup_lines`])
+//! only ever see hemisphere and turn axes.
 //!
 //! The rules come in the float type and the order of operations each caller has always used,
 //! so that tables, lookups and samples keep their bits. Where two rules answer the same
@@ -38,43 +40,50 @@ use std::f64::consts as f64c;
 pub enum Span {
     /// A polar angle from the pole (+Z) to the horizon, [0, 90] degrees; not periodic.
     Hemisphere,
+    /// A polar angle from +Z through the horizon to -Z, [0, 180] degrees; not periodic. The
+    /// polar axes of a two-faced table (light and eye on either side of the cloth).
+    Sphere,
     /// An azimuth from +X toward +Y, [0, 360) degrees; periodic (cell 0 follows the last).
     Turn,
 }
 
 impl Span {
-    /// The span in degrees (f64): 90 or 360.
+    /// The span in degrees (f64): 90, 180 or 360.
     #[inline(always)]
     pub const fn degrees(self) -> f64 {
         match self {
             Span::Hemisphere => 90.0,
+            Span::Sphere => 180.0,
             Span::Turn => 360.0,
         }
     }
 
-    /// The span in degrees (f32, exact): 90 or 360.
+    /// The span in degrees (f32, exact): 90, 180 or 360.
     #[inline(always)]
     pub const fn degrees_f32(self) -> f32 {
         match self {
             Span::Hemisphere => 90.0,
+            Span::Sphere => 180.0,
             Span::Turn => 360.0,
         }
     }
 
-    /// The span in radians (f64): pi/2 or 2 pi.
+    /// The span in radians (f64): pi/2, pi or 2 pi.
     #[inline(always)]
     pub const fn radians(self) -> f64 {
         match self {
             Span::Hemisphere => f64c::FRAC_PI_2,
+            Span::Sphere => f64c::PI,
             Span::Turn => f64c::TAU,
         }
     }
 
-    /// The span in radians (f32): pi/2 or 2 pi, each the f32 nearest.
+    /// The span in radians (f32): pi/2, pi or 2 pi, each the f32 nearest.
     #[inline(always)]
     pub const fn radians_f32(self) -> f32 {
         match self {
             Span::Hemisphere => f32c::FRAC_PI_2,
+            Span::Sphere => f32c::PI,
             Span::Turn => f32c::TAU,
         }
     }
@@ -195,7 +204,7 @@ impl Axis {
     #[inline]
     pub fn cell_of(self, angle: f32) -> usize {
         match self.span {
-            Span::Hemisphere => {
+            Span::Hemisphere | Span::Sphere => {
                 let c = angle * self.cells_per_radian();
                 (c.max(0.0) as usize).min(self.count as usize - 1)
             }
@@ -213,14 +222,16 @@ impl Axis {
     pub fn cell_of_deg(self, angle: f64) -> u32 {
         let n = f64::from(self.count);
         let k = match self.span {
-            Span::Hemisphere => (angle * n / self.span.degrees()).floor(),
+            Span::Hemisphere | Span::Sphere => (angle * n / self.span.degrees()).floor(),
             Span::Turn => (angle.rem_euclid(self.span.degrees()) * n / self.span.degrees()).floor(),
         };
         (k.max(0.0) as u32).min(self.count - 1)
     }
 
     /// The lookup's node and weight at position `c` = angle in cells (cell `k`'s node at
-    /// `k + 0.5`): the padded node `lo <= count - 1` and the weight of node `lo + 1`.
+    /// `k + 0.5`): the padded node `lo <= count - 1` and the weight of node `lo + 1`. A
+    /// [`Span::Sphere`] axis is looked up per hemisphere block, never here (its polar arm is
+    /// the hemisphere's).
     ///
     /// * Polar: the nodes are padded with a pole node, node 0 at the pole and node `k + 1` cell
     ///   `k`'s. Below the first centre the blend is between the pole node and the first cell
@@ -233,7 +244,7 @@ impl Axis {
     pub fn lookup_node(self, c: f32) -> (u32, f32) {
         let n = self.count;
         match self.span {
-            Span::Hemisphere => {
+            Span::Hemisphere | Span::Sphere => {
                 let s = if c < 0.5 { 2.0 * c } else { c + 0.5 };
                 let s = s.max(0.0).min(n as f32); // NaN -> 0
                 let lo = (s as u32).min(n - 1);
@@ -256,7 +267,7 @@ impl Axis {
     pub(crate) fn lookup_lines(self) -> LookupLines {
         let (s, n) = (self.cells_per_radian(), self.count);
         match self.span {
-            Span::Hemisphere => LookupLines {
+            Span::Hemisphere | Span::Sphere => LookupLines {
                 k1: 2.0 * s,
                 b1: 0.0,
                 k2: s,
@@ -283,7 +294,7 @@ impl Axis {
         let n = f64::from(self.count);
         let c = angle * n / self.span.radians();
         match self.span {
-            Span::Hemisphere => (2.0 * c).min(c + 0.5),
+            Span::Hemisphere | Span::Sphere => (2.0 * c).min(c + 0.5),
             Span::Turn => c + n - 0.5,
         }
     }
@@ -298,7 +309,7 @@ impl Axis {
         let x = angle * n as f32 / self.span.degrees_f32() - 0.5;
         let x = if x.is_finite() { x } else { 0.0 };
         let (lo, hi, t) = match self.span {
-            Span::Hemisphere => {
+            Span::Hemisphere | Span::Sphere => {
                 let lo = x.floor().clamp(0.0, (n - 1) as f32);
                 (
                     lo as usize,
@@ -322,7 +333,7 @@ impl Axis {
     pub fn coarse_taps_deg(self, angle: f64) -> [(u32, f64); 2] {
         let n = self.count;
         match self.span {
-            Span::Hemisphere => {
+            Span::Hemisphere | Span::Sphere => {
                 let x =
                     (angle * f64::from(n) / self.span.degrees() - 0.5).clamp(0.0, f64::from(n - 1));
                 let k = (x.floor() as u32).min(n.saturating_sub(2));
@@ -384,13 +395,14 @@ mod tests {
 
     #[test]
     fn spans_are_the_same_angle_in_every_unit() {
-        for s in [Span::Hemisphere, Span::Turn] {
+        for s in [Span::Hemisphere, Span::Sphere, Span::Turn] {
             assert_eq!(s.degrees_f32() as f64, s.degrees());
             assert_eq!(s.degrees().to_radians() as f32, s.radians_f32());
             assert!((s.degrees().to_radians() - s.radians()).abs() < 1e-15);
             assert_eq!(s.radians() as f32, s.radians_f32());
         }
         assert!(Span::Turn.is_periodic() && !Span::Hemisphere.is_periodic());
+        assert!(!Span::Sphere.is_periodic());
     }
 
     #[test]

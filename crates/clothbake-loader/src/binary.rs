@@ -162,7 +162,7 @@ mod legacy {
     struct HeaderV1 {
         format_version: u32,
         tool: String,
-        grid: crate::grid::Grid,
+        grid: [u32; 4],
         centring: String,
         quantity: String,
         units: String,
@@ -176,7 +176,13 @@ mod legacy {
             Metadata {
                 format_version: self.format_version,
                 tool: self.tool,
-                grid: self.grid,
+                // Version-1 grids are one-faced: four counts.
+                grid: crate::grid::Grid::new(
+                    self.grid[0],
+                    self.grid[1],
+                    self.grid[2],
+                    self.grid[3],
+                ),
                 centring: self.centring,
                 quantity: self.quantity,
                 units: self.units,
@@ -185,6 +191,7 @@ mod legacy {
                 symmetry: self.symmetry,
                 spatial: None,
                 yarns: None,
+                openness: None,
             }
         }
     }

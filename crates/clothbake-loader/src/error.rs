@@ -56,7 +56,7 @@ pub enum TableError {
     },
     /// The file has a format version this build does not read.
     #[error(
-        "{}: {what} format version {found}, but this build reads version {reads}; {}",
+        "{}: {what} format version {found}, but this build reads versions up to {reads}; {}",
         .path.display(),
         if *.found > *.reads { "update the loader".to_string() } else { format!("bake the {what} again") }
     )]
@@ -67,7 +67,7 @@ pub enum TableError {
         what: &'static str,
         /// The version in the file.
         found: u32,
-        /// The version this build reads (and writes).
+        /// The newest version this build reads (and writes).
         reads: u32,
     },
     /// A binary container file of another kind than the one wanted (a shard given as a

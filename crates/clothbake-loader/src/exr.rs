@@ -11,7 +11,7 @@ use crate::error::TableError;
 use crate::grid::Grid;
 use crate::spatial::value_index;
 use crate::stored::{Samples, StoredTable};
-use crate::table::{check_format_version, Metadata, Precision, Table, FORMAT_VERSION};
+use crate::table::{check_format_version, Metadata, Precision, Table};
 
 /// The 4 magic bytes that open every OpenEXR file.
 pub const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
@@ -604,12 +604,12 @@ mod exr_io {
                 .and_then(attribute_text)
             {
                 match v.trim().parse::<u32>() {
-                    Ok(found) if found != FORMAT_VERSION => {
+                    Ok(found) if !crate::table::reads_version(u64::from(found)) => {
                         return Err(TableError::Version {
                             path: path.to_path_buf(),
                             what: "table",
                             found,
-                            reads: FORMAT_VERSION,
+                            reads: crate::table::TWO_FACED_VERSION,
                         })
                     }
                     Ok(_) => {}
@@ -1019,7 +1019,7 @@ mod exr_io {
     pub(super) fn half_nodes(c: &Checked<'_>) -> Result<Option<crate::nodes::Nodes>, TableError> {
         use crate::nodes::{Nodes, PlaneFill, Tiles, Values};
         use half::f16;
-        if !c.half_lines() || c.meta.spatial.is_some() {
+        if !c.half_lines() || c.meta.spatial.is_some() || c.meta.grid.faces == crate::Faces::Two {
             return Ok(None);
         }
         let g = c.meta.grid;

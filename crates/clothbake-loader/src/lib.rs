@@ -7,7 +7,8 @@
 //! `docs/table-format.md`. Files are written atomically ([`write_atomic_as`]).
 //! [`mod@stored`] keeps half-float tables half in memory. [`mod@lookup`] interpolates them
 //! ([`Brdf::eval`]) and [`mod@sampling`] importance-samples them ([`Brdf::sample`]); see
-//! `docs/loader.md`.
+//! `docs/loader.md`. A two-faced table (reflection and transmission over the sphere,
+//! [`Faces::Two`]) opens as a [`TwoFacedBrdf`]; [`Lookup::open`] opens either kind.
 
 pub mod angles;
 mod atomic;
@@ -31,6 +32,7 @@ pub mod spatial;
 mod spatial_lookup;
 pub mod stored;
 mod table;
+mod two_faced;
 
 pub use atomic::{abandon_temporaries, bake_owned, check_target, write_atomic_as, Batch};
 pub use axis::{Axis, Span};
@@ -42,11 +44,49 @@ pub use container::{
 };
 pub use error::TableError;
 pub use exr::{read_exr, read_exr_stored, write_exr, EXR_MAGIC};
-pub use grid::{Grid, MAX_CELLS};
+pub use grid::{Faces, Grid, MAX_CELLS};
 pub use half::f16;
 pub use lookup::{Brdf, LengthMismatch, Memory, Options, Sample, SimdPath, HORIZON_COS};
 pub use read::{read_table, read_table_stored};
 pub use spatial::Spatial;
 pub use spatial_lookup::SpatialLookup;
 pub use stored::{Samples, StoredTable};
-pub use table::{Metadata, Precision, Table, FORMAT_VERSION, MAX_VALUE};
+pub use table::{
+    version_for, Metadata, Precision, Table, FORMAT_VERSION, MAX_VALUE, TWO_FACED_VERSION,
+};
+pub use two_faced::TwoFacedBrdf;
+
+/// The lookup of a table of either kind: one-faced ([`Brdf`]) or two-faced ([`TwoFacedBrdf`]).
+#[derive(Clone, Debug)]
+pub enum Lookup {
+    /// Reflection over the thesis's floor (boxed, as the other).
+    One(Box<Brdf>),
+    /// Reflection and transmission over the sphere, and the openness (boxed: four blocks).
+    Two(Box<TwoFacedBrdf>),
+}
+
+impl Lookup {
+    /// Opens a table file of either kind (either format).
+    pub fn open(path: &std::path::Path, options: Options) -> Result<Lookup, TableError> {
+        // The kind is in the header; a two-faced table is read again, which costs a fraction
+        // of building its four blocks.
+        match Brdf::open(path, options) {
+            Ok(b) => Ok(Lookup::One(Box::new(b))),
+            Err(TableError::WrongKind { found, .. }) if found.starts_with(TWO_FACED) => {
+                Ok(Lookup::Two(Box::new(TwoFacedBrdf::open(path, options)?)))
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// The lookup as a [`Bsdf`] (f over the sphere, sampling, the openness).
+    pub fn into_bsdf(self) -> Box<dyn Bsdf + Send> {
+        match self {
+            Lookup::One(b) => b,
+            Lookup::Two(t) => t,
+        }
+    }
+}
+
+/// How a one-faced lookup names a two-faced table it refuses ([`TableError::WrongKind`]).
+pub(crate) const TWO_FACED: &str = "two-faced table";

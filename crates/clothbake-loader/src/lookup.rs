@@ -172,6 +172,18 @@ impl Brdf {
             }
         }
         let stored = crate::read::read_table_stored(path)?;
+        if stored.meta.grid.faces == crate::Faces::Two {
+            return Err(TableError::WrongKind {
+                path: path.to_path_buf(),
+                found: format!(
+                    "{} (reflection and transmission over the sphere)",
+                    crate::TWO_FACED
+                ),
+                expected: "one-faced table".into(),
+                fix: "open it with clothbake_loader::TwoFacedBrdf (or clothbake_loader::Lookup, \
+                      which opens either kind)",
+            });
+        }
         Brdf::from_stored(stored, options).map_err(corrupted)
     }
 
@@ -184,6 +196,13 @@ impl Brdf {
     pub fn from_stored(table: StoredTable, options: Options) -> Result<Brdf, TableError> {
         let StoredTable { meta, mut samples } = StoredTable::new(table.meta, table.samples)?;
         let g = meta.grid;
+        if g.faces == crate::Faces::Two {
+            return Err(TableError::InvalidTable {
+                reason: format!(
+                    "grid {g} is a two-faced table's; open it with clothbake_loader::TwoFacedBrdf"
+                ),
+            });
+        }
         let f16 = matches!(
             (&samples, options.memory),
             (Samples::F16(_), Memory::AsStored)

@@ -8,9 +8,27 @@ use crate::grid::Grid;
 use crate::spatial::Spatial;
 
 /// Version of the table description: the [`Metadata`] record, the grid layout and the OpenEXR
-/// format (`docs/table-format.md`). Readers reject any other version. The binary container
-/// has a version of its own, [`crate::CONTAINER_VERSION`].
+/// format (`docs/table-format.md`), of one-faced tables. Readers reject versions they do not
+/// know. The binary container has a version of its own, [`crate::CONTAINER_VERSION`].
 pub const FORMAT_VERSION: u32 = 1;
+
+/// Version of two-faced tables ([`crate::Faces::Two`]): the same description with a sphere
+/// grid and the openness, numbered apart so that a reader of version 1 alone refuses one
+/// instead of reading its sphere as a hemisphere.
+pub const TWO_FACED_VERSION: u32 = 2;
+
+/// The version of a table with `faces`.
+pub const fn version_for(faces: crate::Faces) -> u32 {
+    match faces {
+        crate::Faces::One => FORMAT_VERSION,
+        crate::Faces::Two => TWO_FACED_VERSION,
+    }
+}
+
+/// Whether this build reads table description version `v`.
+pub(crate) fn reads_version(v: u64) -> bool {
+    v == u64::from(FORMAT_VERSION) || v == u64::from(TWO_FACED_VERSION)
+}
 
 /// Largest value a table may hold, in 1/sr (10^30). Far beyond any physical BRDF (a mirror
 /// tabulated in cells of 0.01 degrees stays below 10^8), and small enough that every sum and
@@ -47,7 +65,8 @@ pub(crate) fn first_unphysical(values: &[f32]) -> Option<usize> {
 /// `docs/table-format.md`): do not reorder.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct Metadata {
-    /// Version of the table description: [`FORMAT_VERSION`].
+    /// Version of the table description: [`FORMAT_VERSION`], or [`TWO_FACED_VERSION`] for a
+    /// two-faced table ([`version_for`]).
     pub format_version: u32,
     /// The tool that wrote the table, e.g. `"clothbake 0.1.0"`.
     pub tool: String,
@@ -74,6 +93,12 @@ pub struct Metadata {
     /// under two crossing cells at the point level (docs/spatial.md). Absent elsewhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub yarns: Option<clothbake_point::Period>,
+    /// For a two-faced table ([`crate::Faces::Two`]), the openness at each incident cell
+    /// centre of the sphere grid, `ti * n_phi_i + pi`: the share of the light from there that
+    /// passes straight through the gaps (docs/transmission.md), each in [0, 1]. Absent from
+    /// one-faced tables.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub openness: Option<Vec<f32>>,
 }
 
 impl Metadata {
@@ -92,7 +117,7 @@ impl Metadata {
         crate::spatial::channel_names(classes, self.class_lanes())
     }
 
-    /// Metadata of the current format version for a cell-centred table of `f_r` in `1/sr`.
+    /// Metadata of the format version of `grid`'s faces ([`version_for`]) for a cell-centred table of `f_r` in `1/sr`.
     pub fn new(
         tool: impl Into<String>,
         grid: Grid,
@@ -101,7 +126,7 @@ impl Metadata {
         symmetry: impl Into<String>,
     ) -> Metadata {
         Metadata {
-            format_version: FORMAT_VERSION,
+            format_version: version_for(grid.faces),
             tool: tool.into(),
             grid,
             centring: "cell".to_string(),
@@ -112,6 +137,7 @@ impl Metadata {
             symmetry: symmetry.into(),
             spatial: None,
             yarns: None,
+            openness: None,
         }
     }
 
@@ -128,11 +154,17 @@ impl Metadata {
 
     /// Checks the format version, the grid and the centring.
     pub fn validate(&self) -> Result<(), TableError> {
-        if self.format_version != FORMAT_VERSION {
+        let want = version_for(self.grid.faces);
+        if self.format_version != want {
             return Err(TableError::InvalidTable {
                 reason: format!(
-                    "metadata says format version {}, but this is version {FORMAT_VERSION}",
-                    self.format_version
+                    "metadata says format version {}, but a {}-faced table is version {want}",
+                    self.format_version,
+                    if self.grid.faces == crate::Faces::Two {
+                        "two"
+                    } else {
+                        "one"
+                    }
                 ),
             });
         }
@@ -140,6 +172,7 @@ impl Metadata {
         if let Some(s) = &self.spatial {
             s.validate(&self.grid)?;
         }
+        self.validate_faces()?;
         if self.centring != "cell" {
             return Err(TableError::InvalidTable {
                 reason: format!(
@@ -149,6 +182,45 @@ impl Metadata {
             });
         }
         Ok(())
+    }
+
+    /// A two-faced table has its openness, one value in [0, 1] per incident cell, and no
+    /// spatial layout or yarns; a one-faced table has no openness.
+    fn validate_faces(&self) -> Result<(), TableError> {
+        let invalid = |reason: String| Err(TableError::InvalidTable { reason });
+        let g = &self.grid;
+        match (g.faces, &self.openness) {
+            (crate::Faces::One, None) => Ok(()),
+            (crate::Faces::One, Some(_)) => invalid(
+                "a one-faced table holds an openness; only two-faced tables have one".into(),
+            ),
+            (crate::Faces::Two, None) => invalid(format!(
+                "the two-faced grid {g} needs the openness of each incident cell (field openness)"
+            )),
+            (crate::Faces::Two, Some(o)) => {
+                let want = g.n_theta_i as usize * g.n_phi_i as usize;
+                if o.len() != want {
+                    return invalid(format!(
+                        "openness has {} values, but the grid {g} has {want} incident cells",
+                        o.len()
+                    ));
+                }
+                if let Some(k) = o.iter().position(|v| !(0.0..=1.0).contains(v)) {
+                    return invalid(format!(
+                        "openness of incident cell {k} is {}; an openness lies in [0, 1]",
+                        o[k]
+                    ));
+                }
+                if self.spatial.is_some() || self.yarns.is_some() {
+                    return invalid(
+                        "a two-faced table has no spatial layout or yarns (it is averaged over \
+                         the period)"
+                            .into(),
+                    );
+                }
+                Ok(())
+            }
+        }
     }
 
     /// The metadata as JSON text with every non-ASCII character escaped (`\uXXXX`), so that
@@ -291,18 +363,19 @@ pub enum Precision {
     F32,
 }
 
-/// Refuses a table whose metadata (`meta`, as JSON) names another [`FORMAT_VERSION`]: checked
+/// Refuses a table whose metadata (`meta`, as JSON) names a version this build does not read
+/// ([`FORMAT_VERSION`] and [`TWO_FACED_VERSION`]): checked
 /// before the rest, so that a newer table says "update the loader" (both formats).
 pub(crate) fn check_format_version(
     path: &std::path::Path,
     meta: &serde_json::Value,
 ) -> Result<(), TableError> {
     match meta.get("format_version").and_then(|v| v.as_u64()) {
-        Some(found) if found != u64::from(FORMAT_VERSION) => Err(TableError::Version {
+        Some(found) if !reads_version(found) => Err(TableError::Version {
             path: path.to_path_buf(),
             what: "table",
             found: u32::try_from(found).unwrap_or(u32::MAX),
-            reads: FORMAT_VERSION,
+            reads: TWO_FACED_VERSION,
         }),
         _ => Ok(()),
     }

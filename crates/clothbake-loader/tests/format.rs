@@ -422,7 +422,7 @@ fn wrong_version_names_the_fix() {
     mentions(
         &e,
         &[
-            "table format version 7, but this build reads version 1",
+            "table format version 7, but this build reads versions up to 2",
             "update the loader",
         ],
     );

@@ -62,6 +62,7 @@ fn parse_v1(b: &[u8]) -> Table {
         symmetry: c.text(),
         spatial: None,
         yarns: None,
+        openness: None,
     };
     assert_eq!(c.1, 20 + h, "the header is exactly H bytes");
     let n = c.u64() as usize;

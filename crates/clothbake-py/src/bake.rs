@@ -102,13 +102,16 @@ fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) ->
 /// "fast" or "T,B,A") or "raytrace" (sampling: "N,STEP,L0,exact|area"); kernel
 /// "radiometric" (default) or "thesis". spatial: True tabulates the weave up close beside the
 /// average (docs/spatial.md; analytic model, bounces=1 or 2); look it up with Table.eval_at(wi, wo, uv,
-/// width).
-/// Returns the Table (None for a shard).
+/// width). faces: "one" (default) or "two", the two-faced cloth over the sphere
+/// (docs/transmission.md; res's polar counts per side; paths: eye rays per node of its
+/// path-traced rest, default 8192), returned as a TwoFaced.
+/// Returns the Table (a TwoFaced for faces="two"; None for a shard).
 #[pyfunction]
 #[pyo3(signature = (fabric, res=(32, 64, 32, 64), bounces=None, facet="huo", progress=None, *,
     output=None, overwrite=false, resume=false, shard=None, format=None, precision=None,
     method="analytic", variant=None, samples=None, seed=None, caps=None, secondary=None,
-    kernel=None, orders=None, sampling=None, checkpoint_every=None, spatial=false))]
+    kernel=None, orders=None, sampling=None, checkpoint_every=None, spatial=false, faces="one",
+    paths=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn bake(
     py: Python<'_>,
@@ -134,7 +137,9 @@ pub fn bake(
     sampling: Option<&str>,
     checkpoint_every: Option<f64>,
     spatial: bool,
-) -> PyResult<Option<PyTable>> {
+    faces: &str,
+    paths: Option<usize>,
+) -> PyResult<Option<Py<PyAny>>> {
     let bounces = bounces_arg(bounces.as_ref())?;
     let grid = Grid::new(res.0, res.1, res.2, res.3);
     grid.validate().map_err(|e| bad("res", e))?;
@@ -147,7 +152,18 @@ pub fn bake(
     if samples == Some(0) {
         return Err(bad("samples", "0 rays; give at least 1"));
     }
+    let faces = choice(
+        "faces",
+        Some(faces),
+        &[
+            ("one", clothbake_loader::Faces::One),
+            ("two", clothbake_loader::Faces::Two),
+        ],
+    )?
+    .unwrap_or_default();
     let settings = Settings {
+        faces,
+        paths,
         grid: Some(grid),
         facet: facet_model(facet)?,
         raytrace,
@@ -333,8 +349,13 @@ pub fn bake(
     })?;
     match done.table {
         None => Ok(None),
+        Some(t) if t.meta.grid.faces == clothbake_loader::Faces::Two => {
+            let cloth = crate::two_faced::PyTwoFaced::from_table(t).map_err(table_err)?;
+            Ok(Some(Py::new(py, cloth)?.into_any()))
+        }
         Some(t) => PyTable::from_stored(StoredTable::from(t), false, true)
-            .map(Some)
-            .map_err(table_err),
+            .map_err(table_err)
+            .and_then(|t| Ok(Py::new(py, t)?.into_any()))
+            .map(Some),
     }
 }

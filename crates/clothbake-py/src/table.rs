@@ -143,7 +143,16 @@ impl PyTable {
                 other => other,
             })
         })
-        .map_err(table_err)
+        .map_err(|e| match e {
+            TableError::WrongKind { found, .. } if found.starts_with("two-faced") => {
+                PyValueError::new_err(format!(
+                    "{}: a two-faced table (reflection and transmission over the sphere); open \
+                     it with clothbake.TwoFaced.open (in Mitsuba: faces=\"two\")",
+                    path.display()
+                ))
+            }
+            other => table_err(other),
+        })
     }
 
     /// The grid: a dict of n_theta_i, n_phi_i, n_theta_o, n_phi_o (cells per axis; polar

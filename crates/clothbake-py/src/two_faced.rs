@@ -3,21 +3,35 @@
 //! or in batches.
 
 use crate::fabric::{facet_model, PyFabric};
+use crate::table::table_err;
 use crate::vectors::{check_unit, same_len, to_array, to_array1, unit_rows};
 use clothbake_bake::two_faced::TwoFaced;
 use clothbake_core::{Bsdf, UnitVec3, Variant, Vec3};
+use clothbake_loader::{Options, TableError, TwoFacedBrdf};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use std::path::PathBuf;
 
 /// The two-faced cloth of a fabric: no floor, light through the gaps and through translucent
 /// yarns, the back the inverted weave (docs/transmission.md). `eval` gives f (1/sr, RGB) for
 /// directions anywhere on the sphere (reflection where `wi` and `wo` are on one side,
 /// transmission across), `openness` the share of the light from a direction that passes
 /// straight through the gaps (a delta toward -wi, not in `eval`).
+///
+/// `TwoFaced.open(path)` opens a two-faced table (baked with `--faces two`) with the same
+/// methods, looked up through the loader (docs/table-format.md, "Two-faced tables").
 #[pyclass(name = "TwoFaced", module = "clothbake", frozen)]
 pub struct PyTwoFaced {
-    cloth: TwoFaced,
+    /// The model (`Fabric.two_faced`) or a table's lookup (`TwoFaced.open`).
+    cloth: Box<dyn Bsdf + Send + Sync>,
     name: String,
+}
+
+/// The `name` of a table's fabric JSON, if it has one.
+fn fabric_name(json: &str) -> Option<String> {
+    serde_json::from_str::<serde_json::Value>(json)
+        .ok()
+        .and_then(|v| v["name"].as_str().map(str::to_string))
 }
 
 fn unit(w: [f64; 3]) -> UnitVec3 {
@@ -25,6 +39,15 @@ fn unit(w: [f64; 3]) -> UnitVec3 {
 }
 
 impl PyTwoFaced {
+    /// A two-faced table in memory (a bake's), looked up through the loader.
+    pub fn from_table(table: clothbake_loader::Table) -> Result<Self, TableError> {
+        let name = fabric_name(&table.meta.fabric_json).unwrap_or_default();
+        Ok(PyTwoFaced {
+            cloth: Box::new(TwoFacedBrdf::from_table(table, Options::default())?),
+            name,
+        })
+    }
+
     /// The cloth of `fabric` with `facet` and `variant`, its path-traced grid computed now
     /// (without the GIL).
     pub fn build(
@@ -60,7 +83,7 @@ impl PyTwoFaced {
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         py.detach(|| cloth.prepare());
         Ok(PyTwoFaced {
-            cloth,
+            cloth: Box::new(cloth),
             name: fabric.fabric.name().to_string(),
         })
     }
@@ -68,6 +91,35 @@ impl PyTwoFaced {
 
 #[pymethods]
 impl PyTwoFaced {
+    /// Opens a two-faced table file (either format; baked with `clothbake --faces two`): its
+    /// four blocks interpolated, the openness between its incident cells. Raises
+    /// FileNotFoundError for a missing file and ValueError for a file that is not a valid
+    /// two-faced table (a one-faced one opens with `Table.open`).
+    #[staticmethod]
+    #[pyo3(signature = (path, reciprocal=false))]
+    fn open(py: Python<'_>, path: PathBuf, reciprocal: bool) -> PyResult<PyTwoFaced> {
+        let options = Options {
+            reciprocal,
+            ..Options::default()
+        };
+        let table = py
+            .detach(|| TwoFacedBrdf::open(&path, options))
+            .map_err(|e| match e {
+                TableError::WrongKind { .. } => PyValueError::new_err(format!(
+                    "{}: a one-faced table (reflection over the floor); open it with \
+                     clothbake.Table.open, or bake it with --faces two",
+                    path.display()
+                )),
+                other => table_err(other),
+            })?;
+        let name =
+            fabric_name(&table.meta().fabric_json).unwrap_or_else(|| path.display().to_string());
+        Ok(PyTwoFaced {
+            cloth: Box::new(table),
+            name,
+        })
+    }
+
     /// f(wi, wo) in 1/sr for `(N, 3)` unit vectors `wi` (toward the light) and `wo` (toward
     /// the eye) anywhere on the sphere: an `(N, 3)` array (or `(3,)` for one pair).
     fn eval<'py>(

@@ -534,3 +534,43 @@ def test_the_two_faced_cloth_transmits_and_passes_light_through_its_gaps():
     assert refl + trans + 0.25 <= 1.0
     with pytest.raises(ValueError, match="variant"):
         fab.two_faced(variant="no such")
+
+
+def test_a_two_faced_table_holds_its_cloth_over_the_sphere(tmp_path):
+    # Baked from the model of the same fabric (the same rays a node), looked up through the
+    # loader: at cell centres the table returns the model's values. (A symmetric weave's bake
+    # evaluates one cell of each mirror orbit and copies it; with the light at the first
+    # azimuth, 22.5 degrees, every cell is its orbit's own.)
+    from conftest import OPEN_PLAIN
+
+    fab = clothbake.Fabric(OPEN_PLAIN)
+    path = tmp_path / "open.exr"
+    baked = clothbake.bake(fab, res=(4, 8, 4, 8), facet="lewis", faces="two", paths=256,
+                           output=str(path), precision="f32")
+    assert isinstance(baked, clothbake.TwoFaced)
+    table = clothbake.TwoFaced.open(str(path))
+    assert "open plain" in repr(table)
+    model = fab.two_faced(facet="lewis", paths=256)
+    # Cell centres: polar (k + 0.5) * 180 / 8 over the sphere, azimuths (k + 0.5) * 45.
+    theta = np.radians([11.25, 33.75, 146.25, 168.75])
+    phi = np.radians([22.5, 112.5, 202.5, 337.5])
+    w = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)],
+                 axis=-1)
+    first = np.radians(22.5)
+    light = np.stack([np.sin(theta) * np.cos(first), np.sin(theta) * np.sin(first),
+                      np.cos(theta)], axis=-1)
+    wi, wo = np.repeat(light, 4, axis=0), np.tile(w, (4, 1))
+    want = model.eval(wi, wo)
+    np.testing.assert_allclose(table.eval(wi, wo), want, rtol=1e-5)
+    np.testing.assert_allclose(baked.eval(wi, wo), want, rtol=1e-5)
+    # The openness at the incident cells' centres: the closed form's.
+    np.testing.assert_allclose(table.openness(w), model.openness(w), atol=1e-6)
+    # The other kinds refuse each other's files, naming the door.
+    with pytest.raises(ValueError, match="TwoFaced.open"):
+        clothbake.Table.open(str(path))
+    one = tmp_path / "one.exr"
+    clothbake.bake(fab, res=(2, 4, 2, 4), output=str(one))
+    with pytest.raises(ValueError, match="one-faced"):
+        clothbake.TwoFaced.open(str(one))
+    with pytest.raises(ValueError, match="faces"):
+        clothbake.bake(fab, res=(2, 4, 2, 4), faces="three")

@@ -277,7 +277,7 @@ def test_the_readme_snippet_renders_the_twill(tmp_path, monkeypatch):
 
 
 
-def two_faced_scene(weave, eye_dir, emitter, integrator, spp, res=16):
+def two_faced_scene(bsdf, eye_dir, emitter, integrator, spp, res=16):
     """A large flat cloth (Mitsuba's rectangle: z = 0, normal +z, dp_du along +x) seen by an
     orthographic camera along ``eye_dir`` (toward the eye), filling the frame."""
     eye_dir = np.asarray(eye_dir, dtype=np.float64)
@@ -296,30 +296,39 @@ def two_faced_scene(weave, eye_dir, emitter, integrator, spp, res=16):
             "sampler": {"type": "independent", "sample_count": spp},
         },
         "shape": {"type": "rectangle", "to_world": mi.ScalarTransform4f().scale([20, 20, 1]),
-                  "bsdf": {"type": "clothbake", "weave": str(weave), "faces": "two",
-                           "facet": "lewis", "nodes": "3,6", "paths": 2048}},
+                  "bsdf": bsdf},
         "light": emitter,
     })
 
 
-def two_faced_checks(tmp_path):
+def two_faced_checks(tmp_path, table=False):
     """Shared by the scalar and llvm tests: (1) backlit: the sun behind the cloth, the eye in
     front, each pixel E f(wi, wo) |cos theta_i| (transmission); (2) a uniform sky around the
     cloth, one bounce: each pixel the sky's radiance times what the cloth scatters toward the
     eye from the whole sphere plus its openness along the eye (the null lobe seen through),
-    against a quadrature of the same cloth through clothbake.TwoFaced."""
+    against a quadrature of the same cloth through clothbake.TwoFaced. The cloth is the model
+    (weave=), or with ``table`` a two-faced table baked from it (table=)."""
     import json
 
-    weave = tmp_path / "open.json"
-    weave.write_text(json.dumps(OPEN_PLAIN))
-    cloth = clothbake.Fabric(OPEN_PLAIN).two_faced(facet="lewis", nodes=(3, 6), paths=2048)
+    if table:
+        path = tmp_path / "open.exr"
+        clothbake.bake(clothbake.Fabric(OPEN_PLAIN), res=(8, 16, 8, 16), facet="lewis",
+                       faces="two", paths=2048, output=str(path))
+        cloth = clothbake.TwoFaced.open(str(path))
+        bsdf = {"type": "clothbake", "table": str(path), "faces": "two"}
+    else:
+        weave = tmp_path / "open.json"
+        weave.write_text(json.dumps(OPEN_PLAIN))
+        cloth = clothbake.Fabric(OPEN_PLAIN).two_faced(facet="lewis", nodes=(3, 6), paths=2048)
+        bsdf = {"type": "clothbake", "weave": str(weave), "faces": "two", "facet": "lewis",
+                "nodes": "3,6", "paths": 2048}
     eye = np.array([0.3, -0.4, 0.866])
     eye = eye / np.linalg.norm(eye)
     travel = np.array([0.2, 0.3, 1.0])  # the sunlight travels up: the sun is behind the cloth
     travel = travel / np.linalg.norm(travel)
     sun = {"type": "directional", "direction": travel.tolist(),
            "irradiance": {"type": "rgb", "value": [E, E, E]}}
-    sc = two_faced_scene(weave, eye, sun, {"type": "direct", "emitter_samples": 1,
+    sc = two_faced_scene(bsdf, eye, sun, {"type": "direct", "emitter_samples": 1,
                                            "bsdf_samples": 0}, 4)
     img = render(sc, 4)
     light = -travel
@@ -330,7 +339,7 @@ def two_faced_checks(tmp_path):
     assert abs(got - want) < 1e-3 * want
     # The sky: one bounce (max_depth 2), every lobe and the null one sampled.
     sky = {"type": "constant", "radiance": {"type": "rgb", "value": 1.0}}
-    sc = two_faced_scene(weave, eye, sky, {"type": "path", "max_depth": 2, "hide_emitters": False}, 256)
+    sc = two_faced_scene(bsdf, eye, sky, {"type": "path", "max_depth": 2, "hide_emitters": False}, 256)
     got = render(sc, 256)[..., 0].mean()
     rng = np.random.default_rng(3)
     n = 20000
@@ -346,3 +355,7 @@ def two_faced_checks(tmp_path):
 
 def test_the_two_faced_cloth_transmits_and_shows_the_sky_through_its_gaps(tmp_path):
     two_faced_checks(tmp_path)
+
+
+def test_a_two_faced_table_draws_as_its_cloth(tmp_path):
+    two_faced_checks(tmp_path, table=True)

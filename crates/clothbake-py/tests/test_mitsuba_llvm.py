@@ -212,5 +212,6 @@ def test_the_two_faced_cloth_in_wavefronts(tmp_path):
     use("llvm_ad_rgb")
     try:
         two_faced_checks(tmp_path)
+        two_faced_checks(tmp_path, table=True)
     finally:
         use("scalar_rgb")

@@ -145,14 +145,23 @@ impl Shader {
         }))
     }
 
-    /// The baked table at `path` (either format), looked up with the loader's interpolation.
+    /// Whether the BSDF is a two-faced cloth's, lit and seen from either side.
+    pub fn is_two_faced(&self) -> bool {
+        self.two_faced
+    }
+
+    /// The baked table at `path` (either format, either kind: a two-faced table is lit and
+    /// seen from either side), looked up with the loader's interpolation.
     pub fn table(path: &std::path::Path) -> Result<Shader, clothbake_loader::TableError> {
         let options = clothbake_loader::Options {
             sampling: false,
             ..Default::default()
         };
-        let brdf = clothbake_loader::Brdf::open(path, options)?;
-        Ok(Shader::new(Box::new(brdf)))
+        Ok(match clothbake_loader::Lookup::open(path, options)? {
+            clothbake_loader::Lookup::One(brdf) => Shader::new(brdf),
+            // A two-faced table: lit and seen from either side.
+            clothbake_loader::Lookup::Two(t) => Shader::two_sided(t),
+        })
     }
 
     /// f_r(wi, wo) in 1/sr, RGB, in the render's f32; zero when either direction is at or

@@ -6,7 +6,7 @@
 //! then write the table atomically through the loader. Ctrl-C raises the cancel flag: the bake
 //! stops and nothing is written (exit 130; a second Ctrl-C exits at once; `signals`).
 
-use crate::cli::{BakeOpts, FormatArg, Method as MethodArg, PrecisionArg, ShardArg};
+use crate::cli::{BakeOpts, Faces, FormatArg, Method as MethodArg, PrecisionArg, ShardArg};
 use crate::error::{table_error, CliError};
 use crate::eval_cmd::load_fabric;
 use crate::signals;
@@ -112,6 +112,11 @@ pub fn plan_with_env(
         caps: o.caps.map(Caps::from),
         bounces: o.bounces.settings(),
         spatial: o.spatial,
+        paths: o.paths,
+        faces: match o.faces {
+            Faces::One => clothbake_loader::Faces::One,
+            Faces::Two => clothbake_loader::Faces::Two,
+        },
     };
     let options = settings.options(Naming::Cli).map_err(CliError::line)?;
     let shard = match (o.shard, o.shards) {
@@ -356,14 +361,27 @@ pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
         if plan.threads == 1 { "" } else { "s" },
     );
     if plan.shard.is_none() {
-        summary.push_str(&next_steps(&plan.weave, &plan.output));
+        let two = plan.options.grid.faces == clothbake_loader::Faces::Two;
+        summary.push_str(&next_steps(&plan.weave, &plan.output, two));
     }
     Ok(summary)
 }
 
 /// The line after a baked table's summary: what to try with it next, spelled as this program
 /// can be run ([`invocation`]).
-pub fn next_steps(weave: &Path, table: &Path) -> String {
+pub fn next_steps(weave: &Path, table: &Path, two_faced: bool) -> String {
+    if two_faced {
+        return format!(
+            "next: `{c} info {t}` (what it holds: reflection, transmission and openness from \
+             each side), `{c} render --table {t} --faces two --scene swatch --eye 0,-55,-45 \
+             --light 0,0.5,0.87 -o {png}` (backlit), `{c} eval --weave {w} --faces two --wi 30,0 \
+             --wo 150,180` (one pair of directions through the cloth)\n",
+            c = invocation(),
+            t = table.display(),
+            png = table.with_extension("png").display(),
+            w = weave.display(),
+        );
+    }
     format!(
         "next: `{c} info {t}` (what it holds), `{c} render --table {t} -o {png}` (a picture), \
          `{c} eval --weave {w} --wi 30,0 --wo 45,180` (one pair of directions)\n",

@@ -189,6 +189,17 @@ pub struct BakeOpts {
     #[arg(long)]
     pub spatial: bool,
 
+    /// `one` face over the thesis's floor (reflection only), or the `two`-faced cloth (no
+    /// floor: light through the gaps and translucent yarns, the back the inverted weave;
+    /// docs/transmission.md): a table over the whole sphere, --res's polar counts per side.
+    #[arg(long, value_enum, default_value_t = Faces::One)]
+    pub faces: Faces,
+
+    /// With --faces two: eye rays per node of the path-traced rest (the light through and
+    /// between the yarns; docs/transmission.md) [default: 8192]. Its noise falls as 1/sqrt(N).
+    #[arg(long, value_name = "N", value_parser = parse_paths)]
+    pub paths: Option<usize>,
+
     /// Material overrides, applied to both yarn groups.
     #[command(flatten)]
     pub material: MaterialArgs,
@@ -966,6 +977,11 @@ pub fn parse_period_point(s: &str) -> Result<clothbake_core::PeriodPoint, String
 /// Parses a sample count, 1 to [`clothbake_bake::settings::MAX_SAMPLES`].
 pub fn parse_samples(s: &str) -> Result<usize, String> {
     clothbake_bake::settings::parse_samples(s, "--samples")
+}
+
+/// Parses the two-faced bake's rays per node (the rule of [`parse_samples`]).
+pub fn parse_paths(s: &str) -> Result<usize, String> {
+    clothbake_bake::settings::parse_samples(s, "--paths")
 }
 
 /// Parses a random seed, a whole number from 0 to 2^64 - 1.

@@ -2,7 +2,7 @@
 
 use crate::cli::InfoArgs;
 use crate::error::CliError;
-use clothbake_bake::albedo::directional_albedo;
+use clothbake_bake::albedo::{directional_albedo, reflected_and_transmitted};
 use clothbake_loader::{read_table, Table};
 use std::fmt::Write as _;
 use std::io::Read;
@@ -134,6 +134,10 @@ pub fn run(args: &InfoArgs) -> Result<String, CliError> {
             v[0], v[1], v[2]
         );
     }
+    if g.faces == clothbake_loader::Faces::Two {
+        two_faced_lines(&mut s, &t);
+        return Ok(s);
+    }
     let pi = g.phi_i().cell_of_deg(0.0);
     let _ = writeln!(
         s,
@@ -159,4 +163,54 @@ pub fn run(args: &InfoArgs) -> Result<String, CliError> {
         );
     }
     Ok(s)
+}
+
+/// A two-faced table's sides, openness and the light from each side's incident rows: reflected
+/// on its side, transmitted to the other (f_r's integrals), and straight through.
+fn two_faced_lines(s: &mut String, t: &Table) {
+    let g = t.meta.grid;
+    let openness = t.meta.openness.as_deref().unwrap_or_default();
+    let _ = writeln!(
+        s,
+        "faces      two (docs/transmission.md): theta 0 to 90 from the front (+Z), 90 to 180 from \
+         the back; each side {} polar cells; the openness (light straight through the gaps) \
+         per incident cell",
+        g.n_theta_i / 2
+    );
+    let pi = g.phi_i().cell_of_deg(0.0);
+    let _ = writeln!(
+        s,
+        "light from each side, phi_i {:.2} (row {pi}, nearest 0): reflected R, transmitted T \
+         (f_r's integrals, mean of RGB) and straight through O",
+        g.phi_i_deg(pi)
+    );
+    let _ = writeln!(
+        s,
+        "  {:<36} {:>8} {:>8} {:>8} {:>8}",
+        "side, theta_i asked -> row used", "R", "T", "O", "R+T+O"
+    );
+    let mean = |a: [f64; 3]| (a[0] + a[1] + a[2]) / 3.0;
+    for (side, flip) in [("front", false), ("back", true)] {
+        for want in ALBEDO_THETAS {
+            let theta = if flip { 180.0 - want } else { want };
+            let ti = g.theta_i().cell_of_deg(theta);
+            let (r, tr) = reflected_and_transmitted(t, ti, pi);
+            let o = openness
+                .get((ti * g.n_phi_i + pi) as usize)
+                .map_or(0.0, |&o| f64::from(o));
+            let (r, tr) = (mean(r), mean(tr));
+            let _ = writeln!(
+                s,
+                "  {:<36} {:>8.4} {:>8.4} {:>8.4} {:>8.4}",
+                format!(
+                    "{side} {want:>2} -> row {ti} ({:.2} deg)",
+                    g.theta_i_deg(ti)
+                ),
+                r,
+                tr,
+                o,
+                r + tr + o
+            );
+        }
+    }
 }

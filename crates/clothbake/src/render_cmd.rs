@@ -78,12 +78,26 @@ fn component_name(c: ComponentArg) -> &'static str {
 }
 
 /// The two-faced cloth's shader of `render --faces two`: the fabric of --weave, whole, averaged
-/// over the period.
+/// over the period, or a two-faced table (--table, baked with --faces two).
 fn two_faced_shader(a: &RenderArgs) -> Result<Shader, CliError> {
+    if let ([table], None) = (a.brdf.table.as_slice(), &a.brdf.weave) {
+        let shader = table_shader(table)?;
+        if !shader.is_two_faced() {
+            return Err(CliError::new(
+                format!(
+                    "{} is a one-faced table (reflection over the floor), and --faces two draws \
+                     the two-faced cloth",
+                    table.display()
+                ),
+                "bake the table with --faces two, or drop --faces two",
+            ));
+        }
+        return Ok(shader);
+    }
     let Some(weave) = &a.brdf.weave else {
         return Err(CliError::new(
-            "--faces two draws a fabric's two-faced cloth, and no --weave was given",
-            "give --weave FILE (e.g. tables/basket.json) with --faces two",
+            "--faces two draws a fabric's two-faced cloth, and no --weave or --table was given",
+            "give --weave FILE (e.g. tables/basket.json) or a table baked with --faces two",
         ));
     };
     let b = &a.brdf.bounces;

@@ -235,6 +235,151 @@ fn spatial_bakes_are_the_same_for_any_thread_count_and_shard_split() {
 }
 
 #[test]
+fn two_faced_bakes_are_the_same_for_any_thread_count_and_shard_split() {
+    let d = fresh_dir("two-faced");
+    let plain = fabric("plain");
+    // Few rays a node: the rest's noise does not matter here, its bits do.
+    let base = [
+        "bake",
+        "--weave",
+        plain.as_str(),
+        "--res",
+        "4,8,4,8",
+        "--faces",
+        "two",
+        "--facet",
+        "lewis",
+        "--translucency",
+        "0.5",
+        "--paths",
+        "64",
+    ];
+    let out = succeeds(&run_in(
+        &d,
+        &[&base[..], &["--threads", "1", "-o", "one.exr"]].concat(),
+    ));
+    assert!(out.contains("grid 8x8x8x8"), "{out}");
+    assert!(
+        out.contains("--faces two"),
+        "the next steps draw it backlit: {out}"
+    );
+    succeeds(&run_in(
+        &d,
+        &[&base[..], &["--threads", "2", "-o", "two.exr"]].concat(),
+    ));
+    identical(&d, "one.exr", "two.exr");
+    for k in 0..3 {
+        let s = format!("{k}/3");
+        succeeds(&run_in(&d, &[&base[..], &["--shard", &s]].concat()));
+    }
+    succeeds(&run_in(
+        &d,
+        &[
+            "merge",
+            "-o",
+            "merged.exr",
+            "plain-1-of-3.shard",
+            "plain-2-of-3.shard",
+            "plain-0-of-3.shard",
+        ],
+    ));
+    identical(&d, "one.exr", "merged.exr");
+    // info: the sides, and the light from each split into reflected, transmitted and through;
+    // the plain weave's gaps are narrow (threads 3 wide every 3.1): at most (1 - 3/3.1)^2 =
+    // 0.001 passes straight.
+    let info = succeeds(&run_in(&d, &["info", "merged.exr"]));
+    assert!(info.contains("faces      two"), "{info}");
+    let front = info
+        .lines()
+        .find(|l| l.trim_start().starts_with("front  0 ->"))
+        .unwrap_or_else(|| panic!("{info}"));
+    let v: Vec<f64> = front
+        .split_whitespace()
+        .rev()
+        .take(4)
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let (sum, o, t, r) = (v[0], v[1], v[2], v[3]);
+    assert!(r > 0.2 && t > 0.05 && o < 1.1e-3, "{front}");
+    assert!((r + t + o - sum).abs() < 2e-4 && sum < 1.0, "{front}");
+    // A two-faced table renders lit from behind; a one-faced one is refused with --faces two.
+    let out = succeeds(&run_in(
+        &d,
+        &[
+            "render",
+            "--table",
+            "one.exr",
+            "--faces",
+            "two",
+            "--scene",
+            "swatch",
+            "--eye",
+            "0,-55,-45",
+            "--light",
+            "0,0.5,0.87",
+            "--res",
+            "24",
+            "-o",
+            "back.png",
+        ],
+    ));
+    assert!(out.contains("wrote back.png"), "{out}");
+    succeeds(&run_in(
+        &d,
+        &[
+            "bake",
+            "--weave",
+            plain.as_str(),
+            "--res",
+            "4,8,4,8",
+            "-o",
+            "flat.exr",
+        ],
+    ));
+    fails_with(
+        &run_in(
+            &d,
+            &[
+                "render", "--table", "flat.exr", "--faces", "two", "-o", "x.png",
+            ],
+        ),
+        &["flat.exr", "one-faced", "--faces two"],
+    );
+    // diff tells the two kinds apart by their grids.
+    fails_with(
+        &run_in(&d, &["diff", "one.exr", "flat.exr"]),
+        &["different grids", "two faces"],
+    );
+    // What a two-faced table cannot hold is refused before anything is written.
+    for (extra, needle) in [
+        (&["--spatial"][..], "--spatial"),
+        (&["--bounces", "2"][..], "--bounces"),
+        (&["--method", "raytrace"][..], "--method raytrace"),
+    ] {
+        fails_with(
+            &run_in(&d, &[&base[..], extra, &["-o", "bad.exr"]].concat()),
+            &["--faces two", needle],
+        );
+    }
+    fails_with(
+        &run_in(
+            &d,
+            &[
+                "bake",
+                "--weave",
+                plain.as_str(),
+                "--paths",
+                "8",
+                "-o",
+                "bad.exr",
+            ],
+        ),
+        &["--paths", "--faces two"],
+    );
+    assert!(!d.join("bad.exr").exists());
+}
+
+#[test]
 fn shard_auto_reads_slurm_and_kubernetes() {
     let d = fresh_dir("auto");
     let twill = fabric("twill");

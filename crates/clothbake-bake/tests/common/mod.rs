@@ -16,12 +16,7 @@ pub fn fabric(name: &str) -> Fabric {
 
 /// The grid of `[n_theta_i, n_phi_i, n_theta_o, n_phi_o]` cells.
 pub fn grid([n_theta_i, n_phi_i, n_theta_o, n_phi_o]: [u32; 4]) -> Grid {
-    Grid {
-        n_theta_i,
-        n_phi_i,
-        n_theta_o,
-        n_phi_o,
-    }
+    Grid::new(n_theta_i, n_phi_i, n_theta_o, n_phi_o)
 }
 
 /// The small grid most tests bake on: 4 x 8 x 4 x 8.

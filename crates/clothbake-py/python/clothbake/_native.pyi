@@ -53,6 +53,9 @@ class Fabric:
 
 class TwoFaced:
     """The two-faced cloth: f over the whole sphere and the openness (docs/transmission.md)."""
+    @staticmethod
+    def open(path: Union[str, "os.PathLike[str]"], reciprocal: bool = False) -> "TwoFaced":
+        """Opens a two-faced table (baked with --faces two); ValueError for a one-faced one."""
     def eval(self, wi: npt.ArrayLike, wo: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
     def openness(self, w: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
     def eval1(self, wi: Vec3, wo: Vec3) -> Vec3: ...

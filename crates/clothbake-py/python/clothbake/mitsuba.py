@@ -27,7 +27,8 @@ evaluated as its front mirrored through the cloth's plane (z negated for both di
 the same weave, seen from the other side. With ``two_sided=False`` the back is black. Light
 and eye on opposite sides give zero (no transmission).
 
-Two faces and transmission: ``faces="two"`` with ``weave=`` draws the two-faced cloth
+Two faces and transmission: ``faces="two"`` with ``weave=`` (or ``table=``, a table baked with
+``clothbake --faces two``) draws the two-faced cloth
 (docs/transmission.md: no floor, light through the gaps and through translucent yarns, the back
 the inverted weave): ``eval`` gives reflection off either face and transmission across, and a
 null lobe passes the ray straight through with the openness O along the eye's direction (a
@@ -51,7 +52,7 @@ variants need an LLVM of version 17 or later (``DRJIT_LIBLLVM_PATH``, e.g.
 
 import math
 
-from . import Fabric, Table
+from . import Fabric, Table, TwoFaced
 
 _REGISTERED = False
 
@@ -67,7 +68,14 @@ class Cloth:
                 "clothbake BSDF: give exactly one of table= (a baked .exr/.bin table) "
                 "or weave= (a fabric .json file)"
             )
-        self.table = Table.open(str(props["table"])) if has_table else None
+        faces = str(props.get("faces", "one"))
+        if faces not in ("one", "two"):
+            raise ValueError(
+                f"clothbake BSDF: faces={faces!r}; use \"one\" (over the thesis's floor) or "
+                "\"two\" (the two-faced cloth: transmission and openness)"
+            )
+        one_table = has_table and faces == "one"
+        self.table = Table.open(str(props["table"])) if one_table else None
         self.fabric = Fabric(str(props["weave"])) if has_weave else None
         self.facet = str(props.get("facet", "huo"))
         self.two_sided = bool(props.get("two_sided", True))
@@ -77,23 +85,20 @@ class Cloth:
                 "clothbake BSDF: periods= is the weave periods per UV unit, a finite number > 0"
             )
         self.source = str(props["table"] if has_table else props["weave"])
-        faces = str(props.get("faces", "one"))
-        if faces not in ("one", "two"):
-            raise ValueError(
-                f"clothbake BSDF: faces={faces!r}; use \"one\" (over the thesis's floor) or "
-                "\"two\" (the two-faced cloth: transmission and openness)"
-            )
         self.cloth = None
         if faces == "two":
-            if self.fabric is None or self.periods is not None or not self.two_sided:
+            if self.periods is not None or not self.two_sided:
                 raise ValueError(
-                    "clothbake BSDF: faces=\"two\" needs weave= (a fabric file), without periods= "
-                    "or two_sided=False (the two-faced cloth is drawn whole from either side)"
+                    "clothbake BSDF: faces=\"two\" takes no periods= or two_sided=False (the "
+                    "two-faced cloth is drawn whole from either side)"
                 )
-            grid = str(props.get("nodes", "5,8")).split(",")
-            self.cloth = self.fabric.two_faced(
-                facet=self.facet, nodes=(int(grid[0]), int(grid[1])),
-                paths=int(props.get("paths", 8192)))
+            if has_table:
+                self.cloth = TwoFaced.open(str(props["table"]))
+            else:
+                grid = str(props.get("nodes", "5,8")).split(",")
+                self.cloth = self.fabric.two_faced(
+                    facet=self.facet, nodes=(int(grid[0]), int(grid[1])),
+                    paths=int(props.get("paths", 8192)))
 
     def flags(self, mi):
         """Glossy reflection, front side (and back side when two-sided); with two faces also
