@@ -138,16 +138,14 @@ impl TwoFacedBrdf {
         });
         let mut blocks = Vec::with_capacity(4);
         for b in 0..4 {
-            let values = block_samples(&g, &samples, b);
             blocks.push(Brdf::from_stored(
                 StoredTable {
                     meta: block_meta.clone(),
-                    samples: values,
+                    samples: block_samples(&g, &samples, b),
                 },
                 block_options,
             )?);
         }
-        drop(samples);
         let blocks: [Brdf; 4] = blocks.try_into().expect("four blocks");
         Ok(TwoFacedBrdf {
             meta,
@@ -307,33 +305,36 @@ fn sphere_cell(g: &Grid, b: usize, ti: u32, pi: u32, to: u32, po: u32) -> usize 
     )
 }
 
+/// The start of each run of `3 n_phi_o` values block `b` takes from the sphere table, in the
+/// block's cell order (ti, pi, to): a run is one outgoing ring's azimuths, contiguous in both.
+fn block_runs(g: &Grid, b: usize) -> impl Iterator<Item = usize> + '_ {
+    let side = g.side();
+    (0..side.n_theta_i).flat_map(move |ti| {
+        (0..side.n_phi_i).flat_map(move |pi| {
+            (0..side.n_theta_o).map(move |to| 3 * sphere_cell(g, b, ti, pi, to, 0))
+        })
+    })
+}
+
 /// Block `b`'s values on the side grid, in its cell order, at the samples' precision.
 fn block_samples(g: &Grid, samples: &Samples, b: usize) -> Samples {
-    let side = g.side();
-    let cells = (0..side.n_theta_i).flat_map(move |ti| {
-        (0..side.n_phi_i).flat_map(move |pi| {
-            (0..side.n_theta_o)
-                .flat_map(move |to| (0..side.n_phi_o).map(move |po| (ti, pi, to, po)))
-        })
-    });
-    let at = move |(ti, pi, to, po)| 3 * sphere_cell(g, b, ti, pi, to, po);
+    let run = 3 * g.n_phi_o as usize;
+    let len = 3 * g.side().len();
     match samples {
-        Samples::F16(v) => Samples::F16(
-            cells
-                .flat_map(|c| {
-                    let i = at(c);
-                    [v[i], v[i + 1], v[i + 2]]
-                })
-                .collect::<Vec<f16>>(),
-        ),
-        Samples::F32(v) => Samples::F32(
-            cells
-                .flat_map(|c| {
-                    let i = at(c);
-                    [v[i], v[i + 1], v[i + 2]]
-                })
-                .collect(),
-        ),
+        Samples::F16(v) => {
+            let mut out: Vec<f16> = Vec::with_capacity(len);
+            for at in block_runs(g, b) {
+                out.extend_from_slice(&v[at..at + run]);
+            }
+            Samples::F16(out)
+        }
+        Samples::F32(v) => {
+            let mut out: Vec<f32> = Vec::with_capacity(len);
+            for at in block_runs(g, b) {
+                out.extend_from_slice(&v[at..at + run]);
+            }
+            Samples::F32(out)
+        }
     }
 }
 
@@ -343,19 +344,19 @@ fn block_samples(g: &Grid, samples: &Samples, b: usize) -> Samples {
 fn block_albedos(g: &Grid, samples: &Samples, b: usize) -> Vec<f32> {
     let side = g.side();
     let (ti_axis, pi_axis) = (side.theta_i(), side.phi_i());
-    let mut out = vec![0f64; (side.n_theta_o * side.n_phi_o) as usize];
-    for ti in 0..side.n_theta_i {
+    let (nto, npo) = (side.n_theta_o as usize, side.n_phi_o as usize);
+    let mut out = vec![0f64; nto * npo];
+    let per_ring = side.n_phi_i as usize * nto;
+    for (k, at) in block_runs(g, b).enumerate() {
+        let ti = (k / per_ring) as u32;
+        let to = k % nto;
         let (s0, s1) = (ti_axis.edge_rad(ti).sin(), ti_axis.edge_rad(ti + 1).sin());
         // The integral of cos theta over the cell: (sin^2 hi - sin^2 lo) / 2 times its azimuth.
         let weight = 0.5 * (s1 * s1 - s0 * s0) * pi_axis.width_rad();
-        for pi in 0..side.n_phi_i {
-            for to in 0..side.n_theta_o {
-                for po in 0..side.n_phi_o {
-                    let i = 3 * sphere_cell(g, b, ti, pi, to, po);
-                    let mean = (samples.get(i) + samples.get(i + 1) + samples.get(i + 2)) / 3.0;
-                    out[(to * side.n_phi_o + po) as usize] += weight * f64::from(mean);
-                }
-            }
+        for po in 0..npo {
+            let i = at + 3 * po;
+            let mean = (samples.get(i) + samples.get(i + 1) + samples.get(i + 2)) / 3.0;
+            out[to * npo + po] += weight * f64::from(mean);
         }
     }
     out.into_iter().map(|a| a as f32).collect()
