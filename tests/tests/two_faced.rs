@@ -73,10 +73,13 @@ fn a_baked_table_holds_the_model_and_its_datasheet_agrees_with_the_light_paths()
     use clothbake_loader::{Bsdf as _, Grid, Options, TwoFacedBrdf};
     use std::sync::atomic::AtomicBool;
     let fabric = open_plain(0.8, 0.2);
-    // The default rays a node, so that the table is the one a user bakes; a coarse grid.
+    // A quarter of the default rays a node (the transmittance integrates their noise away)
+    // and a coarse grid, to keep the test short.
+    let paths = 2048;
     let opts = BakeOptions {
         grid: Grid::new(12, 16, 12, 16).two_faced(),
         facet: FacetModel::Lewis,
+        paths,
         ..BakeOptions::default()
     };
     let baked = bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false)).unwrap();
@@ -89,7 +92,14 @@ fn a_baked_table_holds_the_model_and_its_datasheet_agrees_with_the_light_paths()
     // their directions).
     let syms = clothbake_bake::sweep::usable_symmetries(&fabric, &g);
     assert!(!syms.is_empty(), "the open plain weave is symmetric");
-    let model = TwoFaced::new(&fabric, FacetModel::Lewis, Variant::default()).unwrap();
+    let model = TwoFaced::with_grid(
+        &fabric,
+        FacetModel::Lewis,
+        Variant::default(),
+        clothbake_bake::two_faced::NODES,
+        paths,
+    )
+    .unwrap();
     let centre = |k: u32, polar: bool, n: u32| {
         if polar {
             (f64::from(k) + 0.5) * 180.0 / f64::from(n)
