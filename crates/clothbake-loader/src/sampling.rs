@@ -22,6 +22,7 @@
 //! row's conditional CDF; the remainders of both, rescaled to [0, 1), place the direction
 //! uniformly in solid angle inside the cell (`cos theta` and `phi` uniform).
 
+use crate::axis::Axis;
 use crate::grid::Grid;
 
 /// Weight of the uniform part of the sampling density (see the module documentation).
@@ -80,6 +81,7 @@ fn mass(c: &[f32], k: usize) -> f32 {
 impl Sampler {
     /// CDFs of the table `value(ti, pi, to, po)` (RGB f_r at cell centres) on grid `g`.
     pub(crate) fn new(g: &Grid, value: impl Fn(u32, u32, u32, u32) -> [f32; 3]) -> Sampler {
+        debug_assert_eq!(g.faces, crate::Faces::One, "a sampler's grid is one-faced");
         let (nti, npi, nto, npo) = (g.n_theta_i, g.n_phi_i, g.n_theta_o, g.n_phi_o);
         let d_phi = g.phi_i().width_rad();
         let edges: Vec<f64> = (0..=nti).map(|k| g.theta_i().edge_rad(k)).collect();
@@ -139,11 +141,14 @@ impl Sampler {
         4 * outgoing * g.n_theta_i as usize * (1 + g.n_phi_i as usize)
     }
 
-    /// Index of the outgoing cell that holds (theta_o, phi_o), radians.
+    /// Index of the outgoing cell that holds (theta_o, phi_o), radians. A sampler's grid is
+    /// one-faced (a two-faced table samples block by block, each on a one-faced grid), so its
+    /// polar axes are written as the hemisphere's constant ([`Axis::polar`]): the cell rule's
+    /// span folds away on this path.
     #[inline]
     fn outgoing_cell(&self, theta: f32, phi: f32) -> usize {
         let g = &self.grid;
-        let to = g.theta_o().cell_of(theta);
+        let to = Axis::polar(g.n_theta_o).cell_of(theta);
         let po = g.phi_o().cell_of(phi);
         to * g.n_phi_o as usize + po
     }
@@ -170,7 +175,7 @@ impl Sampler {
         let g = &self.grid;
         let (nti, npi) = (g.n_theta_i as usize, g.n_phi_i as usize);
         let oc = self.outgoing_cell(theta_o, phi_o);
-        let ti = g.theta_i().cell_of(theta_i);
+        let ti = Axis::polar(g.n_theta_i).cell_of(theta_i);
         let pi = g.phi_i().cell_of(phi_i);
         let row = (oc * nti + ti) * npi;
         let p = mass(&self.marginal[oc * nti..(oc + 1) * nti], ti)
