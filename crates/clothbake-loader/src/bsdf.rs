@@ -5,8 +5,28 @@
 use crate::lookup::Brdf;
 use clothbake_bsdf::{Bsdf, BsdfSample, Footprint, Local, Rgb, UnitVec3, Vec3};
 
-fn f32s(u: UnitVec3) -> [f32; 3] {
+/// A unit vector in the lookups' f32.
+pub(crate) fn f32s(u: UnitVec3) -> [f32; 3] {
     [u.x as f32, u.y as f32, u.z as f32]
+}
+
+/// A lookup's [`crate::Sample`] as the interface's [`BsdfSample`] for `wo`: `None` without a
+/// sample (pdf 0), f evaluated again at the sampled direction in f64.
+pub(crate) fn bsdf_sample<B: Bsdf + ?Sized>(
+    bsdf: &B,
+    s: crate::Sample,
+    wo: UnitVec3,
+) -> Option<BsdfSample> {
+    if s.pdf <= 0.0 {
+        return None;
+    }
+    let [x, y, z] = s.wi.map(f64::from);
+    let wi = UnitVec3::new(Vec3::new(x, y, z))?;
+    Some(BsdfSample {
+        wi,
+        f: bsdf.f(wi, wo),
+        pdf: f64::from(s.pdf),
+    })
 }
 
 impl Bsdf for Brdf {
@@ -48,17 +68,7 @@ impl Bsdf for Brdf {
         if !self.has_sampling() {
             return clothbake_bsdf::default_sample(self, wo, u);
         }
-        let s = self.sample(f32s(wo), u[0] as f32, u[1] as f32);
-        if s.pdf <= 0.0 {
-            return None;
-        }
-        let [x, y, z] = s.wi.map(f64::from);
-        let wi = UnitVec3::new(Vec3::new(x, y, z))?;
-        Some(BsdfSample {
-            wi,
-            f: Bsdf::f(self, wi, wo),
-            pdf: f64::from(s.pdf),
-        })
+        bsdf_sample(self, self.sample(f32s(wo), u[0] as f32, u[1] as f32), wo)
     }
 
     fn pdf(&self, wo: UnitVec3, wi: UnitVec3) -> f64 {

@@ -31,12 +31,13 @@
 use std::path::Path;
 
 use crate::angles::{theta_phi, HORIZON_COS};
+use crate::bsdf::f32s;
 use crate::error::TableError;
 use crate::grid::{Faces, Grid};
 use crate::lookup::{Brdf, Options, Sample};
 use crate::stored::{Samples, StoredTable};
 use crate::table::{Metadata, Table};
-use clothbake_bsdf::{Bsdf, BsdfSample, Rgb, UnitVec3, Vec3};
+use clothbake_bsdf::{Bsdf, BsdfSample, Rgb, UnitVec3};
 use half::f16;
 
 /// The sides of the light and the eye of each block (`true`: above the cloth).
@@ -362,10 +363,6 @@ fn block_albedos(g: &Grid, samples: &Samples, b: usize) -> Vec<f32> {
     out.into_iter().map(|a| a as f32).collect()
 }
 
-fn f32s(u: UnitVec3) -> [f32; 3] {
-    [u.x as f32, u.y as f32, u.z as f32]
-}
-
 impl Bsdf for TwoFacedBrdf {
     fn f(&self, wi: UnitVec3, wo: UnitVec3) -> Rgb {
         self.eval(f32s(wi), f32s(wo)).map(f64::from)
@@ -380,16 +377,7 @@ impl Bsdf for TwoFacedBrdf {
             return clothbake_bsdf::two_sided_sample(self, wo, u);
         }
         let s = TwoFacedBrdf::sample(self, f32s(wo), u[0] as f32, u[1] as f32);
-        if s.pdf <= 0.0 {
-            return None;
-        }
-        let [x, y, z] = s.wi.map(f64::from);
-        let wi = UnitVec3::new(Vec3::new(x, y, z))?;
-        Some(BsdfSample {
-            wi,
-            f: Bsdf::f(self, wi, wo),
-            pdf: f64::from(s.pdf),
-        })
+        crate::bsdf::bsdf_sample(self, s, wo)
     }
 
     fn pdf(&self, wo: UnitVec3, wi: UnitVec3) -> f64 {

@@ -8,6 +8,9 @@ use clothbake_loader::{
 };
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
+mod common;
+use common::Rng;
+
 /// Per side: 6 polar cells, 12 azimuths of the light; 5 and 10 of the eye.
 const SIDE: Grid = Grid::new(6, 12, 5, 10);
 
@@ -160,13 +163,8 @@ fn between_centres_each_block_is_a_one_faced_lookup_of_its_side() {
     let blocks: Vec<Brdf> = (0..4)
         .map(|k| Brdf::from_table(block_table(k), Options::default()).unwrap())
         .collect();
-    let mut s = 12345u64;
-    let mut u = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = Rng(12345);
+    let mut u = || rng.next();
     let mut worst_vs_f: f64 = 0.0;
     for _ in 0..4000 {
         let (ti, to) = (FRAC_PI_2 * 0.999 * u(), FRAC_PI_2 * 0.999 * u());
@@ -240,22 +238,26 @@ fn the_openness_interpolates_the_incident_cells_of_its_side() {
     );
 }
 
-/// The density over the sphere by a midpoint rule in (theta, phi) on each side.
-fn integral_of_pdf(b: &TwoFacedBrdf, wo: [f32; 3]) -> f64 {
-    let (n, m) = (200, 200);
-    let mut sum = 0.0;
+/// A midpoint rule over the sphere: `n x n` cells in (theta, phi) on each side, `f` given each
+/// cell's centre direction and solid angle.
+fn over_sphere(n: usize, mut f: impl FnMut([f64; 3], f64)) {
+    let (dt, dp) = (FRAC_PI_2 / n as f64, TAU / n as f64);
     for side in [1.0, -1.0] {
         for i in 0..n {
-            let theta = (i as f64 + 0.5) * FRAC_PI_2 / n as f64;
-            for j in 0..m {
-                let phi = (j as f64 + 0.5) * TAU / m as f64;
-                let mut w = dir(theta, phi);
+            let theta = (i as f64 + 0.5) * dt;
+            for j in 0..n {
+                let mut w = dir(theta, (j as f64 + 0.5) * dp);
                 w[2] *= side;
-                let d = theta.sin() * (FRAC_PI_2 / n as f64) * (TAU / m as f64);
-                sum += f64::from(b.pdf(wo, f32s(w))) * d;
+                f(w, theta.sin() * dt * dp);
             }
         }
     }
+}
+
+/// The density over the sphere by [`over_sphere`].
+fn integral_of_pdf(b: &TwoFacedBrdf, wo: [f32; 3]) -> f64 {
+    let mut sum = 0.0;
+    over_sphere(200, |w, d| sum += f64::from(b.pdf(wo, f32s(w))) * d);
     sum
 }
 
@@ -274,13 +276,8 @@ fn samples_carry_their_density_and_estimate_the_albedo() {
     for wo in [dir(0.5, 0.7), dir(PI - 0.6, 3.0)] {
         let wo32 = f32s(wo);
         let n = 40_000;
-        let mut s = 99u64;
-        let mut u = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 40) as f32) / (1u64 << 24) as f32
-        };
+        let mut rng = Rng(99);
+        let mut u = || rng.next() as f32;
         let (mut est, mut sides) = (0.0, [0usize; 2]);
         for _ in 0..n {
             let smp = b.sample(wo32, u(), u());
@@ -291,20 +288,10 @@ fn samples_carry_their_density_and_estimate_the_albedo() {
             sides[usize::from(smp.wi[2] > 0.0)] += 1;
         }
         // The albedo over the sphere by quadrature of the lookup itself.
-        let (k, m) = (150, 150);
         let mut albedo = 0.0;
-        for side in [1.0, -1.0] {
-            for i in 0..k {
-                let theta = (i as f64 + 0.5) * FRAC_PI_2 / k as f64;
-                for j in 0..m {
-                    let phi = (j as f64 + 0.5) * TAU / m as f64;
-                    let mut w = dir(theta, phi);
-                    w[2] *= side;
-                    let d = theta.sin() * theta.cos() * (FRAC_PI_2 / k as f64) * (TAU / m as f64);
-                    albedo += f64::from(b.eval(f32s(w), wo32)[1]) * d;
-                }
-            }
-        }
+        over_sphere(150, |w, d| {
+            albedo += f64::from(b.eval(f32s(w), wo32)[1]) * w[2].abs() * d;
+        });
         assert!(
             (est - albedo).abs() < 0.02 * albedo,
             "{wo:?}: estimate {est} vs {albedo}"
