@@ -347,6 +347,23 @@ impl Settings {
             }
         };
         let grid = self.grid.unwrap_or(DEFAULT_GRID);
+        if self.faces == Faces::Two {
+            let cells = 4 * grid.len() as u128;
+            if cells > u128::from(clothbake_loader::MAX_CELLS) {
+                let g = grid;
+                return Err(format!(
+                    "{} {},{},{},{} with {} holds its cells on each side of the cloth: {cells} \
+                     cells is more than the limit of 2^31; give a coarser {}",
+                    f("res"),
+                    g.n_theta_i,
+                    g.n_phi_i,
+                    g.n_theta_o,
+                    g.n_phi_o,
+                    n.word("faces", "two"),
+                    f("res")
+                ));
+            }
+        }
         let options = BakeOptions {
             grid: match self.faces {
                 Faces::One => grid,

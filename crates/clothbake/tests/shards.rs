@@ -376,6 +376,27 @@ fn two_faced_bakes_are_the_same_for_any_thread_count_and_shard_split() {
         ),
         &["--paths", "--faces two"],
     );
+    fails_with(
+        &run_in(
+            &d,
+            &[
+                "bake",
+                "--weave",
+                plain.as_str(),
+                "--faces",
+                "two",
+                "--res",
+                "32768,65536,1,1",
+                "-o",
+                "bad.exr",
+            ],
+        ),
+        &[
+            "--res 32768,65536,1,1 with --faces two",
+            "8589934592 cells",
+            "2^31",
+        ],
+    );
     assert!(!d.join("bad.exr").exists());
 }
 
