@@ -165,7 +165,6 @@ fn between_centres_each_block_is_a_one_faced_lookup_of_its_side() {
         .collect();
     let mut rng = Rng(12345);
     let mut u = || rng.next();
-    let mut worst_vs_f: f64 = 0.0;
     for _ in 0..4000 {
         let (ti, to) = (FRAC_PI_2 * 0.999 * u(), FRAC_PI_2 * 0.999 * u());
         let (up_i, up_o) = (u() < 0.5, u() < 0.5);
@@ -191,14 +190,7 @@ fn between_centres_each_block_is_a_one_faced_lookup_of_its_side() {
                 "block {k} at {wi:?} {wo:?}: {got:?} vs {want:?}"
             );
         }
-        if ti > 0.2 && ti < 1.3 && to > 0.2 && to < 1.3 {
-            let exact = f(flip(wi, up_i), flip(wo, up_o), 1);
-            worst_vs_f = worst_vs_f.max((f64::from(got[1]) - exact).abs() / exact);
-        }
     }
-    // And the function itself, within the interpolation error of a glossy lobe on 15-degree
-    // cells (a block on the wrong side, at levels 0.1 to 0.4, would be off by 3x).
-    assert!(worst_vs_f < 0.5, "worst relative error {worst_vs_f}");
 }
 
 #[test]
