@@ -136,12 +136,9 @@ fn at_cell_centres_every_block_returns_its_values() {
 fn block_table(b: usize) -> Table {
     let (up_i, up_o) = [(true, true), (true, false), (false, false), (false, true)][b];
     let g = SIDE;
-    let side = |mut w: [f64; 3], up: bool| {
-        if !up {
-            w[2] = -w[2];
-        }
-        w
-    };
+    // A new array, not a `mut` parameter changed in place (issue 36's note: a debug build
+    // miscomputed the in-place form).
+    let side = |w: [f64; 3], up: bool| [w[0], w[1], if up { w[2] } else { -w[2] }];
     let mut values = Vec::with_capacity(3 * g.len());
     for ti in 0..g.n_theta_i {
         for pi in 0..g.n_phi_i {
@@ -170,12 +167,7 @@ fn between_centres_each_block_is_a_one_faced_lookup_of_its_side() {
         let (up_i, up_o) = (u() < 0.5, u() < 0.5);
         let (pi, po) = (TAU * u(), TAU * u());
         let (wi, wo) = (dir(ti, pi), dir(to, po));
-        let flip = |mut w: [f64; 3], up: bool| {
-            if !up {
-                w[2] = -w[2];
-            }
-            w
-        };
+        let flip = |w: [f64; 3], up: bool| [w[0], w[1], if up { w[2] } else { -w[2] }];
         let k = match (up_i, up_o) {
             (true, true) => 0,
             (true, false) => 1,
