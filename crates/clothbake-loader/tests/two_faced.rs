@@ -162,6 +162,7 @@ fn between_centres_each_block_is_a_one_faced_lookup_of_its_side() {
         .collect();
     let mut rng = Rng(12345);
     let mut u = || rng.next();
+    let mut errs = Vec::new();
     for _ in 0..4000 {
         let (ti, to) = (FRAC_PI_2 * 0.999 * u(), FRAC_PI_2 * 0.999 * u());
         let (up_i, up_o) = (u() < 0.5, u() < 0.5);
@@ -182,7 +183,19 @@ fn between_centres_each_block_is_a_one_faced_lookup_of_its_side() {
                 "block {k} at {wi:?} {wo:?}: {got:?} vs {want:?}"
             );
         }
+        if ti > 0.2 && ti < 1.3 && to > 0.2 && to < 1.3 {
+            let exact = f(flip(wi, up_i), flip(wo, up_o), 1);
+            let e = (f64::from(got[1]) - exact).abs() / exact;
+            errs.push(e);
+        }
     }
+    // And against the function itself (pairs away from the normal and the plane): the
+    // interpolation error of a glossy lobe on 15-degree polar and 30-36-degree azimuth cells,
+    // 4.4% in the mean and 36% at worst here; a block looked up on the wrong side (levels 0.1
+    // to 0.4) would be off by 100-300% on average.
+    let mean = errs.iter().sum::<f64>() / errs.len() as f64;
+    let worst = errs.iter().fold(0.0f64, |a, &e| a.max(e));
+    assert!(mean < 0.08 && worst < 0.5, "mean {mean}, worst {worst}");
 }
 
 #[test]
