@@ -329,6 +329,16 @@ impl Settings {
                 n.word("faces", "two")
             ));
         }
+        if let Some(k) = self
+            .paths
+            .filter(|&k| k == 0 || k > crate::sweep::MAX_PATHS)
+        {
+            return Err(format!(
+                "{} is out of range; give a whole number from 1 to {} (2^24)",
+                n.number("paths", &k.to_string()),
+                crate::sweep::MAX_PATHS
+            ));
+        }
         if let Some(k) = self.samples.filter(|&k| k == 0 || k > MAX_SAMPLES) {
             return Err(format!(
                 "{} is out of range; give a whole number from 1 to {MAX_SAMPLES} (2^24)",
@@ -350,15 +360,14 @@ impl Settings {
         if self.faces == Faces::Two {
             let cells = 4 * grid.len() as u128;
             if cells > u128::from(clothbake_loader::MAX_CELLS) {
-                let g = grid;
                 return Err(format!(
                     "{} {},{},{},{} with {} holds its cells on each side of the cloth: {cells} \
                      cells is more than the limit of 2^31; give a coarser {}",
                     f("res"),
-                    g.n_theta_i,
-                    g.n_phi_i,
-                    g.n_theta_o,
-                    g.n_phi_o,
+                    grid.n_theta_i,
+                    grid.n_phi_i,
+                    grid.n_theta_o,
+                    grid.n_phi_o,
                     n.word("faces", "two"),
                     f("res")
                 ));

@@ -466,6 +466,17 @@ fn per_cell(f: impl Fn(usize, UnitVec3, UnitVec3, &mut Row) + Sync + Send + 'sta
     })
 }
 
+/// The evaluator of a row's cells by `bsdf`'s [`Bsdf::f_batch`] (the row's wi with each cell's
+/// wo), a group of cells at a time.
+fn batched(bsdf: Arc<dyn Bsdf + Send + Sync>) -> CellFn {
+    Box::new(move |wi, cells, out| {
+        let pairs: Vec<_> = cells.iter().map(|&(_, wo)| (wi, wo)).collect();
+        let mut f = vec![[0.0; 3]; pairs.len()];
+        bsdf.f_batch(&pairs, &mut f);
+        out.extend(f.iter().map(|f| f.map(|x| x as f32)));
+    })
+}
+
 /// A prepared bake: the cell evaluator, the orbits and the metadata of the table it makes.
 /// Rows are evaluated independently ([`Baker::eval_row`]), by one process ([`bake`]) or by
 /// several (shards, `clothbake merge`), with the same values.
@@ -504,15 +515,7 @@ impl Baker {
             _ => None,
         };
         let eval: CellFn = match (opts.method, multiple.clone()) {
-            _ if two_faced.is_some() => {
-                let tf = two_faced.clone().expect("matched");
-                Box::new(move |wi, cells, out| {
-                    let pairs: Vec<_> = cells.iter().map(|&(_, wo)| (wi, wo)).collect();
-                    let mut f = vec![[0.0; 3]; pairs.len()];
-                    tf.f_batch(&pairs, &mut f);
-                    out.extend(f.iter().map(|f| f.map(|x| x as f32)));
-                })
-            }
+            _ if two_faced.is_some() => batched(two_faced.clone().expect("matched")),
             (Method::Analytic { variant }, None) if opts.spatial => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
                 let layout = crate::spatial::layout(&m, &g, secondary.is_some())
@@ -553,14 +556,8 @@ impl Baker {
             }
             (Method::Analytic { variant }, None) => {
                 let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
-                let bsdf = AnalyticBsdf::new(m, secondary);
                 // One bounce: four pairs at a time (AnalyticBsdf::f_batch), the same bits.
-                Box::new(move |wi, cells, out| {
-                    let pairs: Vec<_> = cells.iter().map(|&(_, wo)| (wi, wo)).collect();
-                    let mut f = vec![[0.0; 3]; pairs.len()];
-                    bsdf.f_batch(&pairs, &mut f);
-                    out.extend(f.iter().map(|f| f.map(|x| x as f32)));
-                })
+                batched(Arc::new(AnalyticBsdf::new(m, secondary)))
             }
             (
                 Method::Raytrace {

@@ -156,6 +156,12 @@ impl TableError {
         }
     }
 
+    /// Whether this is a one-faced lookup's refusal of a two-faced table ([`crate::Brdf::open`]:
+    /// open it with [`crate::TwoFacedBrdf`] instead).
+    pub fn is_two_faced_table(&self) -> bool {
+        matches!(self, TableError::WrongKind { found, .. } if found.starts_with(crate::TWO_FACED))
+    }
+
     /// Attaches `path` to an [`TableError::InvalidTable`] error found while reading.
     pub(crate) fn in_file(self, path: &Path) -> TableError {
         match self {

@@ -66,17 +66,14 @@ pub enum Lookup {
 }
 
 impl Lookup {
-    /// Opens a table file of either kind (either format).
+    /// Opens a table file of either kind (either format), reading it once.
     pub fn open(path: &std::path::Path, options: Options) -> Result<Lookup, TableError> {
-        // The kind is in the header; a two-faced table is read again, which costs a fraction
-        // of building its four blocks.
-        match Brdf::open(path, options) {
-            Ok(b) => Ok(Lookup::One(Box::new(b))),
-            Err(TableError::WrongKind { found, .. }) if found.starts_with(TWO_FACED) => {
-                Ok(Lookup::Two(Box::new(TwoFacedBrdf::open(path, options)?)))
-            }
-            Err(e) => Err(e),
-        }
+        Ok(match Brdf::open_either(path, options)? {
+            lookup::Opened::One(b) => Lookup::One(b),
+            lookup::Opened::Two(stored) => Lookup::Two(Box::new(
+                TwoFacedBrdf::from_checked(*stored, options).map_err(|e| e.in_file(path))?,
+            )),
+        })
     }
 
     /// The lookup as a [`Bsdf`] (f over the sphere, sampling, the openness).

@@ -119,6 +119,14 @@ impl fmt::Display for LengthMismatch {
 
 impl std::error::Error for LengthMismatch {}
 
+/// What [`Brdf::open_either`] found in a table file.
+pub(crate) enum Opened {
+    /// A one-faced table's lookup (boxed, as `crate::Lookup` holds it).
+    One(Box<Brdf>),
+    /// A two-faced table, as stored and checked (boxed: its metadata is large).
+    Two(Box<StoredTable>),
+}
+
 /// A baked table ready for render-time lookups and importance sampling.
 #[derive(Clone, Debug)]
 pub struct Brdf {
@@ -157,23 +165,12 @@ fn unit(w: [f32; 3]) -> Option<clothbake_bsdf::UnitVec3> {
 impl Brdf {
     /// Loads a table file (either format, see [`crate::read_table_stored`]). An averaged
     /// half-float OpenEXR table opened as stored goes from the file's lines straight into the
-    /// lookup's nodes (the same nodes, with the same checks).
+    /// lookup's nodes (the same nodes, with the same checks). A two-faced table is refused,
+    /// naming [`crate::TwoFacedBrdf`].
     pub fn open(path: &Path, options: Options) -> Result<Brdf, TableError> {
-        let corrupted = |e| match e {
-            TableError::InvalidTable { reason } => TableError::Corrupted {
-                path: path.to_path_buf(),
-                reason,
-            },
-            other => other,
-        };
-        if options.memory == Memory::AsStored && crate::read::is_exr(path)? {
-            if let Some((meta, nodes)) = crate::exr::read_half_nodes(path)? {
-                return Ok(Brdf::assemble(meta, nodes, None, options));
-            }
-        }
-        let stored = crate::read::read_table_stored(path)?;
-        if stored.meta.grid.faces == crate::Faces::Two {
-            return Err(TableError::WrongKind {
+        match Brdf::open_either(path, options)? {
+            Opened::One(b) => Ok(*b),
+            Opened::Two(_) => Err(TableError::WrongKind {
                 path: path.to_path_buf(),
                 found: format!(
                     "{} (reflection and transmission over the sphere)",
@@ -182,9 +179,28 @@ impl Brdf {
                 expected: "one-faced table".into(),
                 fix: "open it with clothbake_loader::TwoFacedBrdf (or clothbake_loader::Lookup, \
                       which opens either kind)",
-            });
+            }),
         }
-        Brdf::from_stored(stored, options).map_err(corrupted)
+    }
+
+    /// A table file of either kind, read and checked once: a one-faced table as its lookup
+    /// ([`Brdf::open`]'s paths), a two-faced one as stored (for [`crate::TwoFacedBrdf`]).
+    pub(crate) fn open_either(path: &Path, options: Options) -> Result<Opened, TableError> {
+        if options.memory == Memory::AsStored && crate::read::is_exr(path)? {
+            if let Some((meta, nodes)) = crate::exr::read_half_nodes(path)? {
+                return Ok(Opened::One(Box::new(Brdf::assemble(
+                    meta, nodes, None, options,
+                ))));
+            }
+        }
+        // The readers check the table (StoredTable::new's rules).
+        let stored = crate::read::read_table_stored(path)?;
+        if stored.meta.grid.faces == crate::Faces::Two {
+            return Ok(Opened::Two(Box::new(stored)));
+        }
+        Brdf::from_checked(stored, options)
+            .map(|b| Opened::One(Box::new(b)))
+            .map_err(|e| e.in_file(path))
     }
 
     /// A lookup of an `f32` table in memory.
@@ -194,7 +210,13 @@ impl Brdf {
 
     /// A lookup of a table in memory, after checking it (see [`StoredTable::new`]).
     pub fn from_stored(table: StoredTable, options: Options) -> Result<Brdf, TableError> {
-        let StoredTable { meta, mut samples } = StoredTable::new(table.meta, table.samples)?;
+        Brdf::from_checked(StoredTable::new(table.meta, table.samples)?, options)
+    }
+
+    /// A lookup of a table that [`StoredTable::new`]'s rules have already passed (a reader's,
+    /// or a two-faced table's block), without checking its values again.
+    pub(crate) fn from_checked(table: StoredTable, options: Options) -> Result<Brdf, TableError> {
+        let StoredTable { meta, mut samples } = table;
         let g = meta.grid;
         if g.faces == crate::Faces::Two {
             return Err(TableError::InvalidTable {

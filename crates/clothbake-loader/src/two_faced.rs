@@ -83,6 +83,7 @@ pub struct TwoFacedBrdf {
 impl TwoFacedBrdf {
     /// Opens a two-faced table file (either format); a one-faced table is refused.
     pub fn open(path: &Path, options: Options) -> Result<TwoFacedBrdf, TableError> {
+        // The readers check the table (StoredTable::new's rules).
         let stored = crate::read::read_table_stored(path)?;
         if stored.meta.grid.faces != Faces::Two {
             return Err(TableError::WrongKind {
@@ -92,7 +93,7 @@ impl TwoFacedBrdf {
                 fix: "open it as a one-faced table (clothbake_loader::Brdf::open)",
             });
         }
-        TwoFacedBrdf::from_stored(stored, options).map_err(|e| e.in_file(path))
+        TwoFacedBrdf::from_checked(stored, options).map_err(|e| e.in_file(path))
     }
 
     /// A lookup of an `f32` two-faced table in memory.
@@ -104,7 +105,16 @@ impl TwoFacedBrdf {
     /// [`Options::reciprocal`] symmetrises over the sphere, `0.5 (f(wi, wo) + f(wo, wi))`
     /// (which pairs a transmission block with the other); `point_level` has no use here.
     pub fn from_stored(table: StoredTable, options: Options) -> Result<TwoFacedBrdf, TableError> {
-        let StoredTable { meta, samples } = StoredTable::new(table.meta, table.samples)?;
+        TwoFacedBrdf::from_checked(StoredTable::new(table.meta, table.samples)?, options)
+    }
+
+    /// [`TwoFacedBrdf::from_stored`] of a table [`StoredTable::new`]'s rules have already
+    /// passed (a reader's): its values and its blocks' are not checked again.
+    pub(crate) fn from_checked(
+        table: StoredTable,
+        options: Options,
+    ) -> Result<TwoFacedBrdf, TableError> {
+        let StoredTable { meta, samples } = table;
         let g = meta.grid;
         if g.faces != Faces::Two {
             return Err(TableError::InvalidTable {
@@ -139,7 +149,7 @@ impl TwoFacedBrdf {
         });
         let mut blocks = Vec::with_capacity(4);
         for b in 0..4 {
-            blocks.push(Brdf::from_stored(
+            blocks.push(Brdf::from_checked(
                 StoredTable {
                     meta: block_meta.clone(),
                     samples: block_samples(&g, &samples, b),

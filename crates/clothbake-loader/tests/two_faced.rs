@@ -55,8 +55,9 @@ fn open_at(wi: [f64; 3]) -> f64 {
     level * c * c * (1.0 + 0.1 * wi[0])
 }
 
-fn table() -> Table {
-    let g = SIDE.two_faced();
+/// The values of `g`'s cells, in cell order: `value(wi, wo, channel)` at each cell's centre
+/// directions.
+fn tabulate(g: Grid, value: impl Fn([f64; 3], [f64; 3], usize) -> f64) -> Vec<f32> {
     let mut values = Vec::with_capacity(3 * g.len());
     for ti in 0..g.n_theta_i {
         for pi in 0..g.n_phi_i {
@@ -64,11 +65,17 @@ fn table() -> Table {
             for to in 0..g.n_theta_o {
                 for po in 0..g.n_phi_o {
                     let wo = dir(g.theta_o_deg(to).to_radians(), g.phi_o_deg(po).to_radians());
-                    values.extend((0..3).map(|k| f(wi, wo, k) as f32));
+                    values.extend((0..3).map(|k| value(wi, wo, k) as f32));
                 }
             }
         }
     }
+    values
+}
+
+fn table() -> Table {
+    let g = SIDE.two_faced();
+    let values = tabulate(g, f);
     let mut meta = Metadata::new("test", g, "{}", "{}", "none");
     meta.openness = Some(
         (0..g.n_theta_i)
@@ -139,18 +146,7 @@ fn block_table(b: usize) -> Table {
     // A new array, not a `mut` parameter changed in place (issue 36's note: a debug build
     // miscomputed the in-place form).
     let side = |w: [f64; 3], up: bool| [w[0], w[1], if up { w[2] } else { -w[2] }];
-    let mut values = Vec::with_capacity(3 * g.len());
-    for ti in 0..g.n_theta_i {
-        for pi in 0..g.n_phi_i {
-            let wi = dir(g.theta_i_deg(ti).to_radians(), g.phi_i_deg(pi).to_radians());
-            for to in 0..g.n_theta_o {
-                for po in 0..g.n_phi_o {
-                    let wo = dir(g.theta_o_deg(to).to_radians(), g.phi_o_deg(po).to_radians());
-                    values.extend((0..3).map(|k| f(side(wi, up_i), side(wo, up_o), k) as f32));
-                }
-            }
-        }
-    }
+    let values = tabulate(g, |wi, wo, k| f(side(wi, up_i), side(wo, up_o), k));
     Table::new(Metadata::new("test", g, "{}", "{}", "none"), values).unwrap()
 }
 

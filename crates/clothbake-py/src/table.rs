@@ -144,13 +144,11 @@ impl PyTable {
             })
         })
         .map_err(|e| match e {
-            TableError::WrongKind { found, .. } if found.starts_with("two-faced") => {
-                PyValueError::new_err(format!(
-                    "{}: a two-faced table (reflection and transmission over the sphere); open \
+            e if e.is_two_faced_table() => PyValueError::new_err(format!(
+                "{}: a two-faced table (reflection and transmission over the sphere); open \
                      it with clothbake.TwoFaced.open (in Mitsuba: faces=\"two\")",
-                    path.display()
-                ))
-            }
+                path.display()
+            )),
             other => table_err(other),
         })
     }

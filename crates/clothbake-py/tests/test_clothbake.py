@@ -574,3 +574,5 @@ def test_a_two_faced_table_holds_its_cloth_over_the_sphere(tmp_path):
         clothbake.TwoFaced.open(str(one))
     with pytest.raises(ValueError, match="faces"):
         clothbake.bake(fab, res=(2, 4, 2, 4), faces="three")
+    with pytest.raises(ValueError, match="paths=0 is out of range"):
+        clothbake.bake(fab, res=(2, 4, 2, 4), faces="two", paths=0)
