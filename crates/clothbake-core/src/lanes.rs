@@ -369,7 +369,11 @@ mod avx {
         /// `f64::clamp` per lane (NaN stays NaN).
         #[inline(always)]
         pub fn clamp(self, lo: f64, hi: f64) -> F64x4 {
-            let (lo, hi) = (F64x4::splat(lo), F64x4::splat(hi));
+            self.clamp_to(F64x4::splat(lo), F64x4::splat(hi))
+        }
+        /// `f64::clamp` per lane with bounds per lane (NaN stays NaN).
+        #[inline(always)]
+        pub fn clamp_to(self, lo: F64x4, hi: F64x4) -> F64x4 {
             self.lt(lo).select(lo, self.gt(hi).select(hi, self))
         }
     }

@@ -141,11 +141,25 @@ const PI_LO: f64 = f64::from_bits(0x3CA1_A626_3314_5C07);
 /// atan(t) for |t| <= 0.4375 (FDLIBM's kernel, no reduction).
 #[inline(always)]
 fn atan_kernel<L: Lane>(t: L) -> L {
-    let c = |k: usize| L::splat(AT[k]);
+    // Not a closure for the coefficients: a closure is compiled without the AVX2 of the lanes'
+    // callers, and its splats would be calls.
+    let c = [
+        L::splat(AT[0]),
+        L::splat(AT[1]),
+        L::splat(AT[2]),
+        L::splat(AT[3]),
+        L::splat(AT[4]),
+        L::splat(AT[5]),
+        L::splat(AT[6]),
+        L::splat(AT[7]),
+        L::splat(AT[8]),
+        L::splat(AT[9]),
+        L::splat(AT[10]),
+    ];
     let z = t * t;
     let w = z * z;
-    let s1 = z * (c(0) + w * (c(2) + w * (c(4) + w * (c(6) + w * (c(8) + w * c(10))))));
-    let s2 = w * (c(1) + w * (c(3) + w * (c(5) + w * (c(7) + w * c(9)))));
+    let s1 = z * (c[0] + w * (c[2] + w * (c[4] + w * (c[6] + w * (c[8] + w * c[10])))));
+    let s2 = w * (c[1] + w * (c[3] + w * (c[5] + w * (c[7] + w * c[9]))));
     t * (s1 + s2)
 }
 

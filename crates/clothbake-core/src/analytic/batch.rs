@@ -1,5 +1,7 @@
-//! The direct model (eq. 4.11) for four direction pairs at once, one pair a lane of an AVX
-//! register: [`AnalyticModel::intensity_batch`].
+//! The direct model (eq. 4.11) in the lanes of an AVX register: four direction pairs at once,
+//! one pair a lane ([`AnalyticModel::intensity_batch`]), or one pair with up to four of its
+//! units at once, one unit a lane ([`AnalyticModel::intensity`]; the units' terms summed
+//! afterwards in the units' order, as the scalar evaluation sums them).
 //!
 //! Each function in `avx2.rs` is the lane form of the scalar one in `analytic.rs`, `arc.rs` or
 //! `shadowing.rs` it names, with the same arithmetic in the same order: branches become
@@ -13,11 +15,10 @@
 //! integral, eq. 4.10), the `thesis` and `refined` variants, one bounce. Anything else (Lewis
 //! facets, an exponent the closed form does not take, the `sliced` variant) is evaluated pair by
 //! pair by
-//! [`AnalyticModel::intensity`].
+//! pair, unit by unit.
 
-use super::AnalyticModel;
+use super::{AnalyticModel, Unit, Variant};
 use crate::analytic::ClassTerms;
-#[cfg(target_arch = "x86_64")]
 use crate::facet::FacetModel;
 use crate::reflect::Reflection;
 use crate::vec3::UnitVec3;
@@ -25,15 +26,33 @@ use crate::vec3::UnitVec3;
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 
+#[cfg(target_arch = "x86_64")]
+pub(crate) use avx2::Lanes;
+
+/// Where the lanes are not built (not x86-64).
+#[cfg(not(target_arch = "x86_64"))]
+#[derive(Clone, Debug)]
+pub(crate) struct Lanes;
+
+/// The units in lanes, where the processor has AVX2 and the closed forms take every unit;
+/// `None` elsewhere (the model is then evaluated unit by unit).
+pub(super) fn lanes(facet: FacetModel, variant: Variant, units: &[Unit]) -> Option<Lanes> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        return Lanes::new(units, &whole_exponents(facet, variant, units)?);
+    }
+    let _ = (facet, variant, units);
+    None
+}
+
 /// The Huo exponent of every unit's material as the closed form takes it, `None` where one
 /// does not.
-#[cfg(target_arch = "x86_64")]
-fn whole_exponents(m: &AnalyticModel) -> Option<Vec<u32>> {
+fn whole_exponents(facet: FacetModel, variant: Variant, units: &[Unit]) -> Option<Vec<u32>> {
     // The sliced variant's units are evaluated slice by slice, pair by pair.
-    if m.facet != FacetModel::Huo || m.variant == super::Variant::Sliced {
+    if facet != FacetModel::Huo || variant == Variant::Sliced {
         return None;
     }
-    m.units
+    units
         .iter()
         .map(|u| {
             let mat = &u.seg.material;
@@ -60,12 +79,10 @@ impl AnalyticModel {
     pub fn intensity_batch(&self, pairs: &[(UnitVec3, UnitVec3)], out: &mut [Reflection]) {
         assert_eq!(pairs.len(), out.len(), "one output per pair");
         #[cfg(target_arch = "x86_64")]
-        if let Some(exps) = whole_exponents(self) {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: AVX2 was detected.
-                unsafe { avx2::run_avx2(self, &exps, pairs, out) };
-                return;
-            }
+        if let Some(lanes) = &self.lanes {
+            // SAFETY: the lanes are built only where AVX2 was detected.
+            unsafe { avx2::run_avx2(self, lanes, pairs, out) };
+            return;
         }
         for (o, &(wi, wo)) in out.iter_mut().zip(pairs) {
             *o = self.intensity(wi, wo);
@@ -89,15 +106,27 @@ impl AnalyticModel {
             return;
         }
         #[cfg(target_arch = "x86_64")]
-        if let Some(exps) = whole_exponents(self) {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: AVX2 was detected.
-                unsafe { avx2::run_classes_avx2(self, &exps, pairs, out) };
-                return;
-            }
+        if let Some(lanes) = &self.lanes {
+            // SAFETY: the lanes are built only where AVX2 was detected.
+            unsafe { avx2::run_classes_avx2(self, lanes, pairs, out) };
+            return;
         }
         for (o, &(wi, wo)) in out.chunks_mut(classes).zip(pairs) {
             self.class_terms(wi, wo, o);
         }
+    }
+
+    /// Eq. 4.11 without I_2 for one pair above the horizon, its units in the lanes of AVX2
+    /// registers (the bits of the unit-by-unit evaluation); `None` where the lanes do not
+    /// take this model.
+    #[inline]
+    pub(super) fn intensity_in_lanes(&self, wi: UnitVec3, wo: UnitVec3) -> Option<Reflection> {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(lanes) = &self.lanes {
+            // SAFETY: the lanes are built only where AVX2 was detected.
+            return Some(unsafe { avx2::one_avx2(self, lanes, wi, wo) });
+        }
+        let _ = (wi, wo);
+        None
     }
 }

@@ -1,12 +1,16 @@
 //! The lanes of [`super`]: every function the lane form of the scalar one it names, inlined
-//! into [`run_avx2`], the one function compiled for AVX2.
+//! into [`run_avx2`], [`run_classes_avx2`] and [`one_avx2`], the functions compiled for AVX2.
+//!
+//! A unit's constants are read from a [`UnitLanes`], lane by lane: one unit in every lane when
+//! the lanes hold four pairs, up to four units when they hold one pair's units. Either way each
+//! lane does the scalar arithmetic of its own pair and unit.
 
-use crate::analytic::{AnalyticModel, ClassTerms, SegmentData, Unit, Variant, EPS};
+use crate::analytic::{AnalyticModel, ClassTerms, Unit, Variant, EPS};
 use crate::lanes::{F64x4 as F, Mask4 as M};
 use crate::reflect::Reflection;
 use crate::shadowing::ActiveTable;
 use crate::trig::{atan2_x4, sin_cos_x4};
-use crate::vec3::UnitVec3;
+use crate::vec3::{UnitVec3, Vec3};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Lanes of an elevation (`shadowing::Elevation`).
@@ -28,6 +32,26 @@ impl Elevation {
             cos: run * inv,
         }
     }
+
+    /// Every lane the elevation in lane `k` of `el` (psi, sine and cosine lane by lane).
+    #[inline(always)]
+    fn lane(el: &[[f64; 4]; 3], k: usize) -> Elevation {
+        Elevation {
+            psi: F::splat(el[0][k]),
+            sin: F::splat(el[1][k]),
+            cos: F::splat(el[2][k]),
+        }
+    }
+
+    /// Per lane, `a` where `w` holds, else `b`.
+    #[inline(always)]
+    fn pick(w: M, a: &Elevation, b: &Elevation) -> Elevation {
+        Elevation {
+            psi: w.select(a.psi, b.psi),
+            sin: w.select(a.sin, b.sin),
+            cos: w.select(a.cos, b.cos),
+        }
+    }
 }
 
 /// Lanes of an occluder (`shadowing::Occluder`).
@@ -46,29 +70,142 @@ impl Occluder {
     }
 }
 
+/// An active table (`shadowing::ActiveTable`) of each lane's unit, entry by entry, each field
+/// lane by lane. A lane whose table is shorter is padded at the front with entries whose bound
+/// is +inf, which are never active; a lane whose table is empty has only such entries, with
+/// an occluder of zeros, and is not `some`.
+#[derive(Clone, Debug, Default)]
+pub(super) struct TableLanes {
+    /// 1 where the lane's table has an entry, else 0.
+    some: [f64; 4],
+    /// The entries' lower elevation bounds, decreasing, and their occluders.
+    lo: Vec<[f64; 4]>,
+    u: Vec<[f64; 4]>,
+    z: Vec<[f64; 4]>,
+    rho: Vec<[f64; 4]>,
+}
+
+impl TableLanes {
+    /// The tables of the lanes, one per lane.
+    fn new(tables: [&ActiveTable; 4]) -> TableLanes {
+        let n = tables.iter().map(|t| t.entries.len()).max().unwrap_or(0);
+        let mut t = TableLanes {
+            some: tables.map(|t| f64::from(u8::from(!t.entries.is_empty()))),
+            lo: vec![[f64::INFINITY; 4]; n],
+            u: vec![[0.0; 4]; n],
+            z: vec![[0.0; 4]; n],
+            rho: vec![[0.0; 4]; n],
+        };
+        for (lane, table) in tables.iter().enumerate() {
+            let pad = n - table.entries.len();
+            for (k, (lo, o)) in table.entries.iter().enumerate() {
+                t.lo[pad + k][lane] = *lo;
+                t.u[pad + k][lane] = o.u;
+                t.z[pad + k][lane] = o.z;
+                t.rho[pad + k][lane] = o.rho;
+            }
+        }
+        t
+    }
+}
+
 /// `ActiveTable::active` per lane: which lanes have an occluder, and each lane's. The entries'
 /// bounds decrease, so the active entry is the first whose bound is at most psi (the last
 /// where none is).
 #[inline(always)]
-fn active(t: &ActiveTable, psi: F) -> (M, Occluder) {
-    let Some(((_, last), rest)) = t.entries.split_last() else {
+fn active(t: &TableLanes, psi: F) -> (M, Occluder) {
+    let Some(last) = t.lo.len().checked_sub(1) else {
         let z = F::splat(0.0);
         return (M::splat(false), Occluder { u: z, z, rho: z });
     };
     let mut o = Occluder {
-        u: F::splat(last.u),
-        z: F::splat(last.z),
-        rho: F::splat(last.rho),
+        u: F::from_array(t.u[last]),
+        z: F::from_array(t.z[last]),
+        rho: F::from_array(t.rho[last]),
     };
-    for (lo, e) in rest.iter().rev() {
-        let here = F::splat(*lo).le(psi);
+    for k in (0..last).rev() {
+        let here = F::from_array(t.lo[k]).le(psi);
         o = Occluder {
-            u: here.select(F::splat(e.u), o.u),
-            z: here.select(F::splat(e.z), o.z),
-            rho: here.select(F::splat(e.rho), o.rho),
+            u: here.select(F::from_array(t.u[k]), o.u),
+            z: here.select(F::from_array(t.z[k]), o.z),
+            rho: here.select(F::from_array(t.rho[k]), o.rho),
         };
     }
-    (M::splat(true), o)
+    (F::from_array(t.some).gt(F::splat(0.0)), o)
+}
+
+/// A unit's constants in each lane: one unit in all four lanes, or up to four units (the lanes
+/// past the last unit repeat it; their results are dropped). Lanes of one `UnitLanes` agree in
+/// what changes the code path: whether the units are endless, whether they have a specular
+/// lobe, and its whole exponent.
+#[derive(Clone, Debug)]
+pub(super) struct UnitLanes {
+    radius: [f64; 4],
+    height: [f64; 4],
+    top: [f64; 4],
+    /// The arc above the floor: lo, hi, and the sines and cosines of its ends.
+    floor: [[f64; 4]; 6],
+    /// The piece's range along the axis.
+    range: [[f64; 4]; 2],
+    /// The segment's extent along the axis; `None` for endless segments.
+    extent: Option<[[f64; 4]; 2]>,
+    /// rho_s; `None` where every lane's is 0.
+    specular: Option<[f64; 4]>,
+    /// The whole exponent of the Huo facets' closed form.
+    exponent: u32,
+    /// 1 where the lane's unit is a weft's, 0 for a warp's.
+    weft: [f64; 4],
+    side_plus: TableLanes,
+    side_minus: TableLanes,
+    end_plus: TableLanes,
+    end_minus: TableLanes,
+}
+
+impl UnitLanes {
+    /// The lanes of `units` (one to four), the lanes past the last repeating it; `exponent`
+    /// their common whole exponent. `None` where they differ in what changes the code path.
+    pub(super) fn new(units: &[&Unit], exponent: u32) -> Option<UnitLanes> {
+        let first = units.first()?;
+        if units.len() > 4
+            || units.iter().any(|u| {
+                u.seg.extent.is_some() != first.seg.extent.is_some()
+                    || (u.seg.material.specular == 0.0) != (first.seg.material.specular == 0.0)
+            })
+        {
+            return None;
+        }
+        let u: [&Unit; 4] = std::array::from_fn(|k| units[k.min(units.len() - 1)]);
+        let lanes = |f: &dyn Fn(&Unit) -> f64| u.map(f);
+        let extent = |end: usize| {
+            lanes(&|u| {
+                let (y0, y1) = u.seg.extent.unwrap_or((0.0, 0.0));
+                [y0, y1][end]
+            })
+        };
+        Some(UnitLanes {
+            radius: lanes(&|u| u.seg.radius),
+            height: lanes(&|u| u.seg.height),
+            top: lanes(&|u| u.seg.top),
+            floor: [
+                lanes(&|u| u.seg.floor.arc.lo),
+                lanes(&|u| u.seg.floor.arc.hi),
+                lanes(&|u| u.seg.floor.lo.0),
+                lanes(&|u| u.seg.floor.lo.1),
+                lanes(&|u| u.seg.floor.hi.0),
+                lanes(&|u| u.seg.floor.hi.1),
+            ],
+            range: [lanes(&|u| u.range.0), lanes(&|u| u.range.1)],
+            extent: first.seg.extent.map(|_| [extent(0), extent(1)]),
+            specular: (first.seg.material.specular != 0.0)
+                .then(|| lanes(&|u| u.seg.material.specular)),
+            exponent,
+            weft: lanes(&|u| f64::from(u8::from(u.seg.group == crate::weave::Group::Weft))),
+            side_plus: TableLanes::new(u.map(|u| &u.side_plus)),
+            side_minus: TableLanes::new(u.map(|u| &u.side_minus)),
+            end_plus: TableLanes::new(u.map(|u| &u.seg.end_plus)),
+            end_minus: TableLanes::new(u.map(|u| &u.seg.end_minus)),
+        })
+    }
 }
 
 /// Per lane, `a`'s occluder where `which` holds, else `b`'s.
@@ -138,6 +275,22 @@ impl View {
     }
 }
 
+impl View {
+    /// The view of `v` from a weft's unit where `weft` holds, else from a warp's, given its
+    /// elevations over |x| and over |y| (`View::both`, per lane the lane's group's).
+    #[inline(always)]
+    fn of_units(weft: M, v: Vec3, over_x: Elevation, over_y: Elevation) -> View {
+        let (x, y) = (F::splat(v.x), F::splat(v.y));
+        View::new(
+            weft.select(y, x),
+            weft.select(x, y),
+            F::splat(v.z),
+            Elevation::pick(weft, &over_y, &over_x),
+            Elevation::pick(weft, &over_x, &over_y),
+        )
+    }
+}
+
 /// Lanes of a unit half vector's projection (`arc::Heading`).
 #[derive(Clone, Copy)]
 struct Heading {
@@ -169,6 +322,29 @@ struct Views {
 }
 
 impl Views {
+    /// The views of one pair (`l`, `e`) for units of either group, lane by lane: a weft's
+    /// where `weft` holds, else a warp's (per lane `Views::both`'s of the lane's group). The
+    /// pair's four elevations are one `atan2` of four lanes.
+    #[inline(always)]
+    fn of_units(weft: M, l: Vec3, e: Vec3) -> Views {
+        let el = Elevation::of(
+            F::from_array([l.z, l.z, e.z, e.z]),
+            F::from_array([l.x.abs(), l.y.abs(), e.x.abs(), e.y.abs()]),
+        );
+        let el = [el.psi.to_array(), el.sin.to_array(), el.cos.to_array()];
+        let (hx, hy, hz) = (
+            F::splat(l.x + e.x),
+            F::splat(l.y + e.y),
+            F::splat(l.z + e.z),
+        );
+        let inv = 1.0 / (hx * hx + hy * hy + hz * hz).sqrt();
+        Views {
+            l: View::of_units(weft, l, Elevation::lane(&el, 0), Elevation::lane(&el, 1)),
+            e: View::of_units(weft, e, Elevation::lane(&el, 2), Elevation::lane(&el, 3)),
+            h: Heading::new(weft.select(hy, hx) * inv, hz * inv),
+        }
+    }
+
     /// `Views::both`.
     #[inline(always)]
     fn both(l: [F; 3], e: [F; 3]) -> [Views; 2] {
@@ -238,14 +414,14 @@ impl Arc {
         self.lo.ge(self.hi)
     }
 
-    /// Every lane the scalar arc `a`.
+    /// The arcs of `UnitLanes::floor`.
     #[inline(always)]
-    fn splat(a: &crate::arc::ArcTrig) -> Arc {
+    fn load(a: &[[f64; 4]; 6]) -> Arc {
         Arc {
-            lo: F::splat(a.arc.lo),
-            hi: F::splat(a.arc.hi),
-            lo_sc: (F::splat(a.lo.0), F::splat(a.lo.1)),
-            hi_sc: (F::splat(a.hi.0), F::splat(a.hi.1)),
+            lo: F::from_array(a[0]),
+            hi: F::from_array(a[1]),
+            lo_sc: (F::from_array(a[2]), F::from_array(a[3])),
+            hi_sc: (F::from_array(a[4]), F::from_array(a[5])),
         }
     }
 }
@@ -265,7 +441,7 @@ fn overlap(a: (F, F), b: (F, F)) -> F {
 
 /// `shadowing::occluded_length` (eq. 3.6).
 #[inline(always)]
-fn occluded_length(top: f64, o: &Occluder, psi: &Elevation) -> F {
+fn occluded_length(top: F, o: &Occluder, psi: &Elevation) -> F {
     let num = o.support(psi.sin, psi.cos) - top * psi.cos;
     let zero = F::splat(0.0);
     num.le(zero).select(
@@ -285,32 +461,58 @@ struct Cut {
     c: F,
 }
 
+// The helpers below are functions, not closures: a closure is compiled without its enclosing
+// function's AVX2 (its lane operations would be calls).
+
+/// The point `(s, c)` (sine and cosine) turned back by the angle whose are `(s0, c0)`.
+#[inline(always)]
+fn from_lo((s, c): (F, F), s0: F, c0: F) -> (F, F) {
+    (s * c0 - c * s0, c * c0 + s * s0)
+}
+
+/// The primitive of w = e.c cos + e.z sin at the point (`mean_occluded_length`).
+#[inline(always)]
+fn weight((s, c): (F, F), e: (F, F)) -> F {
+    e.0 * s - e.1 * c
+}
+
+/// The primitive of sin w at the point, of angle `t` (`mean_occluded_length`).
+#[inline(always)]
+fn sin_weight((s, c): (F, F), t: F, e: (F, F)) -> F {
+    e.0 * 0.5 * s * s + e.1 * 0.5 * (t - s * c)
+}
+
+/// Lanes where a length `l` is clear of 0 and of `max_len` by more than `tol`.
+#[inline(always)]
+fn clear(l: F, tol: F, max_len: F) -> M {
+    (l.abs().gt(tol)) & ((l - max_len).abs().gt(tol))
+}
+
 /// `shadowing::mean_occluded_length` (eq. 3.6 averaged over the arc, the refined variant) for
-/// segment `seg` of length `max_len`. Its fallback's height is `seg.top`, the
+/// the segments of `u`, of lengths `max_len`. Its fallback's height is `u.top`, the
 /// `equal_area_height(r, h)` the scalar function computes.
 #[inline(always)]
 fn mean_occluded_length(
-    seg: &SegmentData,
+    u: &UnitLanes,
     o: &Occluder,
     psi: &Elevation,
     arc: &Arc,
     e: (F, F),
-    max_len: f64,
+    max_len: F,
 ) -> F {
-    let (r, h) = (seg.radius, seg.height);
+    let (r, h) = (F::from_array(u.radius), F::from_array(u.height));
     let zero = F::splat(0.0);
     let inf = F::splat(f64::INFINITY);
     let (sp, cp) = (psi.sin, psi.cos);
     let fallback = arc.empty() | sp.le(zero);
-    let short = occluded_length(seg.top, o, psi).min(F::splat(max_len));
+    let short = occluded_length(F::from_array(u.top), o, psi).min(max_len);
     let num0 = o.support(sp, cp) - h * cp;
     let rc = r * cp;
     let inv_sp = 1.0 / sp;
     let inv_rc = 1.0 / rc;
     let (a, b) = (num0 * inv_sp, rc * inv_sp);
     let (s0, c0) = arc.lo_sc;
-    let from_lo = |(s, c): (F, F)| (s * c0 - c * s0, c * c0 + s * s0);
-    let cos_len = from_lo(arc.hi_sc).1;
+    let cos_len = from_lo(arc.hi_sc, s0, c0).1;
     // The four break points in the scalar's order, each with its validity.
     let b_pos = b.gt(zero);
     let one = F::splat(1.0);
@@ -327,7 +529,7 @@ fn mean_occluded_length(
         let x = ok.select(x, zero);
         let c = ((1.0 - x) * (1.0 + x)).sqrt();
         for (i, point) in [(x, c), (x, -c)].into_iter().enumerate() {
-            let (sf, cf) = from_lo(point);
+            let (sf, cf) = from_lo(point, s0, c0);
             let v = ok & sf.gt(zero) & cf.gt(cos_len);
             cand[2 * j + i] = Cut {
                 key: v.select(-cf, inf),
@@ -381,16 +583,16 @@ fn mean_occluded_length(
     // angle from its offset, computed where a window needs it.
     let mut theta = [arc.lo, zero, zero, zero, zero, arc.hi];
     let mut have = [true, false, false, false, false, true];
-    let sc = |k: usize| match k {
-        0 => (s0, c0),
-        5 => arc.hi_sc,
-        _ => (sorted[k - 1].s, sorted[k - 1].c),
-    };
-    let pw = |(s, c): (F, F)| e.0 * s - e.1 * c;
-    let psw = |(s, c): (F, F), t: F| e.0 * 0.5 * s * s + e.1 * 0.5 * (t - s * c);
+    let sc = [
+        (s0, c0),
+        (sorted[0].s, sorted[0].c),
+        (sorted[1].s, sorted[1].c),
+        (sorted[2].s, sorted[2].c),
+        (sorted[3].s, sorted[3].c),
+        arc.hi_sc,
+    ];
     let tol = 1e-9 * (a.abs() + b.abs() + max_len);
-    let clear = |l: F| (l.abs().gt(tol)) & ((l - max_len).abs().gt(tol));
-    let max = F::splat(max_len);
+    let max = max_len;
     let (mut num, mut den) = (zero, zero);
     for k in 0..5 {
         // Window k runs from point k to point k + 1, or to the arc's end after the last valid
@@ -400,18 +602,18 @@ fn mean_occluded_length(
             break;
         }
         let next = if k < 4 { valid[k] } else { M::splat(false) };
-        let (p0, p1, pe) = (sc(k), sc(k + 1), arc.hi_sc);
+        let (p0, p1, pe) = (sc[k], sc[k + 1], arc.hi_sc);
         let q1 = (next.select(p1.0, pe.0), next.select(p1.1, pe.1));
         let l_end_at = a - b * q1.0;
-        let end_clear = !next & clear(l_end_at);
+        let end_clear = !next & clear(l_end_at, tol, max_len);
         let (known, l_known) = if k == 0 {
             let l0 = a - b * p0.0;
-            let c0 = clear(l0);
+            let c0 = clear(l0, tol, max_len);
             (c0 | end_clear, c0.select(l0, l_end_at))
         } else {
             (end_clear, l_end_at)
         };
-        let wsum = pw(q1) - pw(p0);
+        let wsum = weight(q1, e) - weight(p0, e);
         den = den + live.select(wsum, zero);
         // Where l is known to be 0 or the whole length, the window needs no angle.
         let flat = known & (l_known.le(zero) | l_known.ge(max));
@@ -420,7 +622,7 @@ fn mean_occluded_length(
         if (live & !flat).any() {
             for j in [k, k + 1] {
                 if !have[j] {
-                    let (sf, cf) = from_lo((sorted[j - 1].s, sorted[j - 1].c));
+                    let (sf, cf) = from_lo(sc[j], s0, c0);
                     theta[j] = arc.lo + atan2_x4(sf, cf);
                     have[j] = true;
                 }
@@ -428,21 +630,23 @@ fn mean_occluded_length(
             let t0 = theta[k];
             let t1 = next.select(theta[k + 1], arc.hi);
             l_mid = known.select(l_known, a - b * sin_cos_x4(0.5 * (t0 + t1)).0);
-            inner = a * wsum - b * (psw(q1, t1) - psw(p0, t0));
+            inner = a * wsum - b * (sin_weight(q1, t1, e) - sin_weight(p0, t0, e));
         }
         let term = l_mid
             .le(zero)
             .select(zero, l_mid.ge(max).select(max_len * wsum, inner));
         num = num + live.select(term, zero);
     }
-    let mean = den.le(zero).select(zero, (num / den).clamp(0.0, max_len));
+    let mean = den
+        .le(zero)
+        .select(zero, (num / den).clamp_to(zero, max_len));
     fallback.select(short, mean)
 }
 
 /// The lanes' arc of a unit's cross-section that faces `v`, less what the side neighbour
 /// hides (`AnalyticModel::side_arc`).
 #[inline(always)]
-fn side_arc(u: &Unit, v: &View) -> Arc {
+fn side_arc(u: &UnitLanes, v: &View) -> Arc {
     let mut arc = Arc::facing(v);
     let (some, o) = either(
         v.mirrored,
@@ -454,11 +658,11 @@ fn side_arc(u: &Unit, v: &View) -> Arc {
         return arc;
     }
     // `occluded_arc_at`: theta = psi + alpha, sin(alpha) = s / r1.
-    let (r1, h1) = (u.seg.radius, u.seg.height);
+    let (r1, h1) = (F::from_array(u.radius), F::from_array(u.height));
     let psi = &v.psi;
     let s = o.support(psi.sin, psi.cos) - h1 * psi.cos;
-    let all = s.ge(F::splat(r1));
-    let up_to = s.gt(F::splat(-r1)) & !all;
+    let all = s.ge(r1);
+    let up_to = s.gt(-r1) & !all;
     let sa = up_to.select(s / r1, F::splat(0.0));
     let ca = ((1.0 - sa) * (1.0 + sa)).sqrt();
     let t = psi.psi + atan2_x4(sa, ca);
@@ -489,27 +693,26 @@ fn side_arc(u: &Unit, v: &View) -> Arc {
 
 /// The lanes' interval along the axis the ends' occluders leave (`AnalyticModel::end_interval`).
 #[inline(always)]
-fn end_interval(m: &AnalyticModel, u: &Unit, v: &View, arc: &Arc, e: (F, F)) -> (F, F) {
-    let seg = &u.seg;
-    let Some((y0, y1)) = seg.extent else {
+fn end_interval(m: &AnalyticModel, u: &UnitLanes, v: &View, arc: &Arc, e: (F, F)) -> (F, F) {
+    let Some([y0, y1]) = u.extent else {
         return (F::splat(f64::NEG_INFINITY), F::splat(f64::INFINITY));
     };
+    let (y0, y1) = (F::from_array(y0), F::from_array(y1));
     let max_len = y1 - y0;
-    let (y0, y1) = (F::splat(y0), F::splat(y1));
     let plus = v.va.gt(F::splat(0.0));
     let psi = &v.end_psi;
     let (some, o) = either(
         plus,
-        active(&seg.end_plus, psi.psi),
-        active(&seg.end_minus, psi.psi),
+        active(&u.end_plus, psi.psi),
+        active(&u.end_minus, psi.psi),
     );
     let some = some & v.end;
     if !some.any() {
         return (y0, y1);
     }
     let hidden = match m.variant {
-        Variant::Thesis => occluded_length(seg.top, &o, psi),
-        Variant::Refined | Variant::Sliced => mean_occluded_length(seg, &o, psi, arc, e, max_len),
+        Variant::Thesis => occluded_length(F::from_array(u.top), &o, psi),
+        Variant::Refined | Variant::Sliced => mean_occluded_length(u, &o, psi, arc, e, max_len),
     };
     let hidden = some.select(hidden, F::splat(0.0));
     (plus.select(y0, y0 + hidden), plus.select(y1 - hidden, y1))
@@ -517,9 +720,8 @@ fn end_interval(m: &AnalyticModel, u: &Unit, v: &View, arc: &Arc, e: (F, F)) -> 
 
 /// `arc::projected_width` on a nonempty arc.
 #[inline(always)]
-fn projected_width(r: f64, arc: &Arc, e: (F, F)) -> F {
-    let f = |(s, c): (F, F)| e.0 * s - e.1 * c;
-    r * (f(arc.hi_sc) - f(arc.lo_sc))
+fn projected_width(r: F, arc: &Arc, e: (F, F)) -> F {
+    r * (weight(arc.hi_sc, e) - weight(arc.lo_sc, e))
 }
 
 /// `arc::diffuse_integral` on a nonempty arc.
@@ -547,13 +749,18 @@ fn powi(mut a: F, mut n: u32) -> F {
     }
 }
 
+/// The sine and cosine of u = theta - theta_H for a point `(sin theta, cos theta)`.
+#[inline(always)]
+fn from_heading((st, ct): (F, F), h: &Heading) -> [F; 2] {
+    [st * h.cos - ct * h.sin, ct * h.cos + st * h.sin]
+}
+
 /// `arc::huo_specular_integral` (eq. 4.10) on a nonempty arc, for a whole exponent `n`.
 #[inline(always)]
 fn huo_specular_integral(arc: &Arc, h: &Heading, e: &Heading, n: u32) -> F {
     let sd = h.sin * e.cos - h.cos * e.sin;
     let cd = h.cos * e.cos + h.sin * e.sin;
-    let su_cu = |(st, ct): (F, F)| [st * h.cos - ct * h.sin, ct * h.cos + st * h.sin];
-    let ([s0, c0], [s1, c1]) = (su_cu(arc.lo_sc), su_cu(arc.hi_sc));
+    let ([s0, c0], [s1, c1]) = (from_heading(arc.lo_sc, h), from_heading(arc.hi_sc, h));
     let m = n + 1;
     // `cos_power_integral(m, ...)`.
     let even = m.is_multiple_of(2);
@@ -579,8 +786,8 @@ fn huo_specular_integral(arc: &Arc, h: &Heading, e: &Heading, n: u32) -> F {
         k += 2;
     }
     let ([p0, p1], [q0, q1]) = (acc, power);
-    let prim = |p: F, q: F| cd * p + sd * q / (n as f64 + 1.0);
-    let v = prim(p1, q1) - prim(p0, q0);
+    let n1 = n as f64 + 1.0;
+    let v = (cd * p1 + sd * q1 / n1) - (cd * p0 + sd * q0 / n1);
     powi(h.norm, n) * e.norm * v
 }
 
@@ -599,13 +806,12 @@ struct Terms {
     lit: M,
 }
 
-/// Unit `u`'s terms for the views of its group, `n` its whole exponent: `None` where no lane
-/// sees it.
+/// The terms of the lanes' units `u` for the views of their groups: `None` where no lane sees
+/// its unit.
 #[inline(always)]
-fn unit_terms(m: &AnalyticModel, u: &Unit, v: &Views, n: u32) -> Option<Terms> {
+fn unit_terms(m: &AnalyticModel, u: &UnitLanes, v: &Views) -> Option<Terms> {
     let zero = F::splat(0.0);
-    let seg = &u.seg;
-    let floor = Arc::splat(&seg.floor);
+    let floor = Arc::load(&u.floor);
     let seen = side_arc(u, &v.e).meet(&floor);
     let lit = side_arc(u, &v.l).meet(&floor);
     // `visible_of`.
@@ -615,13 +821,13 @@ fn unit_terms(m: &AnalyticModel, u: &Unit, v: &Views, n: u32) -> Option<Terms> {
         return None;
     }
     let along = end_interval(m, u, &v.e, &seen, ep);
-    let range = (F::splat(u.range.0), F::splat(u.range.1));
+    let range = (F::from_array(u.range[0]), F::from_array(u.range[1]));
     let l_v = overlap(range, along);
     visible = visible & l_v.gt(zero);
     if !visible.any() {
         return None;
     }
-    let width = projected_width(seg.radius, &seen, ep);
+    let width = projected_width(F::from_array(u.radius), &seen, ep);
     let vi = seen.meet(&lit);
     let lit_len = end_interval(m, u, &v.l, &vi, ep);
     let l_vi = overlap(range, meet(along, lit_len));
@@ -638,29 +844,110 @@ fn unit_terms(m: &AnalyticModel, u: &Unit, v: &Views, n: u32) -> Option<Terms> {
     if lit.any() {
         // `arc_integral`.
         t.kd = diffuse_integral(&vi, (v.l.c, v.l.z), ep);
-        if seg.material.specular != 0.0 {
+        if let Some(specular) = u.specular {
             let e = Heading {
                 norm: v.e.norm,
                 cos: v.e.cos,
                 sin: v.e.sin,
             };
-            t.ks = seg.material.specular * huo_specular_integral(&vi, &v.h, &e, n);
+            t.ks = F::from_array(specular) * huo_specular_integral(&vi, &v.h, &e, u.exponent);
         }
     }
     Some(t)
 }
 
-/// Eq. 4.11 for four pairs (`AnalyticModel::intensity_with` without I_2), given each unit's
-/// whole exponent.
+/// The model's units in lanes: each alone in all four lanes (four pairs at a time) and in packs
+/// of up to four (one pair's units at a time).
+#[derive(Clone, Debug)]
+pub(crate) struct Lanes {
+    /// Unit `k` in every lane.
+    single: Vec<UnitLanes>,
+    /// Consecutive units in the lanes of one `UnitLanes`, with their indices; in the units'
+    /// order, so that summing the packs lane by lane sums the units in order.
+    packs: Vec<(UnitLanes, std::ops::Range<usize>)>,
+}
+
+impl Lanes {
+    /// The lanes of `units`, `exps` their whole exponents.
+    pub(super) fn new(units: &[Unit], exps: &[u32]) -> Option<Lanes> {
+        let single = units
+            .iter()
+            .zip(exps)
+            .map(|(u, &n)| UnitLanes::new(&[u], n))
+            .collect::<Option<Vec<_>>>()?;
+        let mut packs: Vec<(UnitLanes, std::ops::Range<usize>)> = Vec::new();
+        let mut start = 0;
+        while start < units.len() {
+            // The longest run from `start` that one pack holds.
+            let mut end = start + 1;
+            let mut pack = single[start].clone();
+            while end < units.len() && end - start < 4 && exps[end] == exps[start] {
+                let run: Vec<&Unit> = units[start..=end].iter().collect();
+                let Some(p) = UnitLanes::new(&run, exps[start]) else {
+                    break;
+                };
+                pack = p;
+                end += 1;
+            }
+            packs.push((pack, start..end));
+            start = end;
+        }
+        Some(Lanes { single, packs })
+    }
+}
+
+/// Eq. 4.11 for one pair (`AnalyticModel::intensity_with` without I_2), both above the horizon:
+/// the units in the lanes of their packs, their terms summed in the units' order as the scalar
+/// evaluation sums them.
 #[inline(always)]
-fn intensity4(m: &AnalyticModel, exps: &[u32], wi: [F; 3], wo: [F; 3]) -> [Reflection; 4] {
+fn intensity1(m: &AnalyticModel, lanes: &Lanes, wi: UnitVec3, wo: UnitVec3) -> Reflection {
+    let zero = F::splat(0.0);
+    let (l, e) = (wi.get(), wo.get());
+    let (mut s_total, mut i_d, mut i_s) = (0.0, [0.0; 3], 0.0);
+    for (pack, units) in &lanes.packs {
+        let weft = F::from_array(pack.weft).gt(zero);
+        let Some(t) = unit_terms(m, pack, &Views::of_units(weft, l, e)) else {
+            continue;
+        };
+        let (visible, lit) = (t.visible.to_array(), t.lit.to_array());
+        let (l_v, width, l_vi) = (t.l_v.to_array(), t.width.to_array(), t.l_vi.to_array());
+        let (kd, ks) = (t.kd.to_array(), t.ks.to_array());
+        for (k, u) in m.units[units.clone()].iter().enumerate() {
+            if !visible[k] {
+                continue;
+            }
+            let d = u.count as f64;
+            s_total += d * l_v[k] * width[k];
+            if !lit[k] {
+                continue;
+            }
+            let w = d * l_vi[k] * u.seg.radius;
+            for (acc, a) in i_d.iter_mut().zip(u.seg.material.albedo) {
+                *acc += w * kd[k] * a;
+            }
+            i_s += w * ks[k];
+        }
+    }
+    if s_total <= 0.0 {
+        return Reflection::default();
+    }
+    Reflection {
+        i_d: i_d.map(|x| x / s_total),
+        i_s: [i_s / s_total; 3],
+        secondary: None,
+    }
+}
+
+/// Eq. 4.11 for four pairs (`AnalyticModel::intensity_with` without I_2).
+#[inline(always)]
+fn intensity4(m: &AnalyticModel, lanes: &Lanes, wi: [F; 3], wo: [F; 3]) -> [Reflection; 4] {
     let zero = F::splat(0.0);
     let views = Views::both(wi, wo);
     let mut s_total = zero;
     let mut i_d = [zero; 3];
     let mut i_s = zero;
-    for (u, &n) in m.units.iter().zip(exps) {
-        let Some(t) = unit_terms(m, u, &views[u.seg.group as usize], n) else {
+    for (u, ul) in m.units.iter().zip(&lanes.single) {
+        let Some(t) = unit_terms(m, ul, &views[u.seg.group as usize]) else {
             continue;
         };
         let d = f64::from(u.count);
@@ -690,7 +977,7 @@ fn intensity4(m: &AnalyticModel, exps: &[u32], wi: [F; 3], wo: [F; 3]) -> [Refle
 /// Each class's terms for four pairs (`AnalyticModel::class_terms`), pair `k`'s into
 /// `out[k * classes..]` (zero where the class is not seen).
 #[inline(always)]
-fn class_terms4(m: &AnalyticModel, exps: &[u32], wi: [F; 3], wo: [F; 3], out: &mut [ClassTerms]) {
+fn class_terms4(m: &AnalyticModel, lanes: &Lanes, wi: [F; 3], wo: [F; 3], out: &mut [ClassTerms]) {
     let zero = F::splat(0.0);
     let classes = m.class_unit.len();
     let views = Views::both(wi, wo);
@@ -698,8 +985,8 @@ fn class_terms4(m: &AnalyticModel, exps: &[u32], wi: [F; 3], wo: [F; 3], out: &m
     // `direct_terms`: the visible share, and f_r = I / (pi cos theta_i) (`intensity_to_brdf`).
     let (area, cos_i) = (px * py * wo[2], PI * wi[2]);
     for (c, &u) in m.class_unit.iter().enumerate() {
-        let (u, n) = (&m.units[u as usize], exps[u as usize]);
-        let Some(t) = unit_terms(m, u, &views[u.seg.group as usize], n) else {
+        let (u, ul) = (&m.units[u as usize], &lanes.single[u as usize]);
+        let Some(t) = unit_terms(m, ul, &views[u.seg.group as usize]) else {
             continue;
         };
         let s_v = t.l_v * t.width;
@@ -750,7 +1037,7 @@ fn lanes_of(q: &[(UnitVec3, UnitVec3)]) -> ([F; 3], [F; 3]) {
 #[inline(always)]
 fn run_classes(
     m: &AnalyticModel,
-    exps: &[u32],
+    lanes: &Lanes,
     pairs: &[(UnitVec3, UnitVec3)],
     out: &mut [ClassTerms],
 ) {
@@ -760,7 +1047,7 @@ fn run_classes(
     for (q, o) in pairs.chunks(4).zip(out.chunks_mut(4 * classes)) {
         let (wi, wo) = lanes_of(q);
         four.fill(ClassTerms::default());
-        class_terms4(m, exps, wi, wo, &mut four);
+        class_terms4(m, lanes, wi, wo, &mut four);
         for (k, &(wi, wo)) in q.iter().enumerate() {
             if wi.above_horizon() && wo.above_horizon() {
                 o[k * classes..(k + 1) * classes]
@@ -773,10 +1060,10 @@ fn run_classes(
 /// Runs [`intensity4`] over the pairs, four at a time (the last group padded with a pair
 /// above the horizon whose result is dropped); pairs below the horizon give 0.
 #[inline(always)]
-fn run(m: &AnalyticModel, exps: &[u32], pairs: &[(UnitVec3, UnitVec3)], out: &mut [Reflection]) {
+fn run(m: &AnalyticModel, lanes: &Lanes, pairs: &[(UnitVec3, UnitVec3)], out: &mut [Reflection]) {
     for (q, o) in pairs.chunks(4).zip(out.chunks_mut(4)) {
         let (wi, wo) = lanes_of(q);
-        let r = intensity4(m, exps, wi, wo);
+        let r = intensity4(m, lanes, wi, wo);
         for (k, slot) in o.iter_mut().enumerate() {
             let (wi, wo) = q[k];
             *slot = if wi.above_horizon() && wo.above_horizon() {
@@ -795,11 +1082,25 @@ fn run(m: &AnalyticModel, exps: &[u32], pairs: &[(UnitVec3, UnitVec3)], out: &mu
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn run_avx2(
     m: &AnalyticModel,
-    exps: &[u32],
+    lanes: &Lanes,
     pairs: &[(UnitVec3, UnitVec3)],
     out: &mut [Reflection],
 ) {
-    run(m, exps, pairs, out)
+    run(m, lanes, pairs, out)
+}
+
+/// [`intensity1`] compiled for AVX2.
+///
+/// # Safety
+/// The processor must have AVX2.
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn one_avx2(
+    m: &AnalyticModel,
+    lanes: &Lanes,
+    wi: UnitVec3,
+    wo: UnitVec3,
+) -> Reflection {
+    intensity1(m, lanes, wi, wo)
 }
 
 /// [`run_classes`] compiled for AVX2.
@@ -809,9 +1110,9 @@ pub(super) unsafe fn run_avx2(
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn run_classes_avx2(
     m: &AnalyticModel,
-    exps: &[u32],
+    lanes: &Lanes,
     pairs: &[(UnitVec3, UnitVec3)],
     out: &mut [ClassTerms],
 ) {
-    run_classes(m, exps, pairs, out)
+    run_classes(m, lanes, pairs, out)
 }
