@@ -47,6 +47,7 @@ pub(super) fn lanes(facet: FacetModel, variant: Variant, units: &[Unit]) -> Opti
 
 /// The Huo exponent of every unit's material as the closed form takes it, `None` where one
 /// does not.
+#[cfg(target_arch = "x86_64")]
 fn whole_exponents(facet: FacetModel, variant: Variant, units: &[Unit]) -> Option<Vec<u32>> {
     // The sliced variant's units are evaluated slice by slice, pair by pair.
     if facet != FacetModel::Huo || variant == Variant::Sliced {
