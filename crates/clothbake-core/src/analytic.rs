@@ -360,6 +360,52 @@ struct Visible {
     width: f64,
 }
 
+/// The sums of eq. 4.11 over the units, in the units' order: the visible projected area
+/// sum_i D_i S_v,i and the lit terms sum_i D_i l_vi,i r_i (diffuse factor times albedo, specular
+/// intensity). One place for the weighting, whatever computed the units' terms (unit by unit, or
+/// a pair's units in AVX2 lanes).
+#[derive(Default)]
+struct Sums {
+    s_total: f64,
+    i_d: [f64; 3],
+    i_s: f64,
+}
+
+impl Sums {
+    /// Adds unit `u`'s visible projected area, l_v times the visible arc's projected width,
+    /// times its multiplicity D_i (eq. 4.3).
+    #[inline(always)]
+    fn seen(&mut self, u: &Unit, l_v: f64, width: f64) {
+        self.s_total += u.count as f64 * l_v * width;
+    }
+
+    /// Adds unit `u`'s lit terms: lit and visible length `l_vi`, and the arc integrals of the
+    /// diffuse factor `kd` and the specular intensity `ks` (eqs 4.4-4.10).
+    #[inline(always)]
+    fn lit(&mut self, u: &Unit, l_vi: f64, kd: f64, ks: f64) {
+        let w = u.count as f64 * l_vi * u.seg.radius;
+        for (acc, a) in self.i_d.iter_mut().zip(u.seg.material.albedo) {
+            *acc += w * kd * a;
+        }
+        self.i_s += w * ks;
+    }
+
+    /// I_d and I_s, the lit terms over the visible area (eq. 4.11); zero where nothing is
+    /// visible.
+    #[inline(always)]
+    fn reflection(&self) -> Reflection {
+        let s = self.s_total;
+        if s <= 0.0 {
+            return Reflection::default();
+        }
+        Reflection {
+            i_d: self.i_d.map(|x| x / s),
+            i_s: [self.i_s / s; 3],
+            secondary: None,
+        }
+    }
+}
+
 /// A unit's share of eq. 4.11 for one pair of directions, before the multiplicity D_i.
 struct UnitTerms {
     /// Visible length l_v along the axis (within the piece).
@@ -1044,9 +1090,7 @@ impl AnalyticModel {
                 ..Reflection::default()
             };
         }
-        let mut s_total = 0.0;
-        let mut i_d = [0.0; 3];
-        let mut i_s = 0.0;
+        let mut sums = Sums::default();
         let mut i_2 = Secondary::default();
         let views = Views::both(wi, wo);
         for u in &self.units {
@@ -1054,30 +1098,24 @@ impl AnalyticModel {
             let Some(t) = self.unit_terms(u, &u.neighbours, v, wi, wo, secondary, false) else {
                 continue;
             };
-            let d = u.count as f64;
-            s_total += d * t.l_v * t.width;
+            sums.seen(u, t.l_v, t.width);
             for (s, n) in &t.secondary {
                 i_2.add_scaled(&both_sides(s), f64::from(*n) * t.l_v);
             }
-            let Some((l_vi, kd, ks)) = t.lit else {
-                continue;
-            };
-            let w = d * l_vi * u.seg.radius;
-            for (acc, a) in i_d.iter_mut().zip(u.seg.material.albedo) {
-                *acc += w * kd * a;
+            if let Some((l_vi, kd, ks)) = t.lit {
+                sums.lit(u, l_vi, kd, ks);
             }
-            i_s += w * ks;
         }
-        if s_total <= 0.0 {
-            return Reflection {
-                secondary: secondary.map(|_| Secondary::default()),
-                ..Reflection::default()
-            };
-        }
+        let (direct, s_total) = (sums.reflection(), sums.s_total);
         Reflection {
-            i_d: i_d.map(|x| x / s_total),
-            i_s: [i_s / s_total; 3],
-            secondary: secondary.map(|_| i_2.scaled(1.0 / s_total)),
+            secondary: secondary.map(|_| {
+                if s_total <= 0.0 {
+                    Secondary::default()
+                } else {
+                    i_2.scaled(1.0 / s_total)
+                }
+            }),
+            ..direct
         }
     }
 

@@ -5,7 +5,7 @@
 //! the lanes hold four pairs, up to four units when they hold one pair's units. Either way each
 //! lane does the scalar arithmetic of its own pair and unit.
 
-use crate::analytic::{AnalyticModel, ClassTerms, Unit, Variant, EPS};
+use crate::analytic::{AnalyticModel, ClassTerms, Sums, Unit, Variant, EPS};
 use crate::lanes::{F64x4 as F, Mask4 as M};
 use crate::reflect::Reflection;
 use crate::shadowing::ActiveTable;
@@ -903,7 +903,7 @@ impl Lanes {
 fn intensity1(m: &AnalyticModel, lanes: &Lanes, wi: UnitVec3, wo: UnitVec3) -> Reflection {
     let zero = F::splat(0.0);
     let (l, e) = (wi.get(), wo.get());
-    let (mut s_total, mut i_d, mut i_s) = (0.0, [0.0; 3], 0.0);
+    let mut sums = Sums::default();
     for (pack, units) in &lanes.packs {
         let weft = F::from_array(pack.weft).gt(zero);
         let Some(t) = unit_terms(m, pack, &Views::of_units(weft, l, e)) else {
@@ -913,29 +913,15 @@ fn intensity1(m: &AnalyticModel, lanes: &Lanes, wi: UnitVec3, wo: UnitVec3) -> R
         let (l_v, width, l_vi) = (t.l_v.to_array(), t.width.to_array(), t.l_vi.to_array());
         let (kd, ks) = (t.kd.to_array(), t.ks.to_array());
         for (k, u) in m.units[units.clone()].iter().enumerate() {
-            if !visible[k] {
-                continue;
+            if visible[k] {
+                sums.seen(u, l_v[k], width[k]);
             }
-            let d = u.count as f64;
-            s_total += d * l_v[k] * width[k];
-            if !lit[k] {
-                continue;
+            if lit[k] {
+                sums.lit(u, l_vi[k], kd[k], ks[k]);
             }
-            let w = d * l_vi[k] * u.seg.radius;
-            for (acc, a) in i_d.iter_mut().zip(u.seg.material.albedo) {
-                *acc += w * kd[k] * a;
-            }
-            i_s += w * ks[k];
         }
     }
-    if s_total <= 0.0 {
-        return Reflection::default();
-    }
-    Reflection {
-        i_d: i_d.map(|x| x / s_total),
-        i_s: [i_s / s_total; 3],
-        secondary: None,
-    }
+    sums.reflection()
 }
 
 /// Eq. 4.11 for four pairs (`AnalyticModel::intensity_with` without I_2).
