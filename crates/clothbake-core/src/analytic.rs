@@ -1014,7 +1014,7 @@ impl AnalyticModel {
         AnalyticModel {
             facet,
             variant,
-            lanes: batch::lanes(facet, variant, &units),
+            lanes: batch::lanes(facet, &units),
             units,
             grid,
             cell_units,
@@ -2160,11 +2160,11 @@ mod tests {
         assert!(e.problem.contains("weft threads (rows)"), "{e}");
     }
 
-    /// One pair's units in AVX2 lanes (`intensity`) and four pairs in lanes
+    /// One pair's units (or slices) in AVX2 lanes (`intensity`) and four pairs in lanes
     /// (`intensity_batch`) give the bits of the unit-by-unit evaluation, on every shipped
-    /// fabric and draft, both variants the lanes take, random pairs with the edge pairs (the
-    /// pole, the symmetry planes, grazing). Packs of units that differ in exponent, in
-    /// endlessness or in having a specular lobe are split: a mixed fabric covers that.
+    /// fabric and draft, every variant, random pairs with the edge pairs (the pole, the symmetry
+    /// planes, grazing). Packs of units that differ in exponent, in endlessness or in having a
+    /// specular lobe are split: a mixed fabric covers that.
     #[test]
     fn lanes_give_the_bits_of_the_units_one_by_one() {
         if !std::arch::is_x86_feature_detected!("avx2") {
@@ -2201,11 +2201,18 @@ mod tests {
         let mut pairs: Vec<(UnitVec3, UnitVec3)> = (0..300).map(|_| (dir(), dir())).collect();
         pairs.extend(crate::validate::edge_pairs());
         let bits = |r: &Reflection| (r.i_d.map(f64::to_bits), r.i_s.map(f64::to_bits));
-        let mut compared = 0;
+        let (mut compared, mut sliced) = (0, 0);
         for (name, fabric) in &fabrics {
-            for variant in [Variant::Refined, Variant::Thesis] {
+            for variant in [Variant::Refined, Variant::Thesis, Variant::Sliced] {
                 let m = AnalyticModel::with_variant(fabric, FacetModel::Huo, variant);
-                assert!(m.lanes.is_some(), "{name}: not in lanes");
+                if variant == Variant::Sliced {
+                    // Units whole beside units in slices are left to the scalar evaluation.
+                    let mixed = m.units.iter().any(|u| u.slices.is_empty());
+                    assert_eq!(m.lanes.is_some(), !mixed, "{name} sliced");
+                    sliced += usize::from(!mixed);
+                } else {
+                    assert!(m.lanes.is_some(), "{name}: not in lanes");
+                }
                 let mut batch = vec![Reflection::default(); pairs.len()];
                 m.intensity_batch(&pairs, &mut batch);
                 for (&(wi, wo), b) in pairs.iter().zip(&batch) {
@@ -2217,7 +2224,8 @@ mod tests {
                 }
             }
         }
-        assert!(compared > 8000, "{compared}");
+        assert!(compared > 12_000, "{compared}");
+        assert!(sliced >= 12, "{sliced} sliced models in lanes");
     }
 
     #[test]

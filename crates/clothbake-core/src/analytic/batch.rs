@@ -1,7 +1,8 @@
 //! The direct model (eq. 4.11) in the lanes of an AVX register: four direction pairs at once,
 //! one pair a lane ([`AnalyticModel::intensity_batch`]), or one pair with up to four of its
-//! units at once, one unit a lane ([`AnalyticModel::intensity`]; the units' terms summed
-//! afterwards in the units' order, as the scalar evaluation sums them).
+//! units (or, with the `sliced` variant, of its units' slices) at once, one a lane
+//! ([`AnalyticModel::intensity`]; the terms summed afterwards in the units' and slices' order,
+//! as the scalar evaluation sums them).
 //!
 //! Each function in `avx2.rs` is the lane form of the scalar one in `analytic.rs`, `arc.rs` or
 //! `shadowing.rs` it names, with the same arithmetic in the same order: branches become
@@ -12,12 +13,11 @@
 //! evaluated pair by pair, with the same results.
 //!
 //! Covered: Huo facets whose exponents are whole numbers up to 4096 (the closed-form specular
-//! integral, eq. 4.10), the `thesis` and `refined` variants, one bounce. Anything else (Lewis
-//! facets, an exponent the closed form does not take, the `sliced` variant) is evaluated pair by
-//! pair by
-//! pair, unit by unit.
+//! integral, eq. 4.10), one bounce; four pairs at a time the `thesis` and `refined` variants,
+//! one pair at a time all three. Anything else (Lewis facets, an exponent the closed form does
+//! not take, the second bounce) is evaluated unit by unit.
 
-use super::{AnalyticModel, Unit, Variant};
+use super::{AnalyticModel, Unit};
 use crate::analytic::ClassTerms;
 use crate::facet::FacetModel;
 use crate::reflect::Reflection;
@@ -36,21 +36,20 @@ pub(crate) struct Lanes;
 
 /// The units in lanes, where the processor has AVX2 and the closed forms take every unit;
 /// `None` elsewhere (the model is then evaluated unit by unit).
-pub(super) fn lanes(facet: FacetModel, variant: Variant, units: &[Unit]) -> Option<Lanes> {
+pub(super) fn lanes(facet: FacetModel, units: &[Unit]) -> Option<Lanes> {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
-        return Lanes::new(units, &whole_exponents(facet, variant, units)?);
+        return Lanes::new(units, &whole_exponents(facet, units)?);
     }
-    let _ = (facet, variant, units);
+    let _ = (facet, units);
     None
 }
 
 /// The Huo exponent of every unit's material as the closed form takes it, `None` where one
 /// does not.
 #[cfg(target_arch = "x86_64")]
-fn whole_exponents(facet: FacetModel, variant: Variant, units: &[Unit]) -> Option<Vec<u32>> {
-    // The sliced variant's units are evaluated slice by slice, pair by pair.
-    if facet != FacetModel::Huo || variant == Variant::Sliced {
+fn whole_exponents(facet: FacetModel, units: &[Unit]) -> Option<Vec<u32>> {
+    if facet != FacetModel::Huo {
         return None;
     }
     units
@@ -80,7 +79,7 @@ impl AnalyticModel {
     pub fn intensity_batch(&self, pairs: &[(UnitVec3, UnitVec3)], out: &mut [Reflection]) {
         assert_eq!(pairs.len(), out.len(), "one output per pair");
         #[cfg(target_arch = "x86_64")]
-        if let Some(lanes) = &self.lanes {
+        if let Some(lanes) = self.lanes.as_ref().filter(|l| l.take_batches()) {
             // SAFETY: the lanes are built only where AVX2 was detected.
             unsafe { avx2::run_avx2(self, lanes, pairs, out) };
             return;
@@ -107,7 +106,7 @@ impl AnalyticModel {
             return;
         }
         #[cfg(target_arch = "x86_64")]
-        if let Some(lanes) = &self.lanes {
+        if let Some(lanes) = self.lanes.as_ref().filter(|l| l.take_batches()) {
             // SAFETY: the lanes are built only where AVX2 was detected.
             unsafe { avx2::run_classes_avx2(self, lanes, pairs, out) };
             return;

@@ -134,10 +134,41 @@ fn active(t: &TableLanes, psi: F) -> (M, Occluder) {
     (F::from_array(t.some).gt(F::splat(0.0)), o)
 }
 
-/// A unit's constants in each lane: one unit in all four lanes, or up to four units (the lanes
-/// past the last unit repeat it; their results are dropped). Lanes of one `UnitLanes` agree in
-/// what changes the code path: whether the units are endless, whether they have a specular
-/// lobe, and its whole exponent.
+/// A piece of a unit in each lane: a unit's whole range with its side tables, or a slice of it
+/// with the slice's ([`crate::analytic::Variant::Sliced`]).
+#[derive(Clone, Copy)]
+pub(super) struct Piece<'a> {
+    unit: &'a Unit,
+    /// The side tables on the +c and the -c side.
+    side: (&'a ActiveTable, &'a ActiveTable),
+    /// The parts of the unit's range along the axis.
+    ranges: &'a [(f64, f64)],
+}
+
+impl<'a> Piece<'a> {
+    /// The unit's whole range.
+    fn whole(unit: &'a Unit) -> Piece<'a> {
+        Piece {
+            unit,
+            side: (&unit.side_plus, &unit.side_minus),
+            ranges: std::slice::from_ref(&unit.range),
+        }
+    }
+
+    /// Each of the unit's slices.
+    fn slices(unit: &'a Unit) -> impl Iterator<Item = Piece<'a>> {
+        unit.slices.iter().map(move |sl| Piece {
+            unit,
+            side: sl.tables(),
+            ranges: &sl.ranges,
+        })
+    }
+}
+
+/// The constants of a piece of a unit in each lane ([`Piece`]): one piece in all four lanes, or
+/// up to four (the lanes past the last repeat it; their results are dropped). Lanes of one
+/// `UnitLanes` agree in what changes the code path: whether the units are endless, whether they
+/// have a specular lobe, and its whole exponent.
 #[derive(Clone, Debug)]
 pub(super) struct UnitLanes {
     radius: [f64; 4],
@@ -145,8 +176,9 @@ pub(super) struct UnitLanes {
     top: [f64; 4],
     /// The arc above the floor: lo, hi, and the sines and cosines of its ends.
     floor: [[f64; 4]; 6],
-    /// The piece's range along the axis.
-    range: [[f64; 4]; 2],
+    /// The parts of the piece's range along the axis, lo and hi, in their order; a lane with
+    /// fewer parts is padded with empty ones (0, 0), whose overlap with anything is +0.
+    ranges: Vec<[[f64; 4]; 2]>,
     /// The segment's extent along the axis; `None` for endless segments.
     extent: Option<[[f64; 4]; 2]>,
     /// rho_s; `None` where every lane's is 0.
@@ -162,19 +194,28 @@ pub(super) struct UnitLanes {
 }
 
 impl UnitLanes {
-    /// The lanes of `units` (one to four), the lanes past the last repeating it; `exponent`
+    /// The lanes of `pieces` (one to four), the lanes past the last repeating it; `exponent`
     /// their common whole exponent. `None` where they differ in what changes the code path.
-    pub(super) fn new(units: &[&Unit], exponent: u32) -> Option<UnitLanes> {
-        let first = units.first()?;
-        if units.len() > 4
-            || units.iter().any(|u| {
+    pub(super) fn new(pieces: &[Piece<'_>], exponent: u32) -> Option<UnitLanes> {
+        let first = pieces.first()?.unit;
+        if pieces.len() > 4
+            || pieces.iter().any(|p| {
+                let u = p.unit;
                 u.seg.extent.is_some() != first.seg.extent.is_some()
                     || (u.seg.material.specular == 0.0) != (first.seg.material.specular == 0.0)
             })
         {
             return None;
         }
-        let u: [&Unit; 4] = std::array::from_fn(|k| units[k.min(units.len() - 1)]);
+        let p: [Piece<'_>; 4] = std::array::from_fn(|k| pieces[k.min(pieces.len() - 1)]);
+        let u = p.map(|p| p.unit);
+        let parts = p.iter().map(|p| p.ranges.len()).max().unwrap_or(0);
+        let ranges = (0..parts)
+            .map(|k| {
+                let part = |end: usize| p.map(|p| p.ranges.get(k).map_or(0.0, |r| [r.0, r.1][end]));
+                [part(0), part(1)]
+            })
+            .collect();
         let lanes = |f: &dyn Fn(&Unit) -> f64| u.map(f);
         let extent = |end: usize| {
             lanes(&|u| {
@@ -194,14 +235,14 @@ impl UnitLanes {
                 lanes(&|u| u.seg.floor.hi.0),
                 lanes(&|u| u.seg.floor.hi.1),
             ],
-            range: [lanes(&|u| u.range.0), lanes(&|u| u.range.1)],
+            ranges,
             extent: first.seg.extent.map(|_| [extent(0), extent(1)]),
             specular: (first.seg.material.specular != 0.0)
                 .then(|| lanes(&|u| u.seg.material.specular)),
             exponent,
             weft: lanes(&|u| f64::from(u8::from(u.seg.group == crate::weave::Group::Weft))),
-            side_plus: TableLanes::new(u.map(|u| &u.side_plus)),
-            side_minus: TableLanes::new(u.map(|u| &u.side_minus)),
+            side_plus: TableLanes::new(p.map(|p| p.side.0)),
+            side_minus: TableLanes::new(p.map(|p| p.side.1)),
             end_plus: TableLanes::new(u.map(|u| &u.seg.end_plus)),
             end_minus: TableLanes::new(u.map(|u| &u.seg.end_minus)),
         })
@@ -437,6 +478,20 @@ fn meet(a: (F, F), b: (F, F)) -> (F, F) {
 fn overlap(a: (F, F), b: (F, F)) -> F {
     let (lo, hi) = meet(a, b);
     (hi - lo).max(F::splat(0.0))
+}
+
+/// The sum of the overlaps of `iv` with the parts `ranges`, in their order (`visible_of`'s
+/// `l_v`; every term is +0 or more, so starting from the first term is the iterator's sum).
+#[inline(always)]
+fn overlap_sum(ranges: &[[[f64; 4]; 2]], iv: (F, F)) -> F {
+    let Some((first, rest)) = ranges.split_first() else {
+        return F::splat(0.0);
+    };
+    let mut sum = overlap((F::from_array(first[0]), F::from_array(first[1])), iv);
+    for r in rest {
+        sum = sum + overlap((F::from_array(r[0]), F::from_array(r[1])), iv);
+    }
+    sum
 }
 
 /// `shadowing::occluded_length` (eq. 3.6).
@@ -821,8 +876,7 @@ fn unit_terms(m: &AnalyticModel, u: &UnitLanes, v: &Views) -> Option<Terms> {
         return None;
     }
     let along = end_interval(m, u, &v.e, &seen, ep);
-    let range = (F::from_array(u.range[0]), F::from_array(u.range[1]));
-    let l_v = overlap(range, along);
+    let l_v = overlap_sum(&u.ranges, along);
     visible = visible & l_v.gt(zero);
     if !visible.any() {
         return None;
@@ -830,7 +884,7 @@ fn unit_terms(m: &AnalyticModel, u: &UnitLanes, v: &Views) -> Option<Terms> {
     let width = projected_width(F::from_array(u.radius), &seen, ep);
     let vi = seen.meet(&lit);
     let lit_len = end_interval(m, u, &v.l, &vi, ep);
-    let l_vi = overlap(range, meet(along, lit_len));
+    let l_vi = overlap_sum(&u.ranges, meet(along, lit_len));
     let lit = visible & !vi.empty() & l_vi.gt(zero);
     let mut t = Terms {
         l_v,
@@ -856,70 +910,168 @@ fn unit_terms(m: &AnalyticModel, u: &UnitLanes, v: &Views) -> Option<Terms> {
     Some(t)
 }
 
-/// The model's units in lanes: each alone in all four lanes (four pairs at a time) and in packs
-/// of up to four (one pair's units at a time).
+/// The model's units in lanes: each alone in all four lanes (four pairs at a time), and the
+/// pieces of one pair (each unit whole, or each slice of each unit with the sliced variant) in
+/// packs of up to four.
 #[derive(Clone, Debug)]
 pub(crate) struct Lanes {
-    /// Unit `k` in every lane.
+    /// Unit `k` whole in every lane; empty with the sliced variant (whose batches go pair by
+    /// pair, each pair in `packs`).
     single: Vec<UnitLanes>,
-    /// Consecutive units in the lanes of one `UnitLanes`, with their indices; in the units'
-    /// order, so that summing the packs lane by lane sums the units in order.
-    packs: Vec<(UnitLanes, std::ops::Range<usize>)>,
+    /// Consecutive pieces in the lanes of one `UnitLanes`, with the index of each lane's unit;
+    /// in the units' order (and each unit's slices in theirs), so that summing the packs lane
+    /// by lane sums as the scalar evaluation does.
+    packs: Vec<(UnitLanes, Vec<usize>)>,
+    /// Whether the pieces are slices, summed per unit first (`sliced_terms`).
+    sliced: bool,
 }
 
 impl Lanes {
-    /// The lanes of `units`, `exps` their whole exponents.
+    /// The lanes of `units`, `exps` their whole exponents; the units' slices where they have
+    /// them (all or none do).
     pub(super) fn new(units: &[Unit], exps: &[u32]) -> Option<Lanes> {
-        let single = units
+        let sliced = units.iter().any(|u| !u.slices.is_empty());
+        if sliced && units.iter().any(|u| u.slices.is_empty()) {
+            // Units whole beside units in slices: left to the unit-by-unit evaluation.
+            return None;
+        }
+        let pieces: Vec<(usize, Piece<'_>)> = units
             .iter()
-            .zip(exps)
-            .map(|(u, &n)| UnitLanes::new(&[u], n))
-            .collect::<Option<Vec<_>>>()?;
-        let mut packs: Vec<(UnitLanes, std::ops::Range<usize>)> = Vec::new();
+            .enumerate()
+            .flat_map(|(k, u)| {
+                let whole = (!sliced).then(|| Piece::whole(u));
+                let slices = Piece::slices(u).filter(move |_| sliced);
+                whole.into_iter().chain(slices).map(move |p| (k, p))
+            })
+            .collect();
+        let single = if sliced {
+            Vec::new()
+        } else {
+            units
+                .iter()
+                .zip(exps)
+                .map(|(u, &n)| UnitLanes::new(&[Piece::whole(u)], n))
+                .collect::<Option<Vec<_>>>()?
+        };
+        let mut packs = Vec::new();
         let mut start = 0;
-        while start < units.len() {
+        while start < pieces.len() {
             // The longest run from `start` that one pack holds.
+            let n = exps[pieces[start].0];
+            let run = |end: usize| pieces[start..end].iter().map(|p| p.1).collect::<Vec<_>>();
             let mut end = start + 1;
-            let mut pack = single[start].clone();
-            while end < units.len() && end - start < 4 && exps[end] == exps[start] {
-                let run: Vec<&Unit> = units[start..=end].iter().collect();
-                let Some(p) = UnitLanes::new(&run, exps[start]) else {
+            let mut pack = UnitLanes::new(&run(end), n)?;
+            while end < pieces.len() && end - start < 4 && exps[pieces[end].0] == n {
+                let Some(p) = UnitLanes::new(&run(end + 1), n) else {
                     break;
                 };
                 pack = p;
                 end += 1;
             }
-            packs.push((pack, start..end));
+            packs.push((pack, pieces[start..end].iter().map(|p| p.0).collect()));
             start = end;
         }
-        Some(Lanes { single, packs })
+        Some(Lanes {
+            single,
+            packs,
+            sliced,
+        })
+    }
+
+    /// Whether four pairs at a time take these lanes (not with the sliced variant).
+    pub(crate) fn take_batches(&self) -> bool {
+        !self.sliced
+    }
+}
+
+/// A sliced unit's sums over its slices (`AnalyticModel::sliced_terms` without I_2).
+#[derive(Default)]
+struct SliceSums {
+    l_v: f64,
+    s_v: f64,
+    l_vi: f64,
+    kd: f64,
+    ks: f64,
+}
+
+impl SliceSums {
+    /// Unit `u`'s terms from its slices into `sums`, as `sliced_terms` gives them to the
+    /// unit-by-unit evaluation.
+    fn finish(&self, u: &Unit, sums: &mut Sums) {
+        if self.l_v <= 0.0 {
+            return;
+        }
+        sums.seen(u, self.l_v, self.s_v / self.l_v);
+        if self.l_vi > 0.0 {
+            sums.lit(u, self.l_vi, self.kd / self.l_vi, self.ks / self.l_vi);
+        }
     }
 }
 
 /// Eq. 4.11 for one pair (`AnalyticModel::intensity_with` without I_2), both above the horizon:
-/// the units in the lanes of their packs, their terms summed in the units' order as the scalar
-/// evaluation sums them.
+/// the pieces in the lanes of their packs, their terms summed in the units' order (and a sliced
+/// unit's slices in theirs) as the scalar evaluation sums them.
 #[inline(always)]
 fn intensity1(m: &AnalyticModel, lanes: &Lanes, wi: UnitVec3, wo: UnitVec3) -> Reflection {
     let zero = F::splat(0.0);
     let (l, e) = (wi.get(), wo.get());
     let mut sums = Sums::default();
+    // The sliced unit being summed, and its sums so far.
+    let mut open: Option<(usize, SliceSums)> = None;
     for (pack, units) in &lanes.packs {
         let weft = F::from_array(pack.weft).gt(zero);
-        let Some(t) = unit_terms(m, pack, &Views::of_units(weft, l, e)) else {
-            continue;
-        };
-        let (visible, lit) = (t.visible.to_array(), t.lit.to_array());
-        let (l_v, width, l_vi) = (t.l_v.to_array(), t.width.to_array(), t.l_vi.to_array());
-        let (kd, ks) = (t.kd.to_array(), t.ks.to_array());
-        for (k, u) in m.units[units.clone()].iter().enumerate() {
-            if visible[k] {
-                sums.seen(u, l_v[k], width[k]);
+        let t = unit_terms(m, pack, &Views::of_units(weft, l, e));
+        if !lanes.sliced {
+            let Some(t) = t else {
+                continue;
+            };
+            let (visible, lit) = (t.visible.to_array(), t.lit.to_array());
+            let (l_v, width, l_vi) = (t.l_v.to_array(), t.width.to_array(), t.l_vi.to_array());
+            let (kd, ks) = (t.kd.to_array(), t.ks.to_array());
+            for (k, &u) in units.iter().enumerate() {
+                let u = &m.units[u];
+                if visible[k] {
+                    sums.seen(u, l_v[k], width[k]);
+                }
+                if lit[k] {
+                    sums.lit(u, l_vi[k], kd[k], ks[k]);
+                }
             }
+            continue;
+        }
+        let lanes_of = t.map(|t| {
+            (
+                (t.visible.to_array(), t.lit.to_array()),
+                (t.l_v.to_array(), t.width.to_array(), t.l_vi.to_array()),
+                (t.kd.to_array(), t.ks.to_array()),
+            )
+        });
+        for (k, &u) in units.iter().enumerate() {
+            if open.as_ref().is_none_or(|(v, _)| *v != u) {
+                if let Some((v, s)) = open.take() {
+                    s.finish(&m.units[v], &mut sums);
+                }
+                open = Some((u, SliceSums::default()));
+            }
+            let (Some((_, s)), Some(((visible, lit), (l_v, width, l_vi), (kd, ks)))) =
+                (open.as_mut(), lanes_of.as_ref())
+            else {
+                continue;
+            };
+            if !visible[k] {
+                continue;
+            }
+            s.l_v += l_v[k];
+            s.s_v += l_v[k] * width[k];
             if lit[k] {
-                sums.lit(u, l_vi[k], kd[k], ks[k]);
+                s.l_vi += l_vi[k];
+                s.kd += l_vi[k] * kd[k];
+                s.ks += l_vi[k] * ks[k];
             }
         }
+    }
+    if let Some((v, s)) = open {
+        s.finish(&m.units[v], &mut sums);
     }
     sums.reflection()
 }
