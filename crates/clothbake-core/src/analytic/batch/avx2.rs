@@ -332,6 +332,39 @@ impl View {
     }
 }
 
+/// What one pair's views share whatever the units' groups: the light and the eye, their four
+/// elevations (over |x| and over |y|, the light's then the eye's: one `atan2` of four lanes),
+/// and the unit half vector (`Views::both`'s), computed once a pair for all its packs.
+struct PairLanes {
+    l: Vec3,
+    e: Vec3,
+    /// psi, sine and cosine, lane by lane.
+    elevations: [[f64; 4]; 3],
+    h: [F; 3],
+}
+
+impl PairLanes {
+    #[inline(always)]
+    fn new(l: Vec3, e: Vec3) -> PairLanes {
+        let el = Elevation::of(
+            F::from_array([l.z, l.z, e.z, e.z]),
+            F::from_array([l.x.abs(), l.y.abs(), e.x.abs(), e.y.abs()]),
+        );
+        let (hx, hy, hz) = (
+            F::splat(l.x + e.x),
+            F::splat(l.y + e.y),
+            F::splat(l.z + e.z),
+        );
+        let inv = 1.0 / (hx * hx + hy * hy + hz * hz).sqrt();
+        PairLanes {
+            l,
+            e,
+            elevations: [el.psi.to_array(), el.sin.to_array(), el.cos.to_array()],
+            h: [hx * inv, hy * inv, hz * inv],
+        }
+    }
+}
+
 /// Lanes of a unit half vector's projection (`arc::Heading`).
 #[derive(Clone, Copy)]
 struct Heading {
@@ -363,26 +396,15 @@ struct Views {
 }
 
 impl Views {
-    /// The views of one pair (`l`, `e`) for units of either group, lane by lane: a weft's
-    /// where `weft` holds, else a warp's (per lane `Views::both`'s of the lane's group). The
-    /// pair's four elevations are one `atan2` of four lanes.
+    /// The views of pair `p` for units of either group, lane by lane: a weft's where `weft`
+    /// holds, else a warp's (per lane `Views::both`'s of the lane's group).
     #[inline(always)]
-    fn of_units(weft: M, l: Vec3, e: Vec3) -> Views {
-        let el = Elevation::of(
-            F::from_array([l.z, l.z, e.z, e.z]),
-            F::from_array([l.x.abs(), l.y.abs(), e.x.abs(), e.y.abs()]),
-        );
-        let el = [el.psi.to_array(), el.sin.to_array(), el.cos.to_array()];
-        let (hx, hy, hz) = (
-            F::splat(l.x + e.x),
-            F::splat(l.y + e.y),
-            F::splat(l.z + e.z),
-        );
-        let inv = 1.0 / (hx * hx + hy * hy + hz * hz).sqrt();
+    fn of_units(weft: M, p: &PairLanes) -> Views {
+        let el = &p.elevations;
         Views {
-            l: View::of_units(weft, l, Elevation::lane(&el, 0), Elevation::lane(&el, 1)),
-            e: View::of_units(weft, e, Elevation::lane(&el, 2), Elevation::lane(&el, 3)),
-            h: Heading::new(weft.select(hy, hx) * inv, hz * inv),
+            l: View::of_units(weft, p.l, Elevation::lane(el, 0), Elevation::lane(el, 1)),
+            e: View::of_units(weft, p.e, Elevation::lane(el, 2), Elevation::lane(el, 3)),
+            h: Heading::new(weft.select(p.h[1], p.h[0]), p.h[2]),
         }
     }
 
@@ -1014,13 +1036,13 @@ impl SliceSums {
 #[inline(always)]
 fn intensity1(m: &AnalyticModel, lanes: &Lanes, wi: UnitVec3, wo: UnitVec3) -> Reflection {
     let zero = F::splat(0.0);
-    let (l, e) = (wi.get(), wo.get());
+    let pair = PairLanes::new(wi.get(), wo.get());
     let mut sums = Sums::default();
     // The sliced unit being summed, and its sums so far.
     let mut open: Option<(usize, SliceSums)> = None;
     for (pack, units) in &lanes.packs {
         let weft = F::from_array(pack.weft).gt(zero);
-        let t = unit_terms(m, pack, &Views::of_units(weft, l, e));
+        let t = unit_terms(m, pack, &Views::of_units(weft, &pair));
         if !lanes.sliced {
             let Some(t) = t else {
                 continue;
