@@ -724,7 +724,7 @@ pub enum VariantArg {
     /// Eq. 3.6 averaged over the arc (default).
     Refined,
     /// Refined, with the side profiles taken slice by slice along each piece: closer to the
-    /// ground truth (docs/model.md), about 2.6x the cost.
+    /// ground truth (docs/model.md), about 2.5x the cost.
     Sliced,
 }
 
