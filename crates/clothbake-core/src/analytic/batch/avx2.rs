@@ -314,9 +314,7 @@ impl View {
             end_psi: ea,
         }
     }
-}
 
-impl View {
     /// The view of `v` from a weft's unit where `weft` holds, else from a warp's, given its
     /// elevations over |x| and over |y| (`View::both`, per lane the lane's group's).
     #[inline(always)]
@@ -541,7 +539,8 @@ struct Cut {
 // The helpers below are functions, not closures: a closure is compiled without its enclosing
 // function's AVX2 (its lane operations would be calls).
 
-/// The point `(s, c)` (sine and cosine) turned back by the angle whose are `(s0, c0)`.
+/// The point `(s, c)` (sine and cosine) turned back by the angle whose sine and cosine are
+/// `(s0, c0)`.
 #[inline(always)]
 fn from_lo((s, c): (F, F), s0: F, c0: F) -> (F, F) {
     (s * c0 - c * s0, c * c0 + s * s0)
