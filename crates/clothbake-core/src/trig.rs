@@ -141,8 +141,9 @@ const PI_LO: f64 = f64::from_bits(0x3CA1_A626_3314_5C07);
 /// atan(t) for |t| <= 0.4375 (FDLIBM's kernel, no reduction).
 #[inline(always)]
 fn atan_kernel<L: Lane>(t: L) -> L {
-    // Not a closure for the coefficients: a closure is compiled without the AVX2 of the lanes'
-    // callers, and its splats would be calls.
+    // Not a closure for the coefficients: a closure here would have this function's target
+    // features (none), not the AVX2 of the lanes' callers, and, left out of line, its splats
+    // would be calls.
     let c = [
         L::splat(AT[0]),
         L::splat(AT[1]),

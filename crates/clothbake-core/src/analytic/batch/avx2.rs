@@ -536,8 +536,9 @@ struct Cut {
     c: F,
 }
 
-// The helpers below are functions, not closures: a closure is compiled without its enclosing
-// function's AVX2 (its lane operations would be calls).
+// The helpers below are functions, not closures: a closure written in an `#[inline(always)]`
+// helper has the helper's target features (none), not the AVX2 of the function it is inlined
+// into, and left out of line its lane operations would be calls.
 
 /// The point `(s, c)` (sine and cosine) turned back by the angle whose sine and cosine are
 /// `(s0, c0)`.
