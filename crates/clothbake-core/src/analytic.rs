@@ -390,6 +390,16 @@ impl Sums {
         self.i_s += w * ks;
     }
 
+    /// Adds unit `u`'s visible area and, where some of it is lit, its lit terms (`seen`,
+    /// `lit`).
+    #[inline(always)]
+    fn add(&mut self, u: &Unit, l_v: f64, width: f64, lit: Option<(f64, f64, f64)>) {
+        self.seen(u, l_v, width);
+        if let Some((l_vi, kd, ks)) = lit {
+            self.lit(u, l_vi, kd, ks);
+        }
+    }
+
     /// I_d and I_s, the lit terms over the visible area (eq. 4.11); zero where nothing is
     /// visible.
     #[inline(always)]
@@ -403,6 +413,47 @@ impl Sums {
             i_s: [self.i_s / s; 3],
             secondary: None,
         }
+    }
+}
+
+/// A sliced unit's sums over its slices ([`Variant::Sliced`]), in the slices' order: the
+/// visible length and area, the lit length and the lit-length-weighted arc integrals. One place
+/// for them, whether the slices were evaluated one by one or in AVX2 lanes.
+#[derive(Default)]
+struct SliceSums {
+    l_v: f64,
+    s_v: f64,
+    l_vi: f64,
+    kd: f64,
+    ks: f64,
+}
+
+impl SliceSums {
+    /// Adds a slice's visible length `l_v` and area `l_v` times `width`.
+    #[inline(always)]
+    fn seen(&mut self, l_v: f64, width: f64) {
+        self.l_v += l_v;
+        self.s_v += l_v * width;
+    }
+
+    /// Adds a slice's lit and visible length `l_vi` and its arc integrals `kd`, `ks`.
+    #[inline(always)]
+    fn lit(&mut self, l_vi: f64, kd: f64, ks: f64) {
+        self.l_vi += l_vi;
+        self.kd += l_vi * kd;
+        self.ks += l_vi * ks;
+    }
+
+    /// The unit's visible length, its width S_v / l_v, and its lit length with the integrals'
+    /// lit-length-weighted means; `None` where no slice is visible.
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    fn unit(&self) -> Option<(f64, f64, Option<(f64, f64, f64)>)> {
+        if self.l_v <= 0.0 {
+            return None;
+        }
+        let lit = (self.l_vi > 0.0).then(|| (self.l_vi, self.kd / self.l_vi, self.ks / self.l_vi));
+        Some((self.l_v, self.s_v / self.l_v, lit))
     }
 }
 
@@ -1098,12 +1149,9 @@ impl AnalyticModel {
             let Some(t) = self.unit_terms(u, &u.neighbours, v, wi, wo, secondary, false) else {
                 continue;
             };
-            sums.seen(u, t.l_v, t.width);
+            sums.add(u, t.l_v, t.width, t.lit);
             for (s, n) in &t.secondary {
                 i_2.add_scaled(&both_sides(s), f64::from(*n) * t.l_v);
-            }
-            if let Some((l_vi, kd, ks)) = t.lit {
-                sums.lit(u, l_vi, kd, ks);
             }
         }
         let (direct, s_total) = (sums.reflection(), sums.s_total);
@@ -1239,7 +1287,7 @@ impl AnalyticModel {
     ) -> Option<UnitTerms> {
         let seg = &u.seg;
         let ep = views.e.p.p;
-        let (mut l_v, mut s_v, mut l_vi, mut kd, mut ks) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        let mut sums = SliceSums::default();
         let mut sec: Vec<([Secondary; 2], u32)> = match secondary {
             Some(_) => variants
                 .iter()
@@ -1252,8 +1300,7 @@ impl AnalyticModel {
                 continue;
             };
             let lit = side_arc_in(seg, sl.tables(), &views.l).meet(&seg.floor);
-            l_v += v.l_v;
-            s_v += v.l_v * v.width;
+            sums.seen(v.l_v, v.width);
             if let Some(opts) = secondary {
                 let (l, e) = (wi.get(), wo.get());
                 for ((acc, _), (nbs, _)) in sec.iter_mut().zip(variants) {
@@ -1269,22 +1316,18 @@ impl AnalyticModel {
             let li: f64 = sl.ranges.iter().map(|&r| overlap(r, lit_along)).sum();
             if !vi.arc.is_empty() && li > 0.0 {
                 let (d, s) = self.arc_integral(&seg.material, seg.group, &vi, views, wi, wo);
-                l_vi += li;
-                kd += li * d;
-                ks += li * s;
+                sums.lit(li, d, s);
             }
         }
-        if l_v <= 0.0 {
-            return None;
-        }
+        let (l_v, width, lit) = sums.unit()?;
         for (acc, _) in &mut sec {
             *acc = acc.map(|a| a.scaled(1.0 / l_v));
         }
         Some(UnitTerms {
             l_v,
-            width: s_v / l_v,
+            width,
             secondary: sec,
-            lit: (l_vi > 0.0).then(|| (l_vi, kd / l_vi, ks / l_vi)),
+            lit,
         })
     }
 

@@ -5,7 +5,7 @@
 //! the lanes hold four pairs, up to four units when they hold one pair's units. Either way each
 //! lane does the scalar arithmetic of its own pair and unit.
 
-use crate::analytic::{AnalyticModel, ClassTerms, Sums, Unit, Variant, EPS};
+use crate::analytic::{AnalyticModel, ClassTerms, SliceSums, Sums, Unit, Variant, EPS};
 use crate::lanes::{F64x4 as F, Mask4 as M};
 use crate::reflect::Reflection;
 use crate::shadowing::ActiveTable;
@@ -1006,27 +1006,63 @@ impl Lanes {
     }
 }
 
-/// A sliced unit's sums over its slices (`AnalyticModel::sliced_terms` without I_2).
-#[derive(Default)]
-struct SliceSums {
-    l_v: f64,
-    s_v: f64,
-    l_vi: f64,
-    kd: f64,
-    ks: f64,
+/// A `Terms` lane by lane, for the sums taken lane after lane.
+struct TermsByLane {
+    visible: [bool; 4],
+    lit: [bool; 4],
+    l_v: [f64; 4],
+    width: [f64; 4],
+    l_vi: [f64; 4],
+    kd: [f64; 4],
+    ks: [f64; 4],
 }
 
-impl SliceSums {
-    /// Unit `u`'s terms from its slices into `sums`, as `sliced_terms` gives them to the
-    /// unit-by-unit evaluation.
-    fn finish(&self, u: &Unit, sums: &mut Sums) {
-        if self.l_v <= 0.0 {
-            return;
+impl TermsByLane {
+    #[inline(always)]
+    fn of(t: &Terms) -> TermsByLane {
+        TermsByLane {
+            visible: t.visible.to_array(),
+            lit: t.lit.to_array(),
+            l_v: t.l_v.to_array(),
+            width: t.width.to_array(),
+            l_vi: t.l_vi.to_array(),
+            kd: t.kd.to_array(),
+            ks: t.ks.to_array(),
         }
-        sums.seen(u, self.l_v, self.s_v / self.l_v);
-        if self.l_vi > 0.0 {
-            sums.lit(u, self.l_vi, self.kd / self.l_vi, self.ks / self.l_vi);
+    }
+
+    /// Lane `k`'s lit terms, where it is lit.
+    #[inline(always)]
+    fn lit(&self, k: usize) -> Option<(f64, f64, f64)> {
+        self.lit[k].then(|| (self.l_vi[k], self.kd[k], self.ks[k]))
+    }
+
+    /// Lane `k`'s terms, those of unit `u`, into `sums` where it is visible.
+    #[inline(always)]
+    fn add_unit(&self, k: usize, u: &Unit, sums: &mut Sums) {
+        if self.visible[k] {
+            sums.add(u, self.l_v[k], self.width[k], self.lit(k));
         }
+    }
+
+    /// Lane `k`'s terms, a slice's, into its unit's `sums` where it is visible.
+    #[inline(always)]
+    fn add_slice(&self, k: usize, sums: &mut SliceSums) {
+        if self.visible[k] {
+            sums.seen(self.l_v[k], self.width[k]);
+            if let Some((l_vi, kd, ks)) = self.lit(k) {
+                sums.lit(l_vi, kd, ks);
+            }
+        }
+    }
+}
+
+/// A sliced unit's slice sums into `sums`, as `sliced_terms` hands them to the unit-by-unit
+/// evaluation.
+#[inline(always)]
+fn add_sliced(u: &Unit, slices: &SliceSums, sums: &mut Sums) {
+    if let Some((l_v, width, lit)) = slices.unit() {
+        sums.add(u, l_v, width, lit);
     }
 }
 
@@ -1042,58 +1078,27 @@ fn intensity1(m: &AnalyticModel, lanes: &Lanes, wi: UnitVec3, wo: UnitVec3) -> R
     let mut open: Option<(usize, SliceSums)> = None;
     for (pack, units) in &lanes.packs {
         let weft = F::from_array(pack.weft).gt(zero);
-        let t = unit_terms(m, pack, &Views::of_units(weft, &pair));
-        if !lanes.sliced {
-            let Some(t) = t else {
-                continue;
-            };
-            let (visible, lit) = (t.visible.to_array(), t.lit.to_array());
-            let (l_v, width, l_vi) = (t.l_v.to_array(), t.width.to_array(), t.l_vi.to_array());
-            let (kd, ks) = (t.kd.to_array(), t.ks.to_array());
-            for (k, &u) in units.iter().enumerate() {
-                let u = &m.units[u];
-                if visible[k] {
-                    sums.seen(u, l_v[k], width[k]);
-                }
-                if lit[k] {
-                    sums.lit(u, l_vi[k], kd[k], ks[k]);
-                }
-            }
-            continue;
-        }
-        let lanes_of = t.map(|t| {
-            (
-                (t.visible.to_array(), t.lit.to_array()),
-                (t.l_v.to_array(), t.width.to_array(), t.l_vi.to_array()),
-                (t.kd.to_array(), t.ks.to_array()),
-            )
-        });
+        let t = unit_terms(m, pack, &Views::of_units(weft, &pair)).map(|t| TermsByLane::of(&t));
         for (k, &u) in units.iter().enumerate() {
+            if !lanes.sliced {
+                if let Some(t) = &t {
+                    t.add_unit(k, &m.units[u], &mut sums);
+                }
+                continue;
+            }
             if open.as_ref().is_none_or(|(v, _)| *v != u) {
                 if let Some((v, s)) = open.take() {
-                    s.finish(&m.units[v], &mut sums);
+                    add_sliced(&m.units[v], &s, &mut sums);
                 }
                 open = Some((u, SliceSums::default()));
             }
-            let (Some((_, s)), Some(((visible, lit), (l_v, width, l_vi), (kd, ks)))) =
-                (open.as_mut(), lanes_of.as_ref())
-            else {
-                continue;
-            };
-            if !visible[k] {
-                continue;
-            }
-            s.l_v += l_v[k];
-            s.s_v += l_v[k] * width[k];
-            if lit[k] {
-                s.l_vi += l_vi[k];
-                s.kd += l_vi[k] * kd[k];
-                s.ks += l_vi[k] * ks[k];
+            if let (Some((_, s)), Some(t)) = (open.as_mut(), &t) {
+                t.add_slice(k, s);
             }
         }
     }
     if let Some((v, s)) = open {
-        s.finish(&m.units[v], &mut sums);
+        add_sliced(&m.units[v], &s, &mut sums);
     }
     sums.reflection()
 }
