@@ -1106,37 +1106,18 @@ fn intensity1(m: &AnalyticModel, lanes: &Lanes, wi: UnitVec3, wo: UnitVec3) -> R
 /// Eq. 4.11 for four pairs (`AnalyticModel::intensity_with` without I_2).
 #[inline(always)]
 fn intensity4(m: &AnalyticModel, lanes: &Lanes, wi: [F; 3], wo: [F; 3]) -> [Reflection; 4] {
-    let zero = F::splat(0.0);
     let views = Views::both(wi, wo);
-    let mut s_total = zero;
-    let mut i_d = [zero; 3];
-    let mut i_s = zero;
+    let mut sums: [Sums; 4] = Default::default();
     for (u, ul) in m.units.iter().zip(&lanes.single) {
         let Some(t) = unit_terms(m, ul, &views[u.seg.group as usize]) else {
             continue;
         };
-        let d = f64::from(u.count);
-        s_total = s_total + t.visible.select(d * t.l_v * t.width, zero);
-        let w = d * t.l_vi * u.seg.radius;
-        for (acc, a) in i_d.iter_mut().zip(u.seg.material.albedo) {
-            *acc = *acc + t.lit.select(w * t.kd * a, zero);
+        let t = TermsByLane::of(&t);
+        for (k, s) in sums.iter_mut().enumerate() {
+            t.add_unit(k, u, s);
         }
-        i_s = i_s + t.lit.select(w * t.ks, zero);
     }
-    let (s_total, i_s) = (s_total.to_array(), i_s.to_array());
-    let i_d = i_d.map(F::to_array);
-    [0, 1, 2, 3].map(|k| {
-        let s = s_total[k];
-        if s <= 0.0 {
-            Reflection::default()
-        } else {
-            Reflection {
-                i_d: [i_d[0][k] / s, i_d[1][k] / s, i_d[2][k] / s],
-                i_s: [i_s[k] / s; 3],
-                secondary: None,
-            }
-        }
-    })
+    [0, 1, 2, 3].map(|k| sums[k].reflection())
 }
 
 /// Each class's terms for four pairs (`AnalyticModel::class_terms`), pair `k`'s into
