@@ -330,6 +330,14 @@ impl View {
     }
 }
 
+/// The unit half vector (L + E) / |L + E| of each lane's light `l` and eye `e`.
+#[inline(always)]
+fn unit_half(l: [F; 3], e: [F; 3]) -> [F; 3] {
+    let h = [l[0] + e[0], l[1] + e[1], l[2] + e[2]];
+    let inv = 1.0 / (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+    [h[0] * inv, h[1] * inv, h[2] * inv]
+}
+
 /// What one pair's views share whatever the units' groups: the light and the eye, their four
 /// elevations (over |x| and over |y|, the light's then the eye's: one `atan2` of four lanes),
 /// and the unit half vector (`Views::both`'s), computed once a pair for all its packs.
@@ -348,17 +356,14 @@ impl PairLanes {
             F::from_array([l.z, l.z, e.z, e.z]),
             F::from_array([l.x.abs(), l.y.abs(), e.x.abs(), e.y.abs()]),
         );
-        let (hx, hy, hz) = (
-            F::splat(l.x + e.x),
-            F::splat(l.y + e.y),
-            F::splat(l.z + e.z),
-        );
-        let inv = 1.0 / (hx * hx + hy * hy + hz * hz).sqrt();
         PairLanes {
             l,
             e,
             elevations: [el.psi.to_array(), el.sin.to_array(), el.cos.to_array()],
-            h: [hx * inv, hy * inv, hz * inv],
+            h: unit_half(
+                [F::splat(l.x), F::splat(l.y), F::splat(l.z)],
+                [F::splat(e.x), F::splat(e.y), F::splat(e.z)],
+            ),
         }
     }
 }
@@ -411,9 +416,7 @@ impl Views {
     fn both(l: [F; 3], e: [F; 3]) -> [Views; 2] {
         let [lw, lf] = View::both(l);
         let [ew, ef] = View::both(e);
-        let h = [l[0] + e[0], l[1] + e[1], l[2] + e[2]];
-        let inv = 1.0 / (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
-        let h = [h[0] * inv, h[1] * inv, h[2] * inv];
+        let h = unit_half(l, e);
         [
             Views {
                 l: lw,
