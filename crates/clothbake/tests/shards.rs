@@ -361,42 +361,25 @@ fn two_faced_bakes_are_the_same_for_any_thread_count_and_shard_split() {
             &["--faces two", needle],
         );
     }
-    fails_with(
-        &run_in(
-            &d,
+    // --paths without --faces two, and a grid whose four blocks pass 2^31 cells.
+    for (extra, needles) in [
+        (&["--paths", "8"][..], &["--paths", "--faces two"][..]),
+        (
+            &["--faces", "two", "--res", "32768,65536,1,1"][..],
             &[
-                "bake",
-                "--weave",
-                plain.as_str(),
-                "--paths",
-                "8",
-                "-o",
-                "bad.exr",
-            ],
+                "--res 32768,65536,1,1 with --faces two",
+                "8589934592 cells",
+                "2^31",
+            ][..],
         ),
-        &["--paths", "--faces two"],
-    );
-    fails_with(
-        &run_in(
-            &d,
-            &[
-                "bake",
-                "--weave",
-                plain.as_str(),
-                "--faces",
-                "two",
-                "--res",
-                "32768,65536,1,1",
-                "-o",
-                "bad.exr",
-            ],
-        ),
-        &[
-            "--res 32768,65536,1,1 with --faces two",
-            "8589934592 cells",
-            "2^31",
-        ],
-    );
+    ] {
+        let args = [
+            &["bake", "--weave", plain.as_str()][..],
+            extra,
+            &["-o", "bad.exr"],
+        ];
+        fails_with(&run_in(&d, &args.concat()), needles);
+    }
     assert!(!d.join("bad.exr").exists());
 }
 
