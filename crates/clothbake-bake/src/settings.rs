@@ -329,21 +329,18 @@ impl Settings {
                 n.word("faces", "two")
             ));
         }
-        if let Some(k) = self
-            .paths
-            .filter(|&k| k == 0 || k > crate::sweep::MAX_PATHS)
-        {
-            return Err(format!(
-                "{} is out of range; give a whole number from 1 to {} (2^24)",
-                n.number("paths", &k.to_string()),
-                crate::sweep::MAX_PATHS
-            ));
-        }
-        if let Some(k) = self.samples.filter(|&k| k == 0 || k > MAX_SAMPLES) {
-            return Err(format!(
-                "{} is out of range; give a whole number from 1 to {MAX_SAMPLES} (2^24)",
-                n.number("samples", &k.to_string())
-            ));
+        // The counts' ranges, each 1 to a power of two.
+        for (name, count, max) in [
+            ("paths", self.paths, crate::sweep::MAX_PATHS),
+            ("samples", self.samples, MAX_SAMPLES),
+        ] {
+            if let Some(k) = count.filter(|&k| k == 0 || k > max) {
+                return Err(format!(
+                    "{} is out of range; give a whole number from 1 to {max} (2^{})",
+                    n.number(name, &k.to_string()),
+                    max.trailing_zeros()
+                ));
+            }
         }
         let method = if self.raytrace {
             Method::Raytrace {
