@@ -4,8 +4,9 @@
 //! For each case (a flat swatch and a sphere; the twill, satin5, gingham and the wool twill
 //! preset; two lights) and each of six distances, from 32 pixels across a thread down to 0.1
 //! pixel per period, the same camera and pixel samples render the one-bounce model through its
-//! footprints (`Shader::model`: point, cells, period) and the ground truth (`Shader::truth`,
-//! twice with different jitter). The relative RMSE is the RMS difference between the level of
+//! footprints (`Shader::model`: point, cells, period), with the default variant (`refined`) and
+//! with `sliced`, and the ground truth (`Shader::truth`, twice with different jitter, shared by
+//! both variants). The relative RMSE is the RMS difference between the level of
 //! detail and the mean of the two truths, with the truths' own noise (estimated from their
 //! difference) subtracted, over the mean truth value of the pixels that see the cloth.
 //! Ambient 0 (the reflected light alone), opaque cloth, 8 x 8 samples a pixel.
@@ -162,20 +163,17 @@ pub fn run(root: &Path) {
         ("front", clothbake_core::Vec3::new(0.0, -0.5, 0.866)),
         ("side", clothbake_core::Vec3::new(0.8, 0.3, 0.52)),
     ];
+    // The default variant and the sliced one (docs/model.md), against the same truths.
+    let variants = [Variant::Refined, Variant::Sliced];
     let mut rows = String::new();
-    let mut worst = 0.0f64;
+    let mut worst = [0.0f64; 2];
     let mut far_equal = 0.0f64;
     for name in fabrics {
         let fabric = Fabric::from_path(&root.join("tables").join(name)).expect("shipped fabric");
         let threads = fabric.weave().n_warp().max(fabric.weave().n_weft()) as f64;
-        let model = Shader::model(
-            &fabric,
-            FacetModel::Huo,
-            Variant::Refined,
-            None,
-            Component::Total,
-        )
-        .expect("one bounce");
+        let models = variants.map(|v| {
+            Shader::model(&fabric, FacetModel::Huo, v, None, Component::Total).expect("one bounce")
+        });
         let truth = [1, 2].map(|seed| Shader::truth(&fabric, FacetModel::Huo, seed, None));
         for (scene_name, eye) in scenes {
             let scene = Scene::by_name(scene_name).expect("scene");
@@ -192,32 +190,42 @@ pub fn run(root: &Path) {
                     irradiance: std::f64::consts::PI,
                     ambient: 0.0,
                 };
-                let averaged = image(&scene, &camera, &lighting, &model, None);
-                let mut cells = Vec::new();
+                let mut cells = [Vec::new(), Vec::new()];
                 for step in 0..STEPS {
                     // Pixels per period, geometric from `near` to 0.1.
                     let ppp = near * (0.1 / near).powf(step as f64 / (STEPS - 1) as f64);
                     let periods = scene.width() * per_length / ppp;
-                    let lod = image(&scene, &camera, &lighting, &model, Some(periods));
                     let [t1, t2] = [&truth[0], &truth[1]]
                         .map(|t| image(&scene, &camera, &lighting, t, Some(periods)));
-                    let (err, noise) = compare(&lod, &t1, &t2);
-                    worst = worst.max(err);
-                    if step == STEPS - 1 {
-                        // A tenth of that again: every sample's footprint a period or more.
-                        let far = image(&scene, &camera, &lighting, &model, Some(10.0 * periods));
-                        far_equal = far_equal.max(max_diff(&far, &averaged));
+                    for (k, model) in models.iter().enumerate() {
+                        let lod = image(&scene, &camera, &lighting, model, Some(periods));
+                        let (err, noise) = compare(&lod, &t1, &t2);
+                        worst[k] = worst[k].max(err);
+                        if step == STEPS - 1 {
+                            // A tenth of that again: every sample's footprint a period or more.
+                            let averaged = image(&scene, &camera, &lighting, model, None);
+                            let far =
+                                image(&scene, &camera, &lighting, model, Some(10.0 * periods));
+                            far_equal = far_equal.max(max_diff(&far, &averaged));
+                        }
+                        cells[k].push(format!("{:.1}% ({:.1}%)", 100.0 * err, 100.0 * noise));
                     }
-                    cells.push(format!("{:.1}% ({:.1}%)", 100.0 * err, 100.0 * noise));
                 }
-                writeln!(
-                    rows,
-                    "| {} | {scene_name} | {light_name} | {} |",
-                    name.split('.').next().unwrap_or(name),
-                    cells.join(" | ")
-                )
-                .unwrap();
-                eprintln!("{name} {scene_name} {light_name}: {}", cells.join(", "));
+                for (v, cells) in variants.iter().zip(&cells) {
+                    writeln!(
+                        rows,
+                        "| {} | {scene_name} | {light_name} | {} | {} |",
+                        name.split('.').next().unwrap_or(name),
+                        v.name(),
+                        cells.join(" | ")
+                    )
+                    .unwrap();
+                    eprintln!(
+                        "{name} {scene_name} {light_name} {}: {}",
+                        v.name(),
+                        cells.join(", ")
+                    );
+                }
             }
         }
     }
@@ -230,12 +238,14 @@ pub fn run(root: &Path) {
          truth's own noise, in brackets, taken out), {RES} x {RES} pixels, {AA} x {AA} samples \
          a pixel, ambient 0, one bounce, Huo facets. Distances in pixels per period at the \
          image centre, from 32 pixels a thread (1) to 0.1 pixel a period (6), geometric \
-         between. Worst: {:.1}%. At 0.01 pixel a period, where every sample's footprint is a \
+         between; each case with the default variant (`refined`) and with `sliced` (docs/model.md), \
+         against the same truths. Worst: {:.1}% (refined), {:.1}% (sliced). At 0.01 pixel a period, where every sample's footprint is a \
          period or more, the level-of-detail picture differs from the averaged render by at \
          most {:.1e} of its largest value.\n\n\
-         | fabric | scene | light | 1 | 2 | 3 | 4 | 5 | 6 |\n|---|---|---|---|---|---|---|---|---|\n{rows}\
+         | fabric | scene | light | variant | 1 | 2 | 3 | 4 | 5 | 6 |\n|---|---|---|---|---|---|---|---|---|---|\n{rows}\
          \n{}<!-- lod-validation:end -->",
-        100.0 * worst,
+        100.0 * worst[0],
+        100.0 * worst[1],
         far_equal,
         cells_table(root)
     )
