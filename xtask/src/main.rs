@@ -180,6 +180,12 @@ fn validate() {
                         Caps::Excluded,
                     ),
                     (
+                        "huo, sliced3d, caps excluded",
+                        FacetModel::Huo,
+                        Variant::Sliced3d,
+                        Caps::Excluded,
+                    ),
+                    (
                         "lewis, refined, caps excluded",
                         FacetModel::Lewis,
                         Variant::Refined,
@@ -204,6 +210,12 @@ fn validate() {
                         "huo, sliced, caps excluded",
                         FacetModel::Huo,
                         Variant::Sliced,
+                        Caps::Excluded,
+                    ),
+                    (
+                        "huo, sliced3d, caps excluded",
+                        FacetModel::Huo,
+                        Variant::Sliced3d,
                         Caps::Excluded,
                     ),
                 ]

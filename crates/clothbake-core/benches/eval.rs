@@ -69,8 +69,9 @@ fn analytic(c: &mut Criterion) {
             })
         });
     }
-    // The variants side by side, one pair at a time (docs/model.md, "The sliced variant").
-    for variant in [Variant::Refined, Variant::Sliced] {
+    // The variants side by side, one pair at a time (docs/model.md, "The sliced variant" and
+    // "The sliced3d variant").
+    for variant in [Variant::Refined, Variant::Sliced, Variant::Sliced3d] {
         let m = AnalyticModel::with_variant(&fabric, FacetModel::Huo, variant);
         c.bench_function(
             &format!("analytic_variant/twill/{}/random", variant.name()),

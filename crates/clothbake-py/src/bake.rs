@@ -97,7 +97,7 @@ fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) ->
 /// checkpoint_every seconds (default 60). resume: continue from that checkpoint.
 /// shard: "K/N", bake only shard K (0-based) of N into `output` (for `clothbake merge`).
 /// format: "exr" or "bin" (default from the extension); precision: "f16" (default) or "f32".
-/// method: "analytic" (default; variant "refined", "thesis" or "sliced") or "raytrace" (samples, seed,
+/// method: "analytic" (default; variant "refined", "thesis", "sliced" or "sliced3d") or "raytrace" (samples, seed,
 /// caps "excluded" or "shaded"). With bounces=2: secondary "analytic" (orders: "default",
 /// "fast" or "T,B,A") or "raytrace" (sampling: "N,STEP,L0,exact|area"); kernel
 /// "radiometric" (default) or "thesis". spatial: True tabulates the weave up close beside the
@@ -174,6 +174,7 @@ pub fn bake(
                 ("refined", Variant::Refined),
                 ("thesis", Variant::Thesis),
                 ("sliced", Variant::Sliced),
+                ("sliced3d", Variant::Sliced3d),
             ],
         )?,
         samples,

@@ -73,9 +73,10 @@ impl PyTwoFaced {
             "refined" => Variant::Refined,
             "thesis" => Variant::Thesis,
             "sliced" => Variant::Sliced,
+            "sliced3d" => Variant::Sliced3d,
             other => {
                 return Err(PyValueError::new_err(format!(
-                    "variant: {other:?} is not one of \"refined\", \"thesis\", \"sliced\"; give one of them"
+                    "variant: {other:?} is not one of \"refined\", \"thesis\", \"sliced\", \"sliced3d\"; give one of them"
                 )))
             }
         };

@@ -726,6 +726,9 @@ pub enum VariantArg {
     /// Refined, with the side profiles taken slice by slice along each piece: closer to the
     /// ground truth (docs/model.md), about 2.5x the cost.
     Sliced,
+    /// Sliced, with what hides each slice's side taken in 3-D through the floats around the
+    /// piece: the closest to the ground truth (docs/model.md), about 300 times the cost.
+    Sliced3d,
 }
 
 impl From<VariantArg> for Variant {
@@ -734,6 +737,7 @@ impl From<VariantArg> for Variant {
             VariantArg::Thesis => Variant::Thesis,
             VariantArg::Refined => Variant::Refined,
             VariantArg::Sliced => Variant::Sliced,
+            VariantArg::Sliced3d => Variant::Sliced3d,
         }
     }
 }

@@ -219,7 +219,7 @@ fn end_interval(
     let seg = &u.seg;
     let hidden = table.active(psi).map_or(0.0, |o| match variant {
         Variant::Thesis => occluded_length(seg.top, o, psi),
-        Variant::Refined | Variant::Sliced => {
+        Variant::Refined | Variant::Sliced | Variant::Sliced3d => {
             mean_occluded_length(seg.radius, seg.height, o, psi, arc, e, y1 - y0)
         }
     });

@@ -792,7 +792,9 @@ fn end_interval(m: &AnalyticModel, u: &UnitLanes, v: &View, arc: &Arc, e: (F, F)
     }
     let hidden = match m.variant {
         Variant::Thesis => occluded_length(F::from_array(u.top), &o, psi),
-        Variant::Refined | Variant::Sliced => mean_occluded_length(u, &o, psi, arc, e, max_len),
+        Variant::Refined | Variant::Sliced | Variant::Sliced3d => {
+            mean_occluded_length(u, &o, psi, arc, e, max_len)
+        }
     };
     let hidden = some.select(hidden, F::splat(0.0));
     (plus.select(y0, y0 + hidden), plus.select(y1 - hidden, y1))
