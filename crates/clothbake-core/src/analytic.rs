@@ -2379,53 +2379,36 @@ mod tests {
         assert!(merges > 100, "{merges}");
     }
 
-    /// On parallel cylinders every slice's profile is the crossing row's: the sliced variant
-    /// is the refined one, to rounding, with and without the second bounce.
+    /// On parallel cylinders every slice's profile is the crossing row's, and the 3-D test meets
+    /// only endless neighbours: `sliced` is `refined` to rounding, `sliced3d` to the bisection's
+    /// precision (a sample spacing / 2^12 of the arc: within 1e-4), with and without the second
+    /// bounce, and so is the coverage.
     #[test]
-    fn sliced_is_refined_where_the_profile_is_constant() {
-        let f = fabric(
-            r#"{"pattern": [[1]], "warp": {"radius": 1, "spacing": 2}, "weft": {"radius": 1, "spacing": 2}}"#,
-        );
-        let opts = SecondaryOptions::default();
-        let refined = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Refined);
-        let sliced = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced);
-        for (wi, wo) in directions() {
-            let (a, b) = (
-                refined.intensity_with(wi, wo, Some(&opts)),
-                sliced.intensity_with(wi, wo, Some(&opts)),
-            );
-            for (x, y) in a.total().into_iter().zip(b.total()) {
-                assert!((x - y).abs() <= 1e-12 * x.abs().max(1e-12), "{x} {y}");
-            }
-            let (c, d) = (refined.coverage(wo), sliced.coverage(wo));
-            assert!((c - d).abs() <= 1e-12, "{c} {d}");
-        }
-    }
-
-    /// On parallel cylinders the cross-section profile is exact, and so is the 3-D test
-    /// (endless neighbours): `sliced3d` is `refined` to the bisection's precision (a sample
-    /// spacing / 2^12 of the arc: within 1e-4), with and without the secondary reflection.
-    #[test]
-    fn sliced3d_is_refined_on_parallel_cylinders() {
+    fn sliced_variants_are_refined_on_parallel_cylinders() {
         let f = fabric(
             r#"{"pattern": [[1]], "warp": {"radius": 1, "spacing": 2.3}, "weft": {"radius": 1, "spacing": 2}}"#,
         );
         let opts = SecondaryOptions::default();
         let refined = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Refined);
-        let s3 = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d);
-        assert_eq!(s3.variant().name(), "sliced3d");
-        for (wi, wo) in directions() {
-            for secondary in [None, Some(&opts)] {
-                let (a, b) = (
-                    refined.intensity_with(wi, wo, secondary),
-                    s3.intensity_with(wi, wo, secondary),
-                );
-                for (x, y) in a.total().into_iter().zip(b.total()) {
-                    assert!((x - y).abs() <= 1e-4 * x.abs().max(1e-6), "{x} {y}");
+        for (variant, tol) in [(Variant::Sliced, 1e-12), (Variant::Sliced3d, 1e-4)] {
+            let m = AnalyticModel::with_variant(&f, FacetModel::Huo, variant);
+            assert_eq!(m.variant(), variant);
+            for (wi, wo) in directions() {
+                for secondary in [None, Some(&opts)] {
+                    let (a, b) = (
+                        refined.intensity_with(wi, wo, secondary),
+                        m.intensity_with(wi, wo, secondary),
+                    );
+                    for (x, y) in a.total().into_iter().zip(b.total()) {
+                        assert!(
+                            (x - y).abs() <= tol * x.abs().max(1e-6),
+                            "{variant:?}: {x} {y}"
+                        );
+                    }
                 }
+                let (c, d) = (refined.coverage(wo), m.coverage(wo));
+                assert!((c - d).abs() <= tol, "{variant:?}: {c} {d}");
             }
-            let (c, d) = (refined.coverage(wo), s3.coverage(wo));
-            assert!((c - d).abs() <= 1e-4, "{c} {d}");
         }
     }
 
