@@ -194,6 +194,31 @@ pub enum Variant {
 /// (its profile taken at the middle of each part).
 pub const SLICE_PARTS: usize = 4;
 
+/// The most cells (warp x weft threads) a period may have for [`Variant::Sliced3d`], whose
+/// preprocessing grows faster than the period (docs/limits.md): about a minute and two
+/// gigabytes at this size for a random period.
+pub const SLICED3D_MAX_CELLS: usize = 16_384;
+
+/// Whether `variant` takes `fabric`'s period: `Err((problem, fix))` for [`Variant::Sliced3d`]
+/// on a period of more than [`SLICED3D_MAX_CELLS`] cells. Callers check before
+/// [`AnalyticModel::with_variant`], which would take minutes and gigabytes past it.
+pub fn check_variant(fabric: &Fabric, variant: Variant) -> Result<(), (String, String)> {
+    let w = fabric.weave();
+    let cells = w.n_warp() * w.n_weft();
+    if variant == Variant::Sliced3d && cells > SLICED3D_MAX_CELLS {
+        return Err((
+            format!(
+                "the variant sliced3d takes a period of at most {SLICED3D_MAX_CELLS} cells, and \
+                 this one has {} x {} = {cells}",
+                w.n_warp(),
+                w.n_weft()
+            ),
+            "use the variant sliced or refined for it (docs/limits.md)".to_string(),
+        ));
+    }
+    Ok(())
+}
+
 /// Parts each slice of a piece is split into by [`Variant::Sliced3d`]: under a crossing
 /// cylinder, elsewhere (what hides the arc taken at the middle of each part).
 pub const SLICE3D_PARTS: (usize, usize) = (8, 2);

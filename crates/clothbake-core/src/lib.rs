@@ -34,8 +34,8 @@ pub mod wif;
 pub mod yarn;
 
 pub use analytic::{
-    AnalyticModel, CellClass, ClassTerms, LocalReflection, SecondaryMethod, SecondaryOptions,
-    Variant,
+    check_variant, AnalyticModel, CellClass, ClassTerms, LocalReflection, SecondaryMethod,
+    SecondaryOptions, Variant, SLICED3D_MAX_CELLS,
 };
 pub use brdf::{AnalyticBsdf, Component};
 pub use cells::{Cell, CellGrid, PeriodPoint};

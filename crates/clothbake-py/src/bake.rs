@@ -210,6 +210,10 @@ pub fn bake(
         },
         spatial,
     };
+    if let Some(v) = settings.variant {
+        clothbake_core::check_variant(&fabric.fabric, v)
+            .map_err(|(problem, fix)| bad("variant", format!("{problem}; {fix}")))?;
+    }
     let options = settings
         .options(Naming::Python)
         .map_err(PyValueError::new_err)?;

@@ -80,6 +80,9 @@ impl PyTwoFaced {
                 )))
             }
         };
+        clothbake_core::check_variant(&fabric.fabric, variant).map_err(|(problem, fix)| {
+            PyValueError::new_err(format!("variant: {problem}; {fix}"))
+        })?;
         let cloth = TwoFaced::with_grid(&fabric.fabric, facet, variant, nodes, paths)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         py.detach(|| cloth.prepare());

@@ -424,6 +424,20 @@ def test_bad_bake_options_name_the_option(twill_path, kwargs, words):
         clothbake.bake(clothbake.Fabric(twill_path), res=(2, 4, 2, 4), **kwargs)
 
 
+def test_a_period_too_large_for_sliced3d_is_refused(twill_path):
+    """docs/limits.md: sliced3d takes periods of at most 16 384 cells; bake and two_faced refuse
+    a larger one before any work, naming the variant and the fix; sliced takes it."""
+    d = json.loads(twill_path.read_text())
+    n = 129
+    d["pattern"] = [[1 if (i * 7 + j * 3) % 5 < 2 else 0 for i in range(n)] for j in range(n)]
+    fab = clothbake.Fabric(d)
+    with pytest.raises(ValueError, match=r"variant: the variant sliced3d takes a period of at most 16384 cells.*129 x 129.*sliced or refined"):
+        clothbake.bake(fab, res=(2, 4, 2, 4), variant="sliced3d")
+    with pytest.raises(ValueError, match=r"variant: the variant sliced3d takes a period of at most 16384 cells"):
+        fab.two_faced(variant="sliced3d", nodes=(1, 1), paths=1)
+    assert clothbake.bake(fab, res=(1, 2, 1, 2), variant="sliced") is not None
+
+
 def test_version_is_the_crates_version():
     """Independent: the workspace's Cargo.toml, read as text."""
     import pathlib

@@ -272,6 +272,9 @@ fn job_error(e: JobError) -> CliError {
 pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     let plan = plan(weave, o)?;
     let fabric = load_fabric(&plan.weave, &o.draft, &o.material)?;
+    if let Some(v) = o.variant {
+        crate::eval_cmd::checked_variant(&plan.weave, &fabric, v)?;
+    }
     let what = if plan.shard.is_some() {
         "shard"
     } else {

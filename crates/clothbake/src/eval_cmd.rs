@@ -77,7 +77,8 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     });
     let (reflection, raytrace) = match args.method {
         Method::Analytic => {
-            let model = AnalyticModel::with_variant(&fabric, facet, args.model.variant.into());
+            let variant = checked_variant(&args.weave, &fabric, args.model.variant)?;
+            let model = AnalyticModel::with_variant(&fabric, facet, variant);
             let coverage = if horizon { 0.0 } else { model.coverage(wo) };
             let at = args.at.map(|p| (p, model.cells().cell_at(p)));
             // With --at the footprint's reflection replaces the period's in the report.
@@ -306,6 +307,19 @@ pub fn describe_secondary(o: &SecondaryOptions) -> String {
 
 /// Reads the fabric of `--weave` (JSON or WIF draft, with the draft's size flags; or a shipped
 /// fabric's name, [`crate::fabrics`]) and applies the material overrides.
+/// The analytic variant `v` for the fabric of `weave`, refused where it does not take the
+/// period (`clothbake_core::check_variant`: sliced3d's size limit).
+pub fn checked_variant(
+    weave: &Path,
+    fabric: &Fabric,
+    v: impl Into<Variant>,
+) -> Result<Variant, CliError> {
+    let v = v.into();
+    clothbake_core::check_variant(fabric, v)
+        .map_err(|(problem, fix)| CliError::new(format!("{}: {problem}", weave.display()), fix))?;
+    Ok(v)
+}
+
 pub fn load_fabric(weave: &Path, draft: &DraftArgs, m: &MaterialArgs) -> Result<Fabric, CliError> {
     if draft.any() && !crate::fabrics::is_draft(weave) {
         return Err(CliError::new(

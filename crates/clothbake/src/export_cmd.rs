@@ -201,11 +201,9 @@ fn model_of(
     )?;
     refuse_existing(args)?;
     let facet = FacetModel::from(args.facet.unwrap_or(crate::cli::FacetArg::Huo));
-    Ok((
-        fabric,
-        facet,
-        args.variant.unwrap_or(crate::cli::VariantArg::Refined),
-    ))
+    let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);
+    crate::eval_cmd::checked_variant(weave, &fabric, variant)?;
+    Ok((fabric, facet, variant))
 }
 
 fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {

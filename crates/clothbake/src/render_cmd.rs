@@ -32,6 +32,7 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
         crate::fabrics::read(weave, &Default::default())?,
         &b.material,
     )?;
+    let variant = crate::eval_cmd::checked_variant(weave, &fabric, b.model.variant)?;
     if b.bounces.bounces > 2 {
         // Full transport: the analytic terms plus the path-traced orders (docs/transport.md),
         // whole only.
@@ -48,7 +49,7 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
         let ft = clothbake_bake::transport::FullTransport::new(
             &fabric,
             FacetModel::from(b.model.facet),
-            b.model.variant.into(),
+            variant,
             b.bounces.bounces,
         );
         return Ok(Shader::new(Box::new(ft)));
@@ -56,7 +57,7 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
     Shader::model(
         &fabric,
         FacetModel::from(b.model.facet),
-        b.model.variant.into(),
+        variant,
         secondary,
         component,
     )
@@ -122,12 +123,9 @@ fn two_faced_shader(a: &RenderArgs) -> Result<Shader, CliError> {
         crate::fabrics::read(weave, &Default::default())?,
         &a.brdf.material,
     )?;
-    Shader::two_faced(
-        &fabric,
-        FacetModel::from(a.brdf.model.facet),
-        a.brdf.model.variant.into(),
-    )
-    .map_err(CliError::line)
+    let variant = crate::eval_cmd::checked_variant(weave, &fabric, a.brdf.model.variant)?;
+    Shader::two_faced(&fabric, FacetModel::from(a.brdf.model.facet), variant)
+        .map_err(CliError::line)
 }
 
 /// The ground truth's shader of `render --truth`: the fabric of --weave, one bounce, with

@@ -52,7 +52,9 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     let facet = FacetModel::from(args.model.facet);
     let (f, std_err, openness, how) = match args.method {
         Method::Analytic => {
-            let tf = TwoFaced::new(&fabric, facet, args.model.variant.into())?;
+            let variant =
+                crate::eval_cmd::checked_variant(&args.weave, &fabric, args.model.variant)?;
+            let tf = TwoFaced::new(&fabric, facet, variant)?;
             (
                 tf.f(wi, wo),
                 None,

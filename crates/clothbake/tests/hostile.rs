@@ -866,3 +866,99 @@ fn a_draft_with_cr_line_endings_reads_like_lf() {
     let (a, b) = (eval("lf.wif"), eval("cr.wif"));
     assert_eq!(a.replace("lf.wif", "cr.wif"), b);
 }
+
+/// A period larger than `--variant sliced3d` takes (docs/limits.md: 16 384 cells) is refused by
+/// every command that builds the model, with one line naming the file, the variant, the size
+/// and the fix, before any work on it; the same period is evaluated with the other variants.
+#[test]
+fn a_period_too_large_for_sliced3d_is_refused_before_work() {
+    let d = fresh_dir("hostile", "sliced3d");
+    let n = 129;
+    let rows: Vec<String> = (0..n)
+        .map(|j| {
+            let row: Vec<&str> = (0..n)
+                .map(|i| if (i * 7 + j * 3) % 5 < 2 { "1" } else { "0" })
+                .collect();
+            format!("[{}]", row.join(","))
+        })
+        .collect();
+    let json = format!(
+        r#"{{"pattern": [{}], "warp": {{"radius": 1.5, "spacing": 3.1}}, "weft": {{"radius": 1.5, "spacing": 3.1}}}}"#,
+        rows.join(",")
+    );
+    std::fs::write(d.join("big.json"), json).unwrap();
+    let cases: [&[&str]; 4] = [
+        &[
+            "eval",
+            "--weave",
+            "big.json",
+            "--variant",
+            "sliced3d",
+            "--wi",
+            "30,0",
+            "--wo",
+            "45,180",
+        ],
+        &[
+            "bake",
+            "--weave",
+            "big.json",
+            "--variant",
+            "sliced3d",
+            "--res",
+            "2,4,2,4",
+            "-o",
+            "b.exr",
+        ],
+        &[
+            "render",
+            "--weave",
+            "big.json",
+            "--variant",
+            "sliced3d",
+            "-o",
+            "r.png",
+        ],
+        &[
+            "export",
+            "--weave",
+            "big.json",
+            "--variant",
+            "sliced3d",
+            "--merl",
+            "m.binary",
+        ],
+    ];
+    for args in cases {
+        let out = run_in(&d, args);
+        common::fails_with(
+            &out,
+            2,
+            &[
+                "big.json",
+                "sliced3d",
+                "16384 cells",
+                "129 x 129",
+                "sliced or refined",
+            ],
+        );
+    }
+    for f in ["b.exr", "r.png", "m.binary"] {
+        assert!(!d.join(f).exists(), "{f} written");
+    }
+    let out = run_in(
+        &d,
+        &[
+            "eval",
+            "--weave",
+            "big.json",
+            "--variant",
+            "sliced",
+            "--wi",
+            "30,0",
+            "--wo",
+            "45,180",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+}
