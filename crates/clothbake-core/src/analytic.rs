@@ -85,7 +85,7 @@ struct Unit {
 
 /// Parts of a piece's range along which its cross-section profile is one and the same
 /// ([`Variant::Sliced`]): the parts with equal side tables together, so that their arcs are
-/// computed once.
+/// computed once. With [`Variant::Sliced3d`] one range each and empty tables (`slice_arc`).
 #[derive(Clone, Debug)]
 struct Slice {
     ranges: Vec<(f64, f64)>,
@@ -981,12 +981,18 @@ impl AnalyticModel {
                 let mut slices: Vec<Slice> = Vec::new();
                 let around =
                     (variant == Variant::Sliced3d).then(|| around::Around::of(&geo, seg, (lo, hi)));
-                if matches!(variant, Variant::Sliced | Variant::Sliced3d) {
-                    let parts = match variant {
-                        Variant::Sliced3d => SLICE3D_PARTS,
-                        _ => (SLICE_PARTS, 1),
-                    };
-                    for (range, _) in slices_of(&geo, seg, k, (lo, hi), parts) {
+                if variant == Variant::Sliced3d {
+                    // Each slice sees its own surroundings (`around`): one range a slice, and no
+                    // side tables (what hides its arc is found in 3-D).
+                    for (range, _) in slices_of(&geo, seg, k, (lo, hi), SLICE3D_PARTS) {
+                        slices.push(Slice {
+                            ranges: vec![range],
+                            side_plus: ActiveTable::default(),
+                            side_minus: ActiveTable::default(),
+                        });
+                    }
+                } else if variant == Variant::Sliced {
+                    for (range, _) in slices_of(&geo, seg, k, (lo, hi), (SLICE_PARTS, 1)) {
                         let table = |dir| {
                             let profile: Vec<Occluder> =
                                 slice_profile(&geo, seg, k, range, dir).collect();
@@ -996,13 +1002,10 @@ impl AnalyticModel {
                         let alike = |a: &ActiveTable, b: &ActiveTable| {
                             tables_alike(a, b, KEY_TOLERANCE * unit_len)
                         };
-                        // In 3-D each slice sees its own surroundings: no two are alike.
-                        let same = |s: &Slice| {
-                            around.is_none()
-                                && alike(&s.side_plus, &plus)
-                                && alike(&s.side_minus, &minus)
-                        };
-                        match slices.iter_mut().find(|s| same(s)) {
+                        match slices
+                            .iter_mut()
+                            .find(|s| alike(&s.side_plus, &plus) && alike(&s.side_minus, &minus))
+                        {
                             Some(s) => s.ranges.push(range),
                             None => slices.push(Slice {
                                 ranges: vec![range],

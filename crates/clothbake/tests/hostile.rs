@@ -29,6 +29,16 @@ fn denim_with(old: &str, new: &str) -> String {
     wif.replacen(old, new, 1)
 }
 
+/// A fabric of `rows` identical rows of `pairs` "1,0" pairs (`rows` x 2 `pairs` cells).
+fn period(rows: usize, pairs: usize) -> String {
+    let row = format!("[{}]", vec!["1,0"; pairs].join(","));
+    format!(
+        r#"{{"pattern": [{}], "warp": {{"radius": 1, "spacing": 2.5}},
+            "weft": {{"radius": 1, "spacing": 2.5}}}}"#,
+        vec![row.as_str(); rows].join(",")
+    )
+}
+
 /// Writes the hostile input files into `d`.
 fn inputs(d: &Path) {
     let w = |name: &str, bytes: &[u8]| std::fs::write(d.join(name), bytes).unwrap();
@@ -94,14 +104,6 @@ fn inputs(d: &Path) {
         denim_with("1=21,46,110", "1=21,46,1100").as_bytes(),
     );
     // Periods past the limits: one row of 70 000 columns; 2000 rows of 2000.
-    let period = |rows: usize, pairs: usize| {
-        let row = format!("[{}]", vec!["1,0"; pairs].join(","));
-        format!(
-            r#"{{"pattern": [{}], "warp": {{"radius": 1, "spacing": 2.5}},
-                "weft": {{"radius": 1, "spacing": 2.5}}}}"#,
-            vec![row.as_str(); rows].join(",")
-        )
-    };
     w("wide.json", period(1, 35_000).as_bytes());
     w("cells.json", period(2000, 1000).as_bytes());
     std::fs::copy(fabric("twill"), d.join("self.json")).unwrap();
@@ -873,20 +875,8 @@ fn a_draft_with_cr_line_endings_reads_like_lf() {
 #[test]
 fn a_period_too_large_for_sliced3d_is_refused_before_work() {
     let d = fresh_dir("hostile", "sliced3d");
-    let n = 129;
-    let rows: Vec<String> = (0..n)
-        .map(|j| {
-            let row: Vec<&str> = (0..n)
-                .map(|i| if (i * 7 + j * 3) % 5 < 2 { "1" } else { "0" })
-                .collect();
-            format!("[{}]", row.join(","))
-        })
-        .collect();
-    let json = format!(
-        r#"{{"pattern": [{}], "warp": {{"radius": 1.5, "spacing": 3.1}}, "weft": {{"radius": 1.5, "spacing": 3.1}}}}"#,
-        rows.join(",")
-    );
-    std::fs::write(d.join("big.json"), json).unwrap();
+    // 130 x 129 = 16 770 cells.
+    std::fs::write(d.join("big.json"), period(129, 65)).unwrap();
     let cases: [&[&str]; 4] = [
         &[
             "eval",
@@ -938,7 +928,7 @@ fn a_period_too_large_for_sliced3d_is_refused_before_work() {
                 "big.json",
                 "sliced3d",
                 "16384 cells",
-                "129 x 129",
+                "130 x 129",
                 "sliced or refined",
             ],
         );
