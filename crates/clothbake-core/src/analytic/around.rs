@@ -24,6 +24,7 @@
 use super::View;
 use crate::arc::ArcTrig;
 use crate::geometry::{Geometry, Segment};
+use std::f64::consts::FRAC_PI_2;
 
 /// Points the arc is sampled at (its ends included).
 const SAMPLES: usize = 16;
@@ -171,49 +172,52 @@ impl Around {
     }
 
     /// Whether the ray from `p` = (c, a, z) along `d` (rising: d.z > 0) meets a float.
+    #[cfg(test)]
     fn blocks(&self, p: [f64; 3], d: [f64; 3]) -> bool {
-        // Beyond this horizontal distance the ray is above every yarn.
-        let reach = (self.top - p[2]).max(0.0) / d[2] * d[0].hypot(d[1]);
+        let all: Vec<&Cylinder> = self.cylinders.iter().collect();
+        blocks_among(&all, self.top, p, d, d[0].hypot(d[1]))
+    }
+
+    /// The floats, nearest first, that a ray along `d` (rising) from a point of the box
+    /// `(lo, hi)` (corners (c, a, z)) can meet below the highest top: those whose bounding box
+    /// the box swept along `d` meets. Every float [`blocks_among`] can find such a ray to meet
+    /// is among them (both boxes grown by a rounding margin).
+    fn candidates(&self, lo: [f64; 3], hi: [f64; 3], d: [f64; 3]) -> Vec<&Cylinder> {
+        let margin = 1e-9 * self.top.abs().max(hi[0] - lo[0]).max(hi[2] - lo[2]);
+        let s_max = (self.top - lo[2]).max(0.0) / d[2] + margin;
+        let reach = s_max * d[0].hypot(d[1]) + margin;
+        let mut out = Vec::new();
         for q in &self.cylinders {
             if q.distance > reach {
                 break;
             }
-            // The ray in the plane perpendicular to the cylinder's axis (u, w) and along it (s).
-            let (u0, du, s0, ds) = if q.across {
-                (p[1] - q.at.0, d[1], p[0], d[0])
+            let r = (q.at.0 - q.radius, q.at.0 + q.radius);
+            let (c, a) = if q.across {
+                (q.extent, r)
             } else {
-                (p[0] - q.at.0, d[0], p[1], d[1])
+                (r, q.extent)
             };
-            let (w0, dw) = (p[2] - q.at.1, d[2]);
-            // Where the ray is within the cylinder's extent along its axis.
-            let (ta, tb) = if ds == 0.0 {
-                if q.extent.0 <= s0 && s0 <= q.extent.1 {
-                    (f64::NEG_INFINITY, f64::INFINITY)
+            let z = (q.at.1 - q.radius, q.at.1 + q.radius);
+            let (mut s0, mut s1) = (0.0f64, s_max);
+            for (k, (b0, b1)) in [c, a, z].into_iter().enumerate() {
+                let (b0, b1) = (b0 - margin, b1 + margin);
+                let (p0, p1) = (lo[k] - margin, hi[k] + margin);
+                // The s where [p0, p1] + s d[k] meets [b0, b1].
+                if d[k] == 0.0 {
+                    if p0 > b1 || p1 < b0 {
+                        s1 = -1.0;
+                    }
                 } else {
-                    continue;
+                    let (x, y) = ((b0 - p1) / d[k], (b1 - p0) / d[k]);
+                    s0 = s0.max(x.min(y));
+                    s1 = s1.min(x.max(y));
                 }
-            } else {
-                let (x, y) = ((q.extent.0 - s0) / ds, (q.extent.1 - s0) / ds);
-                (x.min(y), x.max(y))
-            };
-            if tb <= 0.0 {
-                continue;
             }
-            // Where it is within the cylinder's cross-section: a*t^2 + 2 b t + c <= 0.
-            let a = du * du + dw * dw;
-            let b = u0 * du + w0 * dw;
-            let c = u0 * u0 + w0 * w0 - q.radius * q.radius;
-            let disc = b * b - a * c;
-            if disc <= 0.0 {
-                continue;
-            }
-            let root = disc.sqrt();
-            let (t1, t2) = ((-b - root) / a, (-b + root) / a);
-            if t2.min(tb) > t1.max(ta).max(0.0) {
-                return true;
+            if s0 <= s1 {
+                out.push(q);
             }
         }
-        false
+        out
     }
 
     /// The part of `arc` (of a cross-section of `radius` with its axis at `height`, at axial
@@ -231,11 +235,42 @@ impl Around {
             return arc;
         }
         let d = [v.p.p.c, v.va, v.p.p.z];
+        let (lo, hi) = (arc.arc.lo, arc.arc.hi);
+        // The box of the arc's points: its ends, and the extremes of the circle it passes.
+        let (mut s_range, mut c_range) = (
+            (arc.lo.0.min(arc.hi.0), arc.lo.0.max(arc.hi.0)),
+            (arc.lo.1.min(arc.hi.1), arc.lo.1.max(arc.hi.1)),
+        );
+        for k in -4i32..=8 {
+            let t = f64::from(k) * FRAC_PI_2;
+            if lo <= t && t <= hi {
+                match k.rem_euclid(4) {
+                    0 => c_range.1 = 1.0,
+                    1 => s_range.1 = 1.0,
+                    2 => c_range.0 = -1.0,
+                    _ => s_range.0 = -1.0,
+                }
+            }
+        }
+        let floats = self.candidates(
+            [radius * c_range.0, a, height + radius * s_range.0],
+            [radius * c_range.1, a, height + radius * s_range.1],
+            d,
+        );
+        if floats.is_empty() {
+            return arc;
+        }
+        let horizontal = d[0].hypot(d[1]);
         let hidden = |t: f64| {
             let (s, c) = t.sin_cos();
-            self.blocks([radius * c, a, height + radius * s], d)
+            blocks_among(
+                &floats,
+                self.top,
+                [radius * c, a, height + radius * s],
+                d,
+                horizontal,
+            )
         };
-        let (lo, hi) = (arc.arc.lo, arc.arc.hi);
         let at = |k: usize| lo + (hi - lo) * k as f64 / (SAMPLES - 1) as f64;
         // The longest run of visible samples: (first, last).
         let (mut best, mut run): (Option<(usize, usize)>, Option<usize>) = (None, None);
@@ -279,6 +314,53 @@ impl Around {
         }
         out
     }
+}
+
+/// Whether the ray from `p` = (c, a, z) along `d` (rising: d.z > 0) meets one of `floats`
+/// (nearest first) below `top`; `horizontal` is |(d.c, d.a)|.
+fn blocks_among(floats: &[&Cylinder], top: f64, p: [f64; 3], d: [f64; 3], horizontal: f64) -> bool {
+    // Beyond this horizontal distance the ray is above every yarn.
+    let reach = (top - p[2]).max(0.0) / d[2] * horizontal;
+    for q in floats {
+        if q.distance > reach {
+            break;
+        }
+        // The ray in the plane perpendicular to the cylinder's axis (u, w) and along it (s).
+        let (u0, du, s0, ds) = if q.across {
+            (p[1] - q.at.0, d[1], p[0], d[0])
+        } else {
+            (p[0] - q.at.0, d[0], p[1], d[1])
+        };
+        let (w0, dw) = (p[2] - q.at.1, d[2]);
+        // Where the ray is within the cylinder's extent along its axis.
+        let (ta, tb) = if ds == 0.0 {
+            if q.extent.0 <= s0 && s0 <= q.extent.1 {
+                (f64::NEG_INFINITY, f64::INFINITY)
+            } else {
+                continue;
+            }
+        } else {
+            let (x, y) = ((q.extent.0 - s0) / ds, (q.extent.1 - s0) / ds);
+            (x.min(y), x.max(y))
+        };
+        if tb <= 0.0 {
+            continue;
+        }
+        // Where it is within the cylinder's cross-section: a*t^2 + 2 b t + c <= 0.
+        let a = du * du + dw * dw;
+        let b = u0 * du + w0 * dw;
+        let c = u0 * u0 + w0 * w0 - q.radius * q.radius;
+        let disc = b * b - a * c;
+        if disc <= 0.0 {
+            continue;
+        }
+        let root = disc.sqrt();
+        let (t1, t2) = ((-b - root) / a, (-b + root) / a);
+        if t2.min(tb) > t1.max(ta).max(0.0) {
+            return true;
+        }
+    }
+    false
 }
 
 #[cfg(test)]
@@ -355,5 +437,70 @@ mod tests {
         }
         assert!(n > 1000, "{n} rays");
         assert!(differ * 200 <= n, "{differ} of {n} rays differ");
+    }
+
+    /// The floats [`Around::candidates`] keeps for a box of start points and a direction
+    /// hold every one that a ray from the box meets: `blocks` through them and through all
+    /// floats agree, from random points of random boxes within each piece's cross-section
+    /// toward random directions (grazing ones included), on the same two fabrics.
+    #[test]
+    fn the_floats_kept_for_a_box_hold_every_one_its_rays_meet() {
+        let fabrics = [
+            r#"{"pattern": [[1,1,0],[0,1,1],[1,0,1]],
+                "warp": {"radius": 1.5, "spacing": 3.1}, "weft": {"radius": 1.5, "spacing": 3.1}}"#,
+            r#"{"pattern": [[1,0],[0,1]],
+                "warp": {"radius": 1.0, "height": 0.3, "spacing": 3.0},
+                "weft": {"radius": 0.8, "height": -0.2, "spacing": 2.5}}"#,
+        ];
+        let mut rng = Rng::new(5);
+        let (mut n, mut hits, mut kept, mut all) = (0, 0, 0, 0);
+        for json in fabrics {
+            let f = Fabric::from_json_str(json, "t").unwrap();
+            let geo = Geometry::new(&f);
+            for seg in &geo.segments {
+                let (e0, e1) = seg.extent.unwrap();
+                let around = Around::of(&geo, seg, (e0, e1));
+                for _ in 0..200 {
+                    let a = e0 + (e1 - e0) * rng.next_f64();
+                    let mut box_of = |r: f64| {
+                        let (x, y) = (
+                            r * (2.0 * rng.next_f64() - 1.0),
+                            r * (2.0 * rng.next_f64() - 1.0),
+                        );
+                        (x.min(y), x.max(y))
+                    };
+                    let (c, z) = (box_of(seg.radius), box_of(seg.radius));
+                    let ct = 0.02 + 0.98 * rng.next_f64();
+                    let phi = 2.0 * std::f64::consts::PI * rng.next_f64();
+                    let st = (1.0 - ct * ct).sqrt();
+                    let d = [st * phi.cos(), st * phi.sin(), ct];
+                    let (lo, hi) = ([c.0, a, seg.height + z.0], [c.1, a, seg.height + z.1]);
+                    let floats = around.candidates(lo, hi, d);
+                    kept += floats.len();
+                    all += around.cylinders.len();
+                    for _ in 0..20 {
+                        let p = [
+                            c.0 + (c.1 - c.0) * rng.next_f64(),
+                            a,
+                            seg.height + z.0 + (z.1 - z.0) * rng.next_f64(),
+                        ];
+                        let hit = around.blocks(p, d);
+                        n += 1;
+                        hits += usize::from(hit);
+                        assert_eq!(
+                            hit,
+                            blocks_among(&floats, around.top, p, d, d[0].hypot(d[1])),
+                            "ray from {p:?} along {d:?}"
+                        );
+                    }
+                }
+            }
+        }
+        // Not vacuous: many rays meet a float, and the box keeps few of the floats.
+        assert!(
+            hits * 5 > n && hits * 5 < 4 * n,
+            "{hits} of {n} rays meet a float"
+        );
+        assert!(kept * 10 < all, "kept {kept} of {all}");
     }
 }
