@@ -477,6 +477,33 @@ fn batched(bsdf: Arc<dyn Bsdf + Send + Sync>) -> CellFn {
     })
 }
 
+/// The most memory a bake gives to a [`Variant::Sliced3d`] model's open arcs kept for the
+/// grid's directions (docs/baking.md).
+pub const OPEN_ARCS_BUDGET: usize = 256 << 20;
+
+/// Model `m` with the open arcs of every direction of grid `g` kept
+/// ([`AnalyticModel::keep_open_arcs`], found in parallel), where they fit in
+/// [`OPEN_ARCS_BUDGET`]: the same bits, each direction's arcs found once rather than once a
+/// pair. Other variants' models are given back as they are.
+fn with_grid_arcs(mut m: AnalyticModel, g: &Grid) -> AnalyticModel {
+    let slices = m.open_arc_slices();
+    let incident = (0..g.n_theta_i).flat_map(|t| (0..g.n_phi_i).map(move |p| incident(g, t, p)));
+    let outgoing = (0..g.n_theta_o).flat_map(|t| (0..g.n_phi_o).map(move |p| outgoing(g, t, p)));
+    let mut dirs: Vec<UnitVec3> = incident.chain(outgoing).collect();
+    let key = |w: &UnitVec3| {
+        let v = w.get();
+        [v.x, v.y, v.z].map(f64::to_bits)
+    };
+    dirs.sort_by_key(key);
+    dirs.dedup_by_key(|w| key(w));
+    if slices == 0 || dirs.len().saturating_mul(slices) > OPEN_ARCS_BUDGET / 48 {
+        return m;
+    }
+    let arcs: Vec<_> = dirs.par_iter().map(|&w| (w, m.open_arcs(w))).collect();
+    m.keep_open_arcs(arcs);
+    m
+}
+
 /// A prepared bake: the cell evaluator, the orbits and the metadata of the table it makes.
 /// Rows are evaluated independently ([`Baker::eval_row`]), by one process ([`bake`]) or by
 /// several (shards, `clothbake merge`), with the same values.
@@ -517,7 +544,8 @@ impl Baker {
         let eval: CellFn = match (opts.method, multiple.clone()) {
             _ if two_faced.is_some() => batched(two_faced.clone().expect("matched")),
             (Method::Analytic { variant }, None) if opts.spatial => {
-                let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
+                let m =
+                    with_grid_arcs(AnalyticModel::with_variant(fabric, opts.facet, variant), &g);
                 let layout = crate::spatial::layout(&m, &g, secondary.is_some())
                     .map_err(BakeError::Invalid)?;
                 syms.clear();
@@ -555,7 +583,8 @@ impl Baker {
                 per_cell(move |_, wi, wo, out| out.push(ft.f(wi, wo).map(|x| x as f32)))
             }
             (Method::Analytic { variant }, None) => {
-                let m = AnalyticModel::with_variant(fabric, opts.facet, variant);
+                let m =
+                    with_grid_arcs(AnalyticModel::with_variant(fabric, opts.facet, variant), &g);
                 // One bounce: four pairs at a time (AnalyticBsdf::f_batch), the same bits.
                 batched(Arc::new(AnalyticBsdf::new(m, secondary)))
             }
@@ -852,5 +881,35 @@ mod tests {
         assert_eq!(canonical, 16);
         assert_eq!(representative(5, 3, &[], &g), (5, 3));
         assert_eq!(representative(5, 3, &[Symmetry::Rotate180], &g), (1, 7));
+    }
+
+    /// A sliced3d bake keeps the open arcs of every direction of its grid, and its model gives
+    /// the bits of one that keeps none at every pair of the grid (with and without I_2).
+    #[test]
+    fn a_sliced3d_bake_keeps_its_grids_arcs_with_the_same_bits() {
+        let f = twill();
+        let g = Grid::new(5, 8, 4, 12);
+        let plain = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d);
+        let kept = with_grid_arcs(plain.clone(), &g);
+        // 5 x 8 incident and 4 x 12 outgoing directions, none shared.
+        assert_eq!(kept.open_arcs_kept(), 5 * 8 + 4 * 12);
+        let (plain, kept) = (
+            AnalyticBsdf::new(plain, None),
+            AnalyticBsdf::new(kept, Some(SecondaryOptions::default())),
+        );
+        let both = AnalyticBsdf::new(
+            AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d),
+            Some(SecondaryOptions::default()),
+        );
+        let direct = AnalyticBsdf::new(with_grid_arcs(both.model().clone(), &g), None);
+        for (ti, pi) in (0..5).flat_map(|t| (0..8).map(move |p| (t, p))) {
+            for (to, po) in (0..4).flat_map(|t| (0..12).map(move |p| (t, p))) {
+                let (wi, wo) = (incident(&g, ti, pi), outgoing(&g, to, po));
+                assert_eq!(direct.f(wi, wo), plain.f(wi, wo));
+                assert_eq!(kept.f(wi, wo), both.f(wi, wo));
+            }
+        }
+        let refined = with_grid_arcs(AnalyticModel::new(&f, FacetModel::Huo), &g);
+        assert_eq!(refined.open_arcs_kept(), 0);
     }
 }

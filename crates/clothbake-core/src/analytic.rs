@@ -81,6 +81,9 @@ struct Unit {
     /// [`Variant::Sliced3d`]: the floats around the piece, which decide what hides its slices'
     /// sides (each slice then one range).
     around: Option<around::Around>,
+    /// The number of its first slice among the model's slices with `around` (their open arcs'
+    /// order, [`AnalyticModel::open_arcs`]).
+    first_slice: usize,
 }
 
 /// Parts of a piece's range along which its cross-section profile is one and the same
@@ -256,6 +259,8 @@ pub struct AnalyticModel {
     bounce_unit: Vec<(u32, u32)>,
     /// The units in AVX2 lanes, where the processor and the closed forms take them (`batch`).
     lanes: Option<batch::Lanes>,
+    /// [`Variant::Sliced3d`]: the open arcs kept for directions given in advance.
+    arc_store: open_arcs::ArcStore,
 }
 
 /// A class's reflection for one pair of directions, per unit diffuse albedo
@@ -320,6 +325,9 @@ struct View {
     va: f64,
     /// Elevation along the axis from the end it comes from; `None` across it (|V.a| <= EPS).
     end: Option<Elevation>,
+    /// [`Variant::Sliced3d`]: the place of the direction's open arcs in the model's store,
+    /// where kept ([`AnalyticModel::keep_open_arcs`]).
+    kept: Option<u32>,
 }
 
 impl View {
@@ -351,6 +359,7 @@ impl View {
             side: (vc.abs() > EPS).then_some((ec, mirrored)),
             va,
             end: (va.abs() > EPS).then_some(ea),
+            kept: None,
         }
     }
 }
@@ -1076,6 +1085,7 @@ impl AnalyticModel {
                         count: 1,
                         slices,
                         around,
+                        first_slice: 0,
                     });
                     continue;
                 };
@@ -1118,7 +1128,13 @@ impl AnalyticModel {
                 }
             })
             .collect();
+        let mut first_slice = 0;
+        for u in units.iter_mut().filter(|u| u.around.is_some()) {
+            u.first_slice = first_slice;
+            first_slice += u.slices.len();
+        }
         AnalyticModel {
+            arc_store: open_arcs::ArcStore::default(),
             facet,
             variant,
             lanes: if variant == Variant::Sliced3d {
@@ -1203,7 +1219,7 @@ impl AnalyticModel {
         }
         let mut sums = Sums::default();
         let mut i_2 = Secondary::default();
-        let views = Views::both(wi, wo);
+        let views = self.views(wi, wo);
         for u in &self.units {
             let v = &views[u.seg.group as usize];
             let Some(t) = self.unit_terms(u, &u.neighbours, v, wi, wo, secondary, false) else {
@@ -1243,15 +1259,16 @@ impl AnalyticModel {
         let (l_v, s_v) = u
             .slices
             .iter()
-            .filter_map(|sl| self.slice_visible(u, sl, e))
+            .enumerate()
+            .filter_map(|(k, sl)| self.slice_visible(u, k, sl, e))
             .fold((0.0, 0.0), |(l, s), v| (l + v.l_v, s + v.l_v * v.width));
         (l_v > 0.0).then(|| (l_v, s_v / l_v))
     }
 
-    /// What of the slice `sl` of unit `u` the eye's view `e` sees ([`Visible`] over the
-    /// slice's ranges).
-    fn slice_visible(&self, u: &Unit, sl: &Slice, e: &View) -> Option<Visible> {
-        self.visible_of(u, &sl.ranges, e, slice_arc(u, sl, e))
+    /// What of the slice `sl` (its `k`th) of unit `u` the eye's view `e` sees ([`Visible`]
+    /// over the slice's ranges).
+    fn slice_visible(&self, u: &Unit, k: usize, sl: &Slice, e: &View) -> Option<Visible> {
+        self.visible_of(u, &sl.ranges, e, self.slice_arc(u, k, sl, e))
     }
 
     /// As [`AnalyticModel::visible`] over the parts `ranges` of the piece, given the arc of the
@@ -1354,11 +1371,11 @@ impl AnalyticModel {
                 .collect(),
             None => Vec::new(),
         };
-        for sl in &u.slices {
-            let Some(v) = self.slice_visible(u, sl, &views.e) else {
+        for (k, sl) in u.slices.iter().enumerate() {
+            let Some(v) = self.slice_visible(u, k, sl, &views.e) else {
                 continue;
             };
-            let lit = slice_arc(u, sl, &views.l);
+            let lit = self.slice_arc(u, k, sl, &views.l);
             sums.seen(v.l_v, v.width);
             if let Some(opts) = secondary {
                 let (l, e) = (wi.get(), wo.get());
@@ -1429,7 +1446,7 @@ impl AnalyticModel {
         let (unit, variant) = self.cell_units[self.grid.index(cell)];
         let u = &self.units[unit as usize];
         let variants = std::slice::from_ref(&u.neighbours[variant as usize]);
-        let views = Views::both(wi, wo)[u.seg.group as usize];
+        let views = self.views(wi, wo)[u.seg.group as usize];
         let Some(t) = self.unit_terms(u, variants, &views, wi, wo, secondary, false) else {
             return empty;
         };
@@ -1477,7 +1494,7 @@ impl AnalyticModel {
         if !(wi.above_horizon() && wo.above_horizon()) {
             return;
         }
-        let views = Views::both(wi, wo);
+        let views = self.views(wi, wo);
         for (o, &u) in out.iter_mut().zip(&self.class_unit) {
             let u = &self.units[u as usize];
             let v = &views[u.seg.group as usize];
@@ -1605,7 +1622,7 @@ impl AnalyticModel {
         if !(wi.above_horizon() && wo.above_horizon()) {
             return;
         }
-        let views = Views::both(wi, wo);
+        let views = self.views(wi, wo);
         // I_2 of a cell is its piece's, per unit visible length, over the visible width.
         let f = |x: f64, width: f64| intensity_to_brdf([x / width, 0.0, 0.0], wi)[0];
         for (o, &(u, var)) in out.iter_mut().zip(&self.bounce_unit) {
@@ -1726,8 +1743,10 @@ impl AnalyticModel {
                 } else {
                     u.slices
                         .iter()
-                        .filter_map(|sl| {
-                            lit_area(&sl.ranges, slice_arc(u, sl, &v.e), slice_arc(u, sl, &v.l))
+                        .enumerate()
+                        .filter_map(|(k, sl)| {
+                            let arc = |w: &View| self.slice_arc(u, k, sl, w);
+                            lit_area(&sl.ranges, arc(&v.e), arc(&v.l))
                         })
                         .sum()
                 };
@@ -1813,20 +1832,37 @@ impl AnalyticModel {
     fn side_arc(&self, u: &Unit, v: &View) -> ArcTrig {
         side_arc_in(&u.seg, (&u.side_plus, &u.side_minus), v)
     }
-}
 
-/// The arc of slice `sl` of unit `u` that faces `v` above the floor and that nothing beside
-/// it hides: by the slice's side tables, or ([`Variant::Sliced3d`]) by the floats around the
-/// piece at the middle of the slice's one range.
-fn slice_arc(u: &Unit, sl: &Slice, v: &View) -> ArcTrig {
-    let seg = &u.seg;
-    match &u.around {
-        Some(around) => {
-            let (y0, y1) = sl.ranges[0];
-            let arc = ArcTrig::facing(&v.p).meet(&seg.floor);
-            around.open_arc(seg.radius, seg.height, 0.5 * (y0 + y1), v, arc)
+    /// The arc of slice `sl` (its `k`th) of unit `u` that faces `v` above the floor and that
+    /// nothing beside it hides: by the slice's side tables, or ([`Variant::Sliced3d`]) by the
+    /// floats around the piece at the middle of the slice's one range (kept, where `v`'s
+    /// direction's arcs are).
+    fn slice_arc(&self, u: &Unit, k: usize, sl: &Slice, v: &View) -> ArcTrig {
+        let seg = &u.seg;
+        match &u.around {
+            Some(around) => {
+                if let Some(place) = v.kept {
+                    return self.arc_store.arc(place, u.first_slice + k);
+                }
+                let (y0, y1) = sl.ranges[0];
+                let arc = ArcTrig::facing(&v.p).meet(&seg.floor);
+                around.open_arc(seg.radius, seg.height, 0.5 * (y0 + y1), v, arc)
+            }
+            None => side_arc_in(seg, sl.tables(), v).meet(&seg.floor),
         }
-        None => side_arc_in(seg, sl.tables(), v).meet(&seg.floor),
+    }
+
+    /// [`Views::both`], with the places of the directions' open arcs where kept.
+    fn views(&self, wi: UnitVec3, wo: UnitVec3) -> [Views; 2] {
+        let mut views = Views::both(wi, wo);
+        let (l, e) = (self.arc_store.find(wi), self.arc_store.find(wo));
+        if l.is_some() || e.is_some() {
+            for v in &mut views {
+                v.l.kept = l;
+                v.e.kept = e;
+            }
+        }
+        views
     }
 }
 
@@ -1962,6 +1998,8 @@ fn overlap(a: (f64, f64), b: (f64, f64)) -> f64 {
 }
 
 mod around;
+mod open_arcs;
+pub use open_arcs::OpenArcs;
 mod batch;
 
 #[cfg(test)]

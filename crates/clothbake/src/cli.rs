@@ -727,7 +727,8 @@ pub enum VariantArg {
     /// ground truth (docs/model.md), about 2.5x the cost.
     Sliced,
     /// Sliced, with what hides each slice's side taken in 3-D through the floats around the
-    /// piece: the closest to the ground truth (docs/model.md), about 300 times the cost.
+    /// piece: the closest to the ground truth (docs/model.md); a bake takes 3 to 13 times as
+    /// long, one pair at a time about 200 times.
     Sliced3d,
 }
 

@@ -186,6 +186,7 @@ impl Around {
         let margin = 1e-9 * self.top.abs().max(hi[0] - lo[0]).max(hi[2] - lo[2]);
         let s_max = (self.top - lo[2]).max(0.0) / d[2] + margin;
         let reach = s_max * d[0].hypot(d[1]) + margin;
+        let inv = d.map(|x| 1.0 / x);
         let mut out = Vec::new();
         for q in &self.cylinders {
             if q.distance > reach {
@@ -199,18 +200,27 @@ impl Around {
             };
             let z = (q.at.1 - q.radius, q.at.1 + q.radius);
             let (mut s0, mut s1) = (0.0f64, s_max);
-            for (k, (b0, b1)) in [c, a, z].into_iter().enumerate() {
+            for (k, (b0, b1)) in [z, c, a].into_iter().zip([2, 0, 1]).map(|(b, k)| (k, b)) {
                 let (b0, b1) = (b0 - margin, b1 + margin);
                 let (p0, p1) = (lo[k] - margin, hi[k] + margin);
                 // The s where [p0, p1] + s d[k] meets [b0, b1].
-                if d[k] == 0.0 {
-                    if p0 > b1 || p1 < b0 {
-                        s1 = -1.0;
-                    }
+                let (x, y) = if d[k] > 0.0 {
+                    ((b0 - p1) * inv[k], (b1 - p0) * inv[k])
+                } else if d[k] < 0.0 {
+                    ((b1 - p0) * inv[k], (b0 - p1) * inv[k])
+                } else if p0 > b1 || p1 < b0 {
+                    (1.0, -1.0)
                 } else {
-                    let (x, y) = ((b0 - p1) / d[k], (b1 - p0) / d[k]);
-                    s0 = s0.max(x.min(y));
-                    s1 = s1.min(x.max(y));
+                    continue;
+                };
+                if x > s0 {
+                    s0 = x;
+                }
+                if y < s1 {
+                    s1 = y;
+                }
+                if s0 > s1 {
+                    break;
                 }
             }
             if s0 <= s1 {
@@ -261,8 +271,8 @@ impl Around {
             return arc;
         }
         let horizontal = d[0].hypot(d[1]);
-        let hidden = |t: f64| {
-            let (s, c) = t.sin_cos();
+        // Whether the ray from the arc's point at (sin, cos) meets a float.
+        let hidden = |(s, c): (f64, f64)| {
             blocks_among(
                 &floats,
                 self.top,
@@ -271,11 +281,19 @@ impl Around {
                 horizontal,
             )
         };
-        let at = |k: usize| lo + (hi - lo) * k as f64 / (SAMPLES - 1) as f64;
+        // The samples, by turning the first one a sample spacing at a time.
+        let step = (hi - lo) / (SAMPLES - 1) as f64;
+        let turn = step.sin_cos();
+        let mut points = [(0.0, 0.0); SAMPLES];
+        let mut p = arc.lo;
+        for (k, point) in points.iter_mut().enumerate() {
+            *point = if k + 1 == SAMPLES { arc.hi } else { p };
+            p = (p.0 * turn.1 + p.1 * turn.0, p.1 * turn.1 - p.0 * turn.0);
+        }
         // The longest run of visible samples: (first, last).
         let (mut best, mut run): (Option<(usize, usize)>, Option<usize>) = (None, None);
-        for k in 0..SAMPLES {
-            if hidden(at(k)) {
+        for (k, &point) in points.iter().enumerate() {
+            if hidden(point) {
                 run = None;
                 continue;
             }
@@ -290,11 +308,16 @@ impl Around {
             out.hi = out.lo;
             return out;
         };
-        // Between a visible and a hidden angle, the visible end of the boundary.
-        let refine = |mut seen: f64, mut hid: f64| {
+        let at = |k: usize| (lo + step * k as f64, points[k]);
+        // Between a visible and a hidden point (angle, (sin, cos)), the visible end of the
+        // boundary; the middle of two points less than half a turn apart is their normalised
+        // sum.
+        let refine = |mut seen: (f64, (f64, f64)), mut hid: (f64, (f64, f64))| {
             for _ in 0..STEPS {
-                let m = 0.5 * (seen + hid);
-                if hidden(m) {
+                let (s, c) = (seen.1 .0 + hid.1 .0, seen.1 .1 + hid.1 .1);
+                let n = (s * s + c * c).sqrt();
+                let m = (0.5 * (seen.0 + hid.0), (s / n, c / n));
+                if hidden(m.1) {
                     hid = m;
                 } else {
                     seen = m;
@@ -303,14 +326,14 @@ impl Around {
             seen
         };
         if first > 0 {
-            let t = refine(at(first), at(first - 1));
+            let (t, sc) = refine(at(first), at(first - 1));
             out.arc.lo = t;
-            out.lo = t.sin_cos();
+            out.lo = sc;
         }
         if last + 1 < SAMPLES {
-            let t = refine(at(last), at(last + 1));
+            let (t, sc) = refine(at(last), at(last + 1));
             out.arc.hi = t;
-            out.hi = t.sin_cos();
+            out.hi = sc;
         }
         out
     }
