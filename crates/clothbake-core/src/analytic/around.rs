@@ -392,6 +392,26 @@ mod tests {
     use crate::fabric::Fabric;
     use crate::rng::Rng;
 
+    /// The pieces of the twill and of an open weave with lifted and sunk threads, each with
+    /// the floats around its whole range.
+    fn pieces() -> Vec<(Segment, Around)> {
+        let fabrics = [
+            r#"{"pattern": [[1,1,0],[0,1,1],[1,0,1]],
+                "warp": {"radius": 1.5, "spacing": 3.1}, "weft": {"radius": 1.5, "spacing": 3.1}}"#,
+            r#"{"pattern": [[1,0],[0,1]],
+                "warp": {"radius": 1.0, "height": 0.3, "spacing": 3.0},
+                "weft": {"radius": 0.8, "height": -0.2, "spacing": 2.5}}"#,
+        ];
+        let mut out = Vec::new();
+        for json in fabrics {
+            let geo = Geometry::new(&Fabric::from_json_str(json, "t").unwrap());
+            for seg in &geo.segments {
+                out.push((seg.clone(), Around::of(&geo, seg, seg.extent.unwrap())));
+            }
+        }
+        out
+    }
+
     /// Whether `p` lies inside cylinder `q` (its cross-section and its extent).
     fn inside(q: &Cylinder, p: [f64; 3]) -> bool {
         let (u, s) = if q.across { (p[1], p[0]) } else { (p[0], p[1]) };
@@ -404,57 +424,45 @@ mod tests {
     /// shorter than its step, so a few grazing rays may differ; no more than 0.5% of them.
     #[test]
     fn rays_meet_what_a_march_through_the_floats_meets() {
-        let fabrics = [
-            r#"{"pattern": [[1,1,0],[0,1,1],[1,0,1]],
-                "warp": {"radius": 1.5, "spacing": 3.1}, "weft": {"radius": 1.5, "spacing": 3.1}}"#,
-            r#"{"pattern": [[1,0],[0,1]],
-                "warp": {"radius": 1.0, "height": 0.3, "spacing": 3.0},
-                "weft": {"radius": 0.8, "height": -0.2, "spacing": 2.5}}"#,
-        ];
         let mut rng = Rng::new(3);
         let (mut n, mut differ) = (0, 0);
-        for json in fabrics {
-            let f = Fabric::from_json_str(json, "t").unwrap();
-            let geo = Geometry::new(&f);
-            for seg in &geo.segments {
-                let (e0, e1) = seg.extent.unwrap();
-                let around = Around::of(&geo, seg, (e0, e1));
-                for _ in 0..400 {
-                    let t = std::f64::consts::PI * rng.next_f64();
-                    let a = e0 + (e1 - e0) * rng.next_f64();
-                    let p = [seg.radius * t.cos(), a, seg.height + seg.radius * t.sin()];
-                    let (ct, phi) = (
-                        0.05 + 0.95 * rng.next_f64(),
-                        2.0 * std::f64::consts::PI * rng.next_f64(),
-                    );
-                    let st = (1.0 - ct * ct).sqrt();
-                    let d = [st * phi.cos(), st * phi.sin(), ct];
-                    // Leaving the arc outward only (a ray into its own cylinder is not asked).
-                    if d[0] * t.cos() + d[2] * t.sin() <= 0.0 {
-                        continue;
+        for (seg, around) in pieces() {
+            let (e0, e1) = seg.extent.unwrap();
+            for _ in 0..400 {
+                let t = std::f64::consts::PI * rng.next_f64();
+                let a = e0 + (e1 - e0) * rng.next_f64();
+                let p = [seg.radius * t.cos(), a, seg.height + seg.radius * t.sin()];
+                let (ct, phi) = (
+                    0.05 + 0.95 * rng.next_f64(),
+                    2.0 * std::f64::consts::PI * rng.next_f64(),
+                );
+                let st = (1.0 - ct * ct).sqrt();
+                let d = [st * phi.cos(), st * phi.sin(), ct];
+                // Leaving the arc outward only (a ray into its own cylinder is not asked).
+                if d[0] * t.cos() + d[2] * t.sin() <= 0.0 {
+                    continue;
+                }
+                let step = 2e-3 * seg.radius;
+                let mut hit = false;
+                let mut k = 1;
+                loop {
+                    let q = [
+                        p[0] + k as f64 * step * d[0],
+                        p[1] + k as f64 * step * d[1],
+                        p[2] + k as f64 * step * d[2],
+                    ];
+                    if q[2] > around.top {
+                        break;
                     }
-                    let step = 2e-3 * seg.radius;
-                    let mut hit = false;
-                    let mut k = 1;
-                    loop {
-                        let q = [
-                            p[0] + k as f64 * step * d[0],
-                            p[1] + k as f64 * step * d[1],
-                            p[2] + k as f64 * step * d[2],
-                        ];
-                        if q[2] > around.top {
-                            break;
-                        }
-                        if around.cylinders.iter().any(|c| inside(c, q)) {
-                            hit = true;
-                            break;
-                        }
-                        k += 1;
+                    if around.cylinders.iter().any(|c| inside(c, q)) {
+                        hit = true;
+                        break;
                     }
-                    n += 1;
-                    if hit != around.blocks(p, d) {
-                        differ += 1;
-                    }
+                    k += 1;
+                }
+                n += 1;
+                if hit != around.blocks(p, d) {
+                    differ += 1;
                 }
             }
         }
@@ -468,54 +476,42 @@ mod tests {
     /// toward random directions (grazing ones included), on the same two fabrics.
     #[test]
     fn the_floats_kept_for_a_box_hold_every_one_its_rays_meet() {
-        let fabrics = [
-            r#"{"pattern": [[1,1,0],[0,1,1],[1,0,1]],
-                "warp": {"radius": 1.5, "spacing": 3.1}, "weft": {"radius": 1.5, "spacing": 3.1}}"#,
-            r#"{"pattern": [[1,0],[0,1]],
-                "warp": {"radius": 1.0, "height": 0.3, "spacing": 3.0},
-                "weft": {"radius": 0.8, "height": -0.2, "spacing": 2.5}}"#,
-        ];
         let mut rng = Rng::new(5);
         let (mut n, mut hits, mut kept, mut all) = (0, 0, 0, 0);
-        for json in fabrics {
-            let f = Fabric::from_json_str(json, "t").unwrap();
-            let geo = Geometry::new(&f);
-            for seg in &geo.segments {
-                let (e0, e1) = seg.extent.unwrap();
-                let around = Around::of(&geo, seg, (e0, e1));
-                for _ in 0..200 {
-                    let a = e0 + (e1 - e0) * rng.next_f64();
-                    let mut box_of = |r: f64| {
-                        let (x, y) = (
-                            r * (2.0 * rng.next_f64() - 1.0),
-                            r * (2.0 * rng.next_f64() - 1.0),
-                        );
-                        (x.min(y), x.max(y))
-                    };
-                    let (c, z) = (box_of(seg.radius), box_of(seg.radius));
-                    let ct = 0.02 + 0.98 * rng.next_f64();
-                    let phi = 2.0 * std::f64::consts::PI * rng.next_f64();
-                    let st = (1.0 - ct * ct).sqrt();
-                    let d = [st * phi.cos(), st * phi.sin(), ct];
-                    let (lo, hi) = ([c.0, a, seg.height + z.0], [c.1, a, seg.height + z.1]);
-                    let floats = around.candidates(lo, hi, d);
-                    kept += floats.len();
-                    all += around.cylinders.len();
-                    for _ in 0..20 {
-                        let p = [
-                            c.0 + (c.1 - c.0) * rng.next_f64(),
-                            a,
-                            seg.height + z.0 + (z.1 - z.0) * rng.next_f64(),
-                        ];
-                        let hit = around.blocks(p, d);
-                        n += 1;
-                        hits += usize::from(hit);
-                        assert_eq!(
-                            hit,
-                            blocks_among(&floats, around.top, p, d, d[0].hypot(d[1])),
-                            "ray from {p:?} along {d:?}"
-                        );
-                    }
+        for (seg, around) in pieces() {
+            let (e0, e1) = seg.extent.unwrap();
+            for _ in 0..200 {
+                let a = e0 + (e1 - e0) * rng.next_f64();
+                let mut box_of = |r: f64| {
+                    let (x, y) = (
+                        r * (2.0 * rng.next_f64() - 1.0),
+                        r * (2.0 * rng.next_f64() - 1.0),
+                    );
+                    (x.min(y), x.max(y))
+                };
+                let (c, z) = (box_of(seg.radius), box_of(seg.radius));
+                let ct = 0.02 + 0.98 * rng.next_f64();
+                let phi = 2.0 * std::f64::consts::PI * rng.next_f64();
+                let st = (1.0 - ct * ct).sqrt();
+                let d = [st * phi.cos(), st * phi.sin(), ct];
+                let (lo, hi) = ([c.0, a, seg.height + z.0], [c.1, a, seg.height + z.1]);
+                let floats = around.candidates(lo, hi, d);
+                kept += floats.len();
+                all += around.cylinders.len();
+                for _ in 0..20 {
+                    let p = [
+                        c.0 + (c.1 - c.0) * rng.next_f64(),
+                        a,
+                        seg.height + z.0 + (z.1 - z.0) * rng.next_f64(),
+                    ];
+                    let hit = around.blocks(p, d);
+                    n += 1;
+                    hits += usize::from(hit);
+                    assert_eq!(
+                        hit,
+                        blocks_among(&floats, around.top, p, d, d[0].hypot(d[1])),
+                        "ray from {p:?} along {d:?}"
+                    );
                 }
             }
         }
