@@ -20,7 +20,7 @@ use crate::settings::Naming;
 use crate::shard::{read_part, shard_rows, Kind, ShardId};
 use crate::sweep::{check_options, BakeError, BakeOptions, Baker, Row};
 use clothbake_core::Fabric;
-use clothbake_loader::{Metadata, Table, TableError};
+use clothbake_loader::{Faces, Metadata, Table, TableError};
 use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -524,9 +524,22 @@ pub fn check_memory(
     } else {
         3
     };
+    // A sliced3d model's open arcs kept for the grid's directions (`with_grid_arcs`): at most
+    // their budget.
+    let arcs = match (job.options.method, g.faces, job.options.bounces) {
+        (
+            crate::sweep::Method::Analytic {
+                variant: clothbake_core::Variant::Sliced3d,
+            },
+            Faces::One,
+            1 | 2,
+        ) => crate::sweep::OPEN_ARCS_BUDGET as u64,
+        _ => 0,
+    };
     let need = (memory::peak_bytes(&g, baked, kept, job.resume) / 3)
         .saturating_mul(scale)
-        .saturating_add(extra);
+        .saturating_add(extra)
+        .saturating_add(arcs);
     match available {
         Some(have) if need > have => Err(invalid(
             format!(
@@ -635,5 +648,30 @@ mod tests {
             (19.0 / 3.0 - 0.1..19.0 / 3.0 + 0.4).contains(&ratio),
             "ratio {ratio}"
         );
+    }
+
+    /// A sliced3d bake counts the open arcs it may keep (their budget) on top of what the
+    /// same bake with refined needs; with three bounces it keeps none.
+    #[test]
+    fn a_sliced3d_bake_counts_its_kept_arcs() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables");
+        let f = Fabric::from_path(&dir.join("twill.json")).unwrap();
+        let refined = BakeOptions {
+            grid: Grid::new(8, 16, 8, 16),
+            ..BakeOptions::default()
+        };
+        let sliced3d = BakeOptions {
+            method: crate::sweep::Method::Analytic {
+                variant: clothbake_core::Variant::Sliced3d,
+            },
+            ..refined
+        };
+        let more = need(&Job::new(&f, sliced3d)) - need(&Job::new(&f, refined));
+        let budget = crate::sweep::OPEN_ARCS_BUDGET as f64;
+        // The need is rounded to a megabyte.
+        assert!((more - budget).abs() < 2e6, "{more} more than refined");
+        let three = |o: BakeOptions| BakeOptions { bounces: 3, ..o };
+        let more = need(&Job::new(&f, three(sliced3d))) - need(&Job::new(&f, three(refined)));
+        assert!(more.abs() < 2e6, "{more} more with three bounces");
     }
 }

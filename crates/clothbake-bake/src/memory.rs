@@ -8,7 +8,9 @@
 //! while they are read (12 bytes per cell at most), and for an OpenEXR table the encoder's
 //! block (16 lines of the image, or all of them when fewer, in the encoder's working copies:
 //! measured at 51 bytes per pixel of the block in f32 and 22 in f16, counted as 56, and 4 MiB
-//! for the rest of its state; binary tables stream from the buffer). [`available_bytes`] reads the operating system's
+//! for the rest of its state; binary tables stream from the buffer). A `sliced3d` bake adds
+//! the open arcs it keeps for the grid's directions, counted at their budget
+//! ([`crate::sweep::OPEN_ARCS_BUDGET`], 256 MiB; `job::check_memory`). [`available_bytes`] reads the operating system's
 //! figure (Linux: `MemAvailable` of /proc/meminfo, lowered to the cgroup's limit where one is
 //! set).
 
