@@ -499,7 +499,7 @@ fn with_grid_arcs(mut m: AnalyticModel, g: &Grid) -> AnalyticModel {
     if slices == 0 || dirs.len().saturating_mul(slices) > OPEN_ARCS_BUDGET / 48 {
         return m;
     }
-    let arcs: Vec<_> = dirs.par_iter().map(|&w| (w, m.open_arcs(w))).collect();
+    let arcs: Vec<_> = dirs.par_iter().map(|&w| m.open_arcs(w)).collect();
     m.keep_open_arcs(arcs);
     m
 }

@@ -261,6 +261,8 @@ pub struct AnalyticModel {
     lanes: Option<batch::Lanes>,
     /// [`Variant::Sliced3d`]: the open arcs kept for directions given in advance.
     arc_store: open_arcs::ArcStore,
+    /// The key of the units' slices the open arcs belong to (`open_arcs::model_key`).
+    arcs_key: u64,
 }
 
 /// A class's reflection for one pair of directions, per unit diffuse albedo
@@ -1135,6 +1137,7 @@ impl AnalyticModel {
         }
         AnalyticModel {
             arc_store: open_arcs::ArcStore::default(),
+            arcs_key: open_arcs::model_key(&units),
             facet,
             variant,
             lanes: if variant == Variant::Sliced3d {

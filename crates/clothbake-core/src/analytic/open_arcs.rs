@@ -3,18 +3,57 @@
 //! dearest part) depends on that direction alone, so a bake, whose pairs reuse the grid's
 //! directions row after row, finds it once a direction instead of once a pair.
 //!
-//! The arcs kept are those [`AnalyticModel::open_arcs`] computes, looked up by the direction's
-//! bits: a model with arcs kept gives the same bits as one without.
+//! The arcs kept are those [`AnalyticModel::open_arcs`] computes, each set carrying its
+//! direction and its model's key (so that no other model's arcs, and no other direction's, can
+//! be kept), looked up by the direction's bits: a model with arcs kept gives the same bits as
+//! one without.
 
-use super::{AnalyticModel, Variant, View};
+use super::{AnalyticModel, Unit, Variant, View};
 use crate::arc::ArcTrig;
 use crate::vec3::UnitVec3;
 use std::collections::HashMap;
 
 /// The open arc of every slice of a [`Variant::Sliced3d`] model toward one direction, in the
-/// order of the model's units and their slices ([`AnalyticModel::open_arcs`]).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct OpenArcs(Vec<ArcTrig>);
+/// order of the model's units and their slices ([`AnalyticModel::open_arcs`]), with that
+/// direction and the model's key.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OpenArcs {
+    toward: [u64; 3],
+    model: u64,
+    arcs: Vec<ArcTrig>,
+}
+
+/// The key of a model's slices: a hash (FNV-1a) of all that decides their open arcs toward a
+/// direction (each sliced unit's group, radius, height, floor, slices and the floats around
+/// it), in order.
+pub(super) fn model_key(units: &[Unit]) -> u64 {
+    let mut hash = 0xcbf2_9ce4_8422_2325_u64;
+    let mut key = Vec::new();
+    for u in units {
+        let Some(around) = &u.around else {
+            continue;
+        };
+        let seg = &u.seg;
+        key.clear();
+        key.extend([
+            f64::from(seg.group as u8),
+            seg.radius,
+            seg.height,
+            seg.floor.arc.lo,
+            seg.floor.arc.hi,
+        ]);
+        for sl in &u.slices {
+            key.extend(sl.ranges.iter().flat_map(|&(a, b)| [a, b]));
+        }
+        around.key(0.0, 1.0, &mut key);
+        for x in &key {
+            for b in x.to_bits().to_le_bytes() {
+                hash = (hash ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+            }
+        }
+    }
+    hash
+}
 
 /// The open arcs kept for some directions (`AnalyticModel::keep_open_arcs`).
 #[derive(Clone, Debug, Default)]
@@ -67,36 +106,43 @@ impl AnalyticModel {
     /// hidden by no float around it (docs/model.md, "The sliced3d variant"), for every slice
     /// of a [`Variant::Sliced3d`] model; empty for the other variants and below the horizon.
     pub fn open_arcs(&self, w: UnitVec3) -> OpenArcs {
+        let mut out = OpenArcs {
+            toward: bits(w),
+            model: self.arcs_key,
+            arcs: Vec::new(),
+        };
         if self.variant != Variant::Sliced3d || !w.above_horizon() {
-            return OpenArcs::default();
+            return out;
         }
         let views = View::both(w.get());
-        let mut out = Vec::with_capacity(self.open_arc_slices());
+        out.arcs.reserve(self.open_arc_slices());
         for u in self.units.iter().filter(|u| u.around.is_some()) {
             let v = &views[u.seg.group as usize];
             let arcs = u.slices.iter().enumerate();
-            out.extend(arcs.map(|(k, sl)| self.slice_arc(u, k, sl, v)));
+            out.arcs
+                .extend(arcs.map(|(k, sl)| self.slice_arc(u, k, sl, v)));
         }
-        OpenArcs(out)
+        out
     }
 
-    /// Keeps `arcs`, each [`AnalyticModel::open_arcs`] of its direction, in place of computing
+    /// Keeps `arcs` ([`AnalyticModel::open_arcs`] of some directions) in place of computing
     /// them again for every pair with one of those directions: the same bits, faster where
-    /// pairs share directions (a bake). Arcs of the wrong length (another model's, or of a
-    /// direction below the horizon) are not kept.
-    pub fn keep_open_arcs(&mut self, arcs: impl IntoIterator<Item = (UnitVec3, OpenArcs)>) {
+    /// pairs share directions (a bake). Arcs of another model (by its key) and of directions
+    /// below the horizon (none) are left out.
+    pub fn keep_open_arcs(&mut self, arcs: impl IntoIterator<Item = OpenArcs>) {
         let slices = self.open_arc_slices();
         if slices == 0 {
             return;
         }
         let store = &mut self.arc_store;
         store.slices = slices;
-        for (w, a) in arcs {
-            if a.0.len() != slices || store.index.contains_key(&bits(w)) {
+        for a in arcs {
+            let fits = a.model == self.arcs_key && a.arcs.len() == slices;
+            if !fits || store.index.contains_key(&a.toward) {
                 continue;
             }
-            store.index.insert(bits(w), store.index.len() as u32);
-            store.arcs.extend(a.0);
+            store.index.insert(a.toward, store.index.len() as u32);
+            store.arcs.extend(a.arcs);
         }
     }
 }
@@ -118,8 +164,8 @@ mod tests {
     /// A model with the open arcs of some directions kept gives the bits of one without, for
     /// pairs of kept directions, of kept and other ones, and below the horizon: the average
     /// (with and without I_2), a cell's reflection and the classes' terms, on the twill and the
-    /// gingham. Arcs kept under the wrong directions change the twill's values (the lookup is
-    /// used), and another variant keeps none.
+    /// gingham. Arcs kept under the wrong direction change the twill's values (the lookup is
+    /// used); another model's arcs are not kept, and another variant keeps none.
     #[test]
     fn kept_arcs_give_the_bits_of_arcs_found_again() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables");
@@ -131,7 +177,7 @@ mod tests {
             let kept = dirs[..7].to_vec();
             dirs.push(UnitVec3::from_degrees(95.0, 30.0));
             let mut model = plain.clone();
-            model.keep_open_arcs(kept.iter().map(|&w| (w, plain.open_arcs(w))));
+            model.keep_open_arcs(kept.iter().map(|&w| plain.open_arcs(w)));
             assert!(kept.iter().all(|&w| model.arc_store.find(w).is_some()));
             assert!(model.arc_store.find(dirs[8]).is_none());
             let opts = SecondaryOptions::default();
@@ -171,11 +217,28 @@ mod tests {
             UnitVec3::from_degrees(60.0, 200.0),
         );
         let mut wrong = plain.clone();
-        wrong.keep_open_arcs([(a, plain.open_arcs(b))]);
+        let mut b_as_a = plain.open_arcs(b);
+        b_as_a.toward = bits(a);
+        wrong.keep_open_arcs([b_as_a]);
         assert_ne!(wrong.intensity(a, b), plain.intensity(a, b));
+        // Another model's arcs are not kept: the satin's, and those of the twill with another
+        // spacing, as many as the twill's.
+        let twill = std::fs::read_to_string(dir.join("twill.json")).expect("twill");
+        let wider = twill.replace("\"spacing\": 3.1", "\"spacing\": 3.3");
+        assert_ne!(wider, twill);
+        let wider = Fabric::from_json_str(&wider, "wider.json").expect("wider twill");
+        let wider = AnalyticModel::with_variant(&wider, FacetModel::Huo, Variant::Sliced3d);
+        assert_eq!(wider.open_arc_slices(), plain.open_arc_slices());
+        let satin = Fabric::from_path(&dir.join("satin5.json")).expect("satin");
+        let satin = AnalyticModel::with_variant(&satin, FacetModel::Huo, Variant::Sliced3d);
+        let mut model = plain.clone();
+        model.keep_open_arcs([wider.open_arcs(a), satin.open_arcs(a)]);
+        assert_eq!(model.open_arcs_kept(), 0);
+        model.keep_open_arcs([plain.open_arcs(a)]);
+        assert_eq!(model.open_arcs_kept(), 1);
         let mut refined = AnalyticModel::new(&f, FacetModel::Huo);
         assert_eq!(refined.open_arc_slices(), 0);
-        refined.keep_open_arcs([(a, plain.open_arcs(a))]);
+        refined.keep_open_arcs([plain.open_arcs(a)]);
         assert!(refined.arc_store.find(a).is_none());
     }
 }
