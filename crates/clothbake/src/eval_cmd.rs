@@ -305,8 +305,6 @@ pub fn describe_secondary(o: &SecondaryOptions) -> String {
     format!("{how}, {} kernel", o.kernel.name())
 }
 
-/// Reads the fabric of `--weave` (JSON or WIF draft, with the draft's size flags; or a shipped
-/// fabric's name, [`crate::fabrics`]) and applies the material overrides.
 /// The analytic variant `v` for the fabric of `weave`, refused where it does not take the
 /// period (`clothbake_core::check_variant`: sliced3d's size limit).
 pub fn checked_variant(
@@ -320,6 +318,8 @@ pub fn checked_variant(
     Ok(v)
 }
 
+/// Reads the fabric of `--weave` (JSON or WIF draft, with the draft's size flags; or a shipped
+/// fabric's name, [`crate::fabrics`]) and applies the material overrides.
 pub fn load_fabric(weave: &Path, draft: &DraftArgs, m: &MaterialArgs) -> Result<Fabric, CliError> {
     if draft.any() && !crate::fabrics::is_draft(weave) {
         return Err(CliError::new(
