@@ -5,8 +5,8 @@
 //! preset; two lights) and each of six distances, from 32 pixels across a thread down to 0.1
 //! pixel per period, the same camera and pixel samples render the one-bounce model through its
 //! footprints (`Shader::model`: point, cells, period), with the default variant (`refined`),
-//! with `sliced` and with `sliced3d`, and the ground truth (`Shader::truth`, twice with different jitter, shared by
-//! both variants). The relative RMSE is the RMS difference between the level of
+//! with `sliced` and with `sliced3d`, and the ground truth (`Shader::truth`, twice with
+//! different jitter, shared by the three). The relative RMSE is the RMS difference between the level of
 //! detail and the mean of the two truths, with the truths' own noise (estimated from their
 //! difference) subtracted, over the mean truth value of the pixels that see the cloth.
 //! Ambient 0 (the reflected light alone), opaque cloth, 16 x 16 samples a pixel: with 8 x 8 the

@@ -487,6 +487,9 @@ pub const OPEN_ARCS_BUDGET: usize = 256 << 20;
 /// pair. Other variants' models are given back as they are.
 fn with_grid_arcs(mut m: AnalyticModel, g: &Grid) -> AnalyticModel {
     let slices = m.open_arc_slices();
+    if slices == 0 {
+        return m;
+    }
     let incident = (0..g.n_theta_i).flat_map(|t| (0..g.n_phi_i).map(move |p| incident(g, t, p)));
     let outgoing = (0..g.n_theta_o).flat_map(|t| (0..g.n_phi_o).map(move |p| outgoing(g, t, p)));
     let mut dirs: Vec<UnitVec3> = incident.chain(outgoing).collect();
@@ -496,7 +499,7 @@ fn with_grid_arcs(mut m: AnalyticModel, g: &Grid) -> AnalyticModel {
     };
     dirs.sort_by_key(key);
     dirs.dedup_by_key(|w| key(w));
-    if slices == 0 || dirs.len().saturating_mul(slices) > OPEN_ARCS_BUDGET / 48 {
+    if dirs.len().saturating_mul(slices) > OPEN_ARCS_BUDGET / 48 {
         return m;
     }
     let arcs: Vec<_> = dirs.par_iter().map(|&w| m.open_arcs(w)).collect();

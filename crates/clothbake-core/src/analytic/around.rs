@@ -181,11 +181,17 @@ impl Around {
     /// The floats, nearest first, that a ray along `d` (rising) from a point of the box
     /// `(lo, hi)` (corners (c, a, z)) can meet below the highest top: those whose bounding box
     /// the box swept along `d` meets. Every float [`blocks_among`] can find such a ray to meet
-    /// is among them (both boxes grown by a rounding margin).
-    fn candidates(&self, lo: [f64; 3], hi: [f64; 3], d: [f64; 3]) -> Vec<&Cylinder> {
+    /// is among them (both boxes grown by a rounding margin). `horizontal` is |(d.c, d.a)|.
+    fn candidates(
+        &self,
+        lo: [f64; 3],
+        hi: [f64; 3],
+        d: [f64; 3],
+        horizontal: f64,
+    ) -> Vec<&Cylinder> {
         let margin = 1e-9 * self.top.abs().max(hi[0] - lo[0]).max(hi[2] - lo[2]);
         let s_max = (self.top - lo[2]).max(0.0) / d[2] + margin;
-        let reach = s_max * d[0].hypot(d[1]) + margin;
+        let reach = s_max * horizontal + margin;
         let inv = d.map(|x| 1.0 / x);
         let mut out = Vec::new();
         for q in &self.cylinders {
@@ -200,7 +206,7 @@ impl Around {
             };
             let z = (q.at.1 - q.radius, q.at.1 + q.radius);
             let (mut s0, mut s1) = (0.0f64, s_max);
-            for (k, (b0, b1)) in [z, c, a].into_iter().zip([2, 0, 1]).map(|(b, k)| (k, b)) {
+            for (k, (b0, b1)) in [(2, z), (0, c), (1, a)] {
                 let (b0, b1) = (b0 - margin, b1 + margin);
                 let (p0, p1) = (lo[k] - margin, hi[k] + margin);
                 // The s where [p0, p1] + s d[k] meets [b0, b1].
@@ -262,15 +268,16 @@ impl Around {
                 }
             }
         }
+        let horizontal = d[0].hypot(d[1]);
         let floats = self.candidates(
             [radius * c_range.0, a, height + radius * s_range.0],
             [radius * c_range.1, a, height + radius * s_range.1],
             d,
+            horizontal,
         );
         if floats.is_empty() {
             return arc;
         }
-        let horizontal = d[0].hypot(d[1]);
         // Whether the ray from the arc's point at (sin, cos) meets a float.
         let hidden = |(s, c): (f64, f64)| {
             blocks_among(
@@ -495,7 +502,7 @@ mod tests {
                 let st = (1.0 - ct * ct).sqrt();
                 let d = [st * phi.cos(), st * phi.sin(), ct];
                 let (lo, hi) = ([c.0, a, seg.height + z.0], [c.1, a, seg.height + z.1]);
-                let floats = around.candidates(lo, hi, d);
+                let floats = around.candidates(lo, hi, d, d[0].hypot(d[1]));
                 kept += floats.len();
                 all += around.cylinders.len();
                 for _ in 0..20 {
