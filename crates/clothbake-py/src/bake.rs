@@ -41,6 +41,19 @@ fn choice<T: Copy>(name: &str, value: Option<&str>, words: &[(&str, T)]) -> PyRe
     }
 }
 
+/// The analytic variants by name (`variant=`).
+const VARIANTS: &[(&str, Variant)] = &[
+    ("refined", Variant::Refined),
+    ("thesis", Variant::Thesis),
+    ("sliced", Variant::Sliced),
+    ("sliced3d", Variant::Sliced3d),
+];
+
+/// The analytic variant named `name`, or the error naming `variant=` and the choices.
+pub(crate) fn variant_of(name: &str) -> PyResult<Variant> {
+    Ok(choice("variant", Some(name), VARIANTS)?.expect("a name was given"))
+}
+
 /// The table format of `output` from `format=` and `precision=` (default: from the
 /// extension, `.bin` binary, anything else EXR; EXR precision f16).
 fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) -> PyResult<Format> {
@@ -167,16 +180,7 @@ pub fn bake(
         grid: Some(grid),
         facet: facet_model(facet)?,
         raytrace,
-        variant: choice(
-            "variant",
-            variant,
-            &[
-                ("refined", Variant::Refined),
-                ("thesis", Variant::Thesis),
-                ("sliced", Variant::Sliced),
-                ("sliced3d", Variant::Sliced3d),
-            ],
-        )?,
+        variant: choice("variant", variant, VARIANTS)?,
         samples,
         seed,
         caps: choice(

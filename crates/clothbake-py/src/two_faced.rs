@@ -6,7 +6,7 @@ use crate::fabric::{facet_model, PyFabric};
 use crate::table::table_err;
 use crate::vectors::{check_unit, same_len, to_array, to_array1, unit_rows};
 use clothbake_bake::two_faced::TwoFaced;
-use clothbake_core::{Bsdf, UnitVec3, Variant, Vec3};
+use clothbake_core::{Bsdf, UnitVec3, Vec3};
 use clothbake_loader::{Options, TableError, TwoFacedBrdf};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -69,17 +69,7 @@ impl PyTwoFaced {
             )));
         }
         let facet = facet_model(facet)?;
-        let variant = match variant {
-            "refined" => Variant::Refined,
-            "thesis" => Variant::Thesis,
-            "sliced" => Variant::Sliced,
-            "sliced3d" => Variant::Sliced3d,
-            other => {
-                return Err(PyValueError::new_err(format!(
-                    "variant: {other:?} is not one of \"refined\", \"thesis\", \"sliced\", \"sliced3d\"; give one of them"
-                )))
-            }
-        };
+        let variant = crate::bake::variant_of(variant)?;
         clothbake_core::check_variant(&fabric.fabric, variant).map_err(|(problem, fix)| {
             PyValueError::new_err(format!("variant: {problem}; {fix}"))
         })?;

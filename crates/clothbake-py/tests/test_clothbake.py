@@ -438,6 +438,16 @@ def test_a_period_too_large_for_sliced3d_is_refused(twill_path):
     assert clothbake.bake(fab, res=(1, 2, 1, 2), variant="sliced") is not None
 
 
+def test_an_unknown_variant_is_refused_alike_by_bake_and_two_faced(twill_path):
+    """bake and two_faced take the same variant names and refuse another with the same line."""
+    fab = clothbake.Fabric(twill_path)
+    needle = r'^variant: "best" is not one of "refined", "thesis", "sliced", "sliced3d"; give one of them$'
+    with pytest.raises(ValueError, match=needle):
+        clothbake.bake(fab, res=(1, 2, 1, 2), variant="best")
+    with pytest.raises(ValueError, match=needle):
+        fab.two_faced(variant="best", nodes=(1, 1), paths=1)
+
+
 def test_version_is_the_crates_version():
     """Independent: the workspace's Cargo.toml, read as text."""
     import pathlib
