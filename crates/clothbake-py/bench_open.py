@@ -6,7 +6,7 @@ process's resident memory before and after.
 Prints each open's time, their median, and the resident set (VmRSS) before the first open and
 after the last (one table held), next to what the lookup layout holds (`memory_bytes` of the
 loader is not exposed to Python; the layout of a 32 x 64 x 32 x 64 f16 table is 95.2 MB,
-docs/loader.md).
+docs/reference/loader.md).
 """
 
 import statistics

@@ -3,7 +3,7 @@
  * Build against the source tree (after `cargo build --release -p clothbake-capi`):
  *   cc -I crates/clothbake-capi/include examples/c/sample.c \
  *      target/release/libclothbake_capi.a -lpthread -ldl -lm -o sample
- * or against an installed copy (`cargo xtask install-capi PREFIX`, docs/loader.md):
+ * or against an installed copy (`cargo xtask install-capi PREFIX`, docs/reference/loader.md):
  *   cc examples/c/sample.c $(pkg-config --cflags --libs clothbake) -o sample
  * Run: ./sample twill.exr
  */

@@ -44,7 +44,7 @@ class Settings:
         self.width, self.height = (160, 120) if quick else (1024, 768)
         # Samples a pixel: scenes with the native `measured` BSDF only, and scenes with the
         # clothbake plugin: the same count (a plugin sample costs about 1.5 times measured's,
-        # docs/performance.md).
+        # docs/results/performance.md).
         self.spp = 4 if quick else 32
         self.spp_plugin = self.spp
         self.pass_spp = 4 if quick else 8
@@ -154,7 +154,7 @@ def plan(settings, baker):
             f"the clothbake plugin with `periods` = {scene.PERIODS:g} weave periods per UV unit "
             f"(about {scene.PERIODS / (2 * scene.drape.HALF_SIDE):.0f} per unit of length, "
             "the ball's radius being 1): each sample traces the yarns at its point "
-            "(docs/spatial.md, the point level).", "close",
+            "(docs/science/spatial.md, the point level).", "close",
             scene.plugin(table, periods=scene.PERIODS)))
     fab = dict(fabrics())
     if BOUNCES_FABRIC in fab:
@@ -214,7 +214,7 @@ def write_readme(out, pics, results, settings, light, bake_seconds):
         "light and of the BSDF's own sampling, shadows, light bouncing between cloth, ball and "
         f"floor), {settings.width} x {settings.height} pixels, {settings.spp} samples a pixel "
         "through `measured` and through the clothbake plugin alike (a plugin sample costs "
-        "about 1.5 times `measured`'s, docs/performance.md). "
+        "about 1.5 times `measured`'s, docs/results/performance.md). "
         f"Tone mapping: one fixed exposure per view for the sky ({scene.SKY_EXPOSURE['far']:g} "
         f"far, {scene.SKY_EXPOSURE['close']:g} close: the same for every fabric, so that "
         "fabrics compare), then the ACES filmic curve as fitted by Narkowicz (2015), "

@@ -55,7 +55,7 @@ CAPTION = (
     "0.241; close: 0.49, 0.58, 0.56. The fitted pictures are brighter because the plugin "
     "with `periods` draws the cloth over its black floor (each value times the coverage, "
     "0.83-0.93 for this cloth at these views), while a fitted material, like the table's RGL "
-    "export, is the averaged BRDF, which has no gaps (docs/export.md).")
+    "export, is the averaged BRDF, which has no gaps (docs/guide/export.md).")
 WIDTH, HEIGHT = 400, 300
 SUN_IRRADIANCE = 3.0
 SKY_RADIANCE = 0.35

@@ -4,7 +4,7 @@
 //! `sample` after an open (the sampling CDFs are built then); and, for the time's proportion to
 //! the size, synthetic half-float tables of growing grids (`open_scaling/<cells>`).
 //!
-//! `cargo bench -p clothbake-tests --bench open_table` (docs/performance.md, "Opening a table").
+//! `cargo bench -p clothbake-tests --bench open_table` (docs/reference/benchmarks.md, "Opening a table").
 
 use std::hint::black_box;
 use std::path::PathBuf;

@@ -1,9 +1,9 @@
-//! Spatial lookups (issue 19, docs/spatial.md) beside the averaged lookup, in one run: the
+//! Spatial lookups (issue 19, docs/science/spatial.md) beside the averaged lookup, in one run: the
 //! twill baked with `--spatial` on the default grid, held in f16 as a default EXR holds it;
 //! 2^20 distinct random direction pairs and points of the period (not a small cycled set: each
 //! lookup reads 4 cache lines of node tables of 95 MB each, and 2^20 lookups touch far more
 //! lines than the 32 MB last-level cache holds, where 2^16 touched 16 MB and stayed in it).
-//! Medians in docs/spatial.md.
+//! Medians in docs/science/spatial.md.
 
 use clothbake_bake::{bake, BakeOptions, DEFAULT_GRID};
 use clothbake_core::Fabric;

@@ -143,12 +143,12 @@ fn the_c_program_agrees_with_the_rust_loader() {
 
 #[test]
 fn the_documented_example_compiles_as_given_and_runs() {
-    // docs/loader.md shows examples/c/sample.c whole.
+    // docs/reference/loader.md shows examples/c/sample.c whole.
     let example = std::fs::read_to_string(root().join("examples/c/sample.c")).unwrap();
-    let doc = std::fs::read_to_string(root().join("docs/loader.md")).unwrap();
+    let doc = std::fs::read_to_string(root().join("docs/reference/loader.md")).unwrap();
     assert!(
         doc.contains(&format!("```c\n{example}```")),
-        "the C block of docs/loader.md is not examples/c/sample.c"
+        "the C block of docs/reference/loader.md is not examples/c/sample.c"
     );
     let dir = temp_dir("capi-example");
     // A small twill table (8 x 16 x 8 x 16, f16 EXR) and the Rust loader on it.

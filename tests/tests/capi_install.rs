@@ -1,5 +1,5 @@
 //! `cargo xtask install-capi PREFIX` into a temporary folder, then examples/c/sample.c compiled
-//! the way docs/loader.md says, with `pkg-config --cflags --libs clothbake` (shared library)
+//! the way docs/reference/loader.md says, with `pkg-config --cflags --libs clothbake` (shared library)
 //! and against the installed, stripped static library, and run on a baked table: both print
 //! what the Rust loader computes.
 //!

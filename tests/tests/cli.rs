@@ -1,7 +1,7 @@
 //! The inputs the `clothbake` CLI ships, checked at library level: every fabric table in
 //! `tables/` loads with `Fabric::from_path`, builds its micro-geometry, has the documented
 //! weave and segment lengths, and (the thesis's samples) spells out the thesis's sec. 4.3
-//! material. The fabric presets (real cloth, docs/fabric-format.md) are checked against their
+//! material. The fabric presets (real cloth, docs/reference/fabric-format.md) are checked against their
 //! documented sources in `tests/tests/presets.rs`.
 //! (Tests that drive the binary itself live in `crates/clothbake/tests/cli.rs`.)
 
@@ -64,7 +64,7 @@ const fn shipped(
 
 impl Shipped {
     /// This fabric as a preset of real cloth: float length (f + 1) s - 2 r over f crossing
-    /// threads of spacing s and radius r (docs/fabric-format.md).
+    /// threads of spacing s and radius r (docs/reference/fabric-format.md).
     const fn real(self) -> Shipped {
         Shipped {
             thesis: false,
@@ -222,14 +222,14 @@ fn weaves_are_what_their_names_say() {
 
 #[test]
 fn documented_example_loads() {
-    // The complete example in docs/fabric-format.md (the first ```json block) is valid.
+    // The complete example in docs/reference/fabric-format.md (the first ```json block) is valid.
     let doc = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/fabric-format.md"),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reference/fabric-format.md"),
     )
     .unwrap();
     let start = doc.find("```json\n").expect("a ```json block") + "```json\n".len();
     let end = start + doc[start..].find("```").unwrap();
-    let f = Fabric::from_json_str(&doc[start..end], "docs/fabric-format.md")
+    let f = Fabric::from_json_str(&doc[start..end], "docs/reference/fabric-format.md")
         .unwrap_or_else(|e| panic!("{e}"));
     Geometry::new(&f);
 }

@@ -1,4 +1,4 @@
-//! The Radiance round trip of the daylighting export (docs/daylighting.md): Radiance (the
+//! The Radiance round trip of the daylighting export (docs/guide/daylighting.md): Radiance (the
 //! binaries and BSDF library the `pyradiance` package ships) reads the Klems XML that
 //! `clothbake_export::klems` writes for a two-faced test cloth (transmission, a straight-through
 //! delta lobe, different faces, anisotropic), and

@@ -1,4 +1,4 @@
-//! Fitted standard materials (docs/export.md, "Fitted materials"): what the fit finds held
+//! Fitted standard materials (docs/guide/export.md, "Fitted materials"): what the fit finds held
 //! against the weave itself, the files read back by other code (a PNG decoder, MaterialX, USD),
 //! and the parameters rendered by the real renderers (three.js in Chromium, Blender's Cycles),
 //! compared with clothbake's own evaluation of the same parameters.

@@ -1,5 +1,5 @@
 //! pbrt-v4's `measured` material and the spectral RGL file. pbrt-v4 cannot be built here (see
-//! docs/export.md), so this is NOT a real-client proof: tests/python/rgl_check.py reads the
+//! docs/guide/export.md), so this is NOT a real-client proof: tests/python/rgl_check.py reads the
 //! file with its own numpy parser and checks every condition pbrt-v4's reader
 //! (`MeasuredBxDFData::Create`, src/pbrt/bxdfs.cpp) places on it, as found in pbrt-v4's public
 //! source: field names, types, ranks, matching extents, a full 2 pi azimuth range, increasing

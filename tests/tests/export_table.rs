@@ -1,6 +1,6 @@
 //! Export from a baked table (`clothbake export --table`): the RGL file made through the
 //! loader's lookup against the RGL file made from the model, node by node. They differ by the
-//! table's interpolation error only (docs/loader.md: 1.5% mean at the default grid, larger
+//! table's interpolation error only (docs/reference/loader.md: 1.5% mean at the default grid, larger
 //! within a few degrees of the horizon), so the luminance-weighted relative RMSE over all nodes
 //! must be small and most nodes close.
 

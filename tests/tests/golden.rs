@@ -1,12 +1,12 @@
 //! Golden tables: every shipped fabric, baked afresh at the golden grid, equals its table in
 //! `tables/golden/` to a relative 1e-9, so any change of the model shows up here as a table
 //! difference. After an intended change, regenerate them with `cargo xtask golden` and review
-//! the difference (`clothbake diff`) before committing (see docs/baking.md).
+//! the difference (`clothbake diff`) before committing (see docs/guide/baking.md).
 //!
 //! That detects change, not error; so each golden table is also held, at a handful of cells,
 //! against the ray-traced ground truth (`clothbake_core::truth`, which builds its own
 //! micro-geometry and facet terms from the fabric description stored in the table): within
-//! the tracer's standard error plus the model's documented error (docs/validation.md).
+//! the tracer's standard error plus the model's documented error (docs/results/validation.md).
 
 use clothbake_bake::compare::compare;
 use clothbake_bake::golden::{bake_golden, golden_path, shipped_fabrics, GRID, TOLERANCE};
@@ -97,7 +97,7 @@ fn fresh_bakes_equal_the_golden_tables() {
 }
 
 /// The model's documented relative error on the total intensity for directions up to 70 degrees
-/// (docs/validation.md, "huo, refined, caps excluded"), as (mean, worst): plain 1.89% and
+/// (docs/results/validation.md, "huo, refined, caps excluded"), as (mean, worst): plain 1.89% and
 /// 9.42%, basket 0.78% and 4.13%, twill 1.10% and 4.09%, twill31 0.81% and 3.19%, satin5 0.65%
 /// and 3.33%; the parallel cylinders are exact (0.01% and 0.11% are the ground truth's noise
 /// there), rounded up; for any other fabric the 10% contract.

@@ -1,6 +1,6 @@
 //! The analytic direct model held against the ray-traced ground truth of the same
 //! micro-geometry, for every shipped fabric (issue: within 10% mean relative error on total I
-//! for directions up to 70 degrees from the normal). The full table is `docs/validation.md`
+//! for directions up to 70 degrees from the normal). The full table is `docs/results/validation.md`
 //! (`cargo xtask validate`).
 
 use clothbake_core::validate::{compare_with, direction_set};
@@ -51,7 +51,7 @@ fn check(variant: Variant, facet: FacetModel, mean_bound: f64, max_bound: f64) {
 
 #[test]
 fn refined_model_matches_ground_truth() {
-    // Measured (docs/validation.md): mean <= 2%, worst 9.3% (plain weave); the bounds leave
+    // Measured (docs/results/validation.md): mean <= 2%, worst 9.3% (plain weave); the bounds leave
     // a margin over the measured values and catch regressions well inside the 10% contract.
     check(Variant::Refined, FacetModel::Huo, 0.04, 0.12);
 }
@@ -96,7 +96,7 @@ fn parallel_cylinders_are_exact() {
 
 #[test]
 fn presets_of_real_cloth_keep_the_10_percent_contract() {
-    // The presets (docs/fabric-format.md) are not the thesis's nearly touching, equal yarns:
+    // The presets (docs/reference/fabric-format.md) are not the thesis's nearly touching, equal yarns:
     // the issue's contract (mean relative error under 10% up to 70 degrees) is what they are
     // held to, for both facet models; the measured means are printed.
     let pairs = direction_set(PAIRS, 70.0);
@@ -133,7 +133,7 @@ fn presets_of_real_cloth_keep_the_10_percent_contract() {
     }
 }
 
-/// The `sliced3d` variant (docs/model.md), against the ground truth on every shipped fabric,
+/// The `sliced3d` variant (docs/science/model.md), against the ground truth on every shipped fabric,
 /// preset and draft: issue 37's bounds, 0.5% mean and 2% worst relative error on the total
 /// intensity up to 70 degrees (measured over 96 pairs: 0.08-0.22% mean, 1.26% worst; the truth's
 /// own noise at 100 000 rays is about 0.05%).

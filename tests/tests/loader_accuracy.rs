@@ -1,6 +1,6 @@
 //! The default grid's lookup of the thesis's twill (exponent 10) reaches a mean relative error
 //! under 3% against direct evaluation of the analytic model (issue 5; the full table with other
-//! grids is `cargo xtask loader-accuracy`, docs/loader.md).
+//! grids is `cargo xtask loader-accuracy`, docs/reference/loader.md).
 
 use clothbake_bake::DEFAULT_GRID;
 use clothbake_core::Fabric;

@@ -1,4 +1,4 @@
-//! The presets of real cloth (docs/fabric-format.md, "Presets of real cloth"): each file
+//! The presets of real cloth (docs/reference/fabric-format.md, "Presets of real cloth"): each file
 //! against the documented table (ends and picks per cm, yarn diameters, rho_s, n), the model
 //! finite and positive on them, and what their inputs imply about their look: the denim's
 //! reflection is blue (an indigo warp over most of the surface, a beige weft adding nearly the
@@ -21,13 +21,13 @@ struct Row {
     exponent: f64,
 }
 
-/// The rows of the table under "## Presets of real cloth" in docs/fabric-format.md.
+/// The rows of the table under "## Presets of real cloth" in docs/reference/fabric-format.md.
 fn documented() -> Vec<Row> {
-    let text = std::fs::read_to_string(root().join("docs/fabric-format.md")).unwrap();
+    let text = std::fs::read_to_string(root().join("docs/reference/fabric-format.md")).unwrap();
     let section = text
         .split("## Presets of real cloth")
         .nth(1)
-        .expect("docs/fabric-format.md has the presets section");
+        .expect("docs/reference/fabric-format.md has the presets section");
     let num = |s: &str| -> f64 { s.trim().parse().unwrap_or_else(|_| panic!("`{s}`")) };
     section
         .lines()
@@ -164,7 +164,7 @@ fn lightness_d8(f: &Fabric) -> f64 {
 
 /// The denim's lightness lies in the range a colour instrument measures on indigo denim: L*
 /// about 30 for a dark shade to 60 for a light one (H. Mercer, "Shade control in indigo
-/// dyeing", part 2, denimsandjeans.com; docs/fabric-format.md).
+/// dyeing", part 2, denimsandjeans.com; docs/reference/fabric-format.md).
 #[test]
 fn denim_lightness_is_that_of_measured_indigo_shades() {
     let l = lightness_d8(&load("denim.wif"));

@@ -1,4 +1,4 @@
-//! The model resolved over the weave period (docs/spatial.md): the local reflection at a point
+//! The model resolved over the weave period (docs/science/spatial.md): the local reflection at a point
 //! against the period's average (their coverage-weighted mean), against the ray-traced ground
 //! truth per crossing cell, and what it shows of each weave.
 
@@ -136,7 +136,7 @@ fn cell_errors(
     (worst, sum / count.max(1) as f64, worst_cov)
 }
 
-/// The presets of real cloth (docs/fabric-format.md): real yarn counts, so warp and weft
+/// The presets of real cloth (docs/reference/fabric-format.md): real yarn counts, so warp and weft
 /// spacings differ and the yarns are thinner than their spacing in one direction, unlike the
 /// thesis's nearly touching, equal yarns the per-cell contract below was set on.
 const PRESETS: [&str; 5] = [
@@ -152,7 +152,7 @@ fn each_cell_matches_the_ray_traced_truth() {
     // The averaged model's contract against the truth (tests/tests/ground_truth.rs): mean
     // relative error under 4%, worst direction under 12%. Per cell the model makes the same
     // error as on average: measured worst cell 9.1% (gingham at wi 70/270, wo 65/30), worst
-    // coverage difference 0.027 (docs/validation.md).
+    // coverage difference 0.027 (docs/results/validation.md).
     for file in &shipped() {
         let file = file.as_str();
         if PRESETS.contains(&file) {
@@ -184,7 +184,7 @@ fn cells_within(file: &str, worst: f64, coverage: f64, mean: f64) {
 #[test]
 fn each_cell_of_the_presets_stays_within_the_measured_bounds() {
     // The per-cell model is weaker where yarns leave gaps in one direction: on the presets
-    // (measured, docs/spatial.md) worst cell 21% (wool-twill, silk-charmeuse at the grazing
+    // (measured, docs/science/spatial.md) worst cell 21% (wool-twill, silk-charmeuse at the grazing
     // pairs), coverage off by up to 0.21, mean cell error 1.5% (denim) to 4.8% (wool-twill).
     // Bounds a little above those: a regression detector, and the documented limit.
     for file in PRESETS {

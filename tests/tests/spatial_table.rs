@@ -1,4 +1,4 @@
-//! Spatially varying tables (`bake --spatial`, docs/spatial.md): the baked classes and the
+//! Spatially varying tables (`bake --spatial`, docs/science/spatial.md): the baked classes and the
 //! loader's lookup at a point of the period against the model's own reflection per crossing
 //! cell, the averaged part against the averaged bake, footprints against the average, and the
 //! table through both file formats.
@@ -114,7 +114,7 @@ const HELD: [(&str, usize); 4] = [
 #[test]
 fn with_the_second_bounce_each_cell_is_the_models_reflection_there() {
     // As above with `--bounces 2`: each cell adds its piece's I_2 from its two parallel
-    // neighbours (docs/spatial.md; the gingham, a plain weave, has none beside any piece).
+    // neighbours (docs/science/spatial.md; the gingham, a plain weave, has none beside any piece).
     // Classes are apart where the neighbours differ in geometry (none of these: their direct
     // classes already differ there), and a mirror image is held once with its sides exchanged
     // where the mirror exchanges them: the twill's warp pieces, and the basket's threads side

@@ -1,4 +1,4 @@
-//! The two-faced cloth (docs/transmission.md) end to end: the model's datasheet figures, the
+//! The two-faced cloth (docs/science/transmission.md) end to end: the model's datasheet figures, the
 //! ones a fabric-shade maker publishes, against the ground truth's light paths.
 
 use clothbake_bake::two_faced::{TwoFaced, MAX_BOUNCES};
@@ -35,7 +35,7 @@ fn the_datasheet_agrees_with_the_light_paths() {
         assert!((front.through - 0.25).abs() < 4.0 * front.std_err.2 + 1e-3);
         // Transmittance: openness plus the diffuse part. The model's diffuse part is the
         // path-traced rest at coarse nodes, interpolated; its error at normal incidence is a
-        // few per cent of the diffuse part (docs/transmission.md).
+        // few per cent of the diffuse part (docs/science/transmission.md).
         let t_truth = front.through + solar(front.transmitted);
         let t_err = front.std_err.2 + solar(front.std_err.1);
         let t_diffuse = solar(front.transmitted);

@@ -1,5 +1,5 @@
 //! WIF drafts (`tables/*.wif`, written by hand) against point papers derived by hand from the
-//! weaving logic, and the documented colour and size mappings (`docs/wif.md`).
+//! weaving logic, and the documented colour and size mappings (`docs/reference/wif.md`).
 
 use clothbake_core::wif::{parse, WifOptions};
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, Group, UnitVec3};
@@ -323,7 +323,7 @@ fn advancing12_liftplan_draft_with_per_thread_thickness() {
 #[test]
 fn packed_drafts_match_the_ground_truth() {
     // The model on packed yarns (round, touching) against the ray tracer of the same geometry,
-    // as tests/tests/ground_truth.rs does for the shipped fabrics (docs/wif.md has the numbers:
+    // as tests/tests/ground_truth.rs does for the shipped fabrics (docs/reference/wif.md has the numbers:
     // mean 0.5-0.9%, worst 2-4%).
     use clothbake_core::validate::compare;
     let pairs = clothbake_core::validate::direction_set(48, 70.0);

@@ -1,5 +1,5 @@
 /* Timing harness for ThunderLoom's tl_shade (the Irawan cloth model) on a 2/1 twill, for the
- * side-by-side run in docs/performance.md. ThunderLoom is not part of clothbake: fetch its
+ * side-by-side run in docs/results/performance.md. ThunderLoom is not part of clothbake: fetch its
  * single header src/thunderloom.h (github.com/vidarn/ThunderLoom, commit 62e6d750, v0.97.0)
  * beside this file, then
  *   gcc -x c++ -O3 -march=native -o tl_bench thunderloom_bench.c -lm -lstdc++

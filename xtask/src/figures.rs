@@ -10,7 +10,7 @@
 //!   above the plane toward (0, -cos 75, sin 75), as `cargo xtask ch5`) shaded with I_ss alone
 //!   (Fig. 5.10) and I_2 alone (Fig. 5.11) for n = 1, 2, 4, 8, 16, 24, 32, left to right.
 //!
-//! * `up-close.png`: the weave up close (docs/spatial.md): the gingham, the twill and the denim
+//! * `up-close.png`: the weave up close (docs/science/spatial.md): the gingham, the twill and the denim
 //!   draft on the swatch seen close (eye (0, -20, 24), 40 degrees of view, light from the
 //!   side toward (0.8, -0.2, 0.56)),
 //!   each from its averaged table (left) and from its spatial table with 16 weave periods
@@ -18,7 +18,7 @@
 //!   they are traced); tables baked with `--spatial` on a 16 x 32 x 16 x 32 grid, direct
 //!   reflection.
 //!
-//! * `yarns.png` (`yarns [--thunderloom DIR]`): the yarns up close (docs/spatial.md, the point
+//! * `yarns.png` (`yarns [--thunderloom DIR]`): the yarns up close (docs/science/spatial.md, the point
 //!   level): the twill, satin5, the denim draft, the gingham and an open plain weave (radius
 //!   1, spacing 3.1: gaps between the yarns) on the swatch seen close (eye (0, -14, 16), 40
 //!   degrees of view, about six threads across the view, light from the side toward
@@ -203,7 +203,7 @@ fn up_close(root: &Path, dir: &Path, width: u32, height: u32) {
     eprintln!("up-close: {:.1} s", start.elapsed().as_secs_f64());
 }
 
-/// The two-faced cloth (docs/transmission.md) draped, lit from the front and backlit (the sun
+/// The two-faced cloth (docs/science/transmission.md) draped, lit from the front and backlit (the sun
 /// behind the cloth, the eye in front): an open plain weave, the thesis's plain weave and the
 /// gingham, Lewis facets with translucency 0.5 (`transmission::translucent`).
 fn backlit(root: &Path, dir: &Path, width: u32, height: u32) {

@@ -1,6 +1,6 @@
 //! `cargo xtask fitted`: the residuals of the fitted standard materials for every shipped
 //! fabric (the analytic model, Huo facets, one bounce, per crossing cell), into the table of
-//! `docs/export.md` between its `fitted-residuals` markers. The numbers are those
+//! `docs/guide/export.md` between its `fitted-residuals` markers. The numbers are those
 //! `clothbake export --weave F --gltf --mtlx --blender` prints (the same library calls);
 //! crates/clothbake/tests/export_fitted_cli.rs holds the table to the command's output.
 
@@ -62,6 +62,6 @@ pub fn run(root: &Path) {
          | fabric | cells | glTF (specification) | OpenPBR (MaterialX, USD) | Blender (Cycles) |\n\
          |---|---|---|---|---|\n{rows}<!-- fitted-residuals:end -->"
     );
-    crate::replace_section(&root.join("docs/export.md"), "fitted-residuals", &out);
+    crate::replace_section(&root.join("docs/guide/export.md"), "fitted-residuals", &out);
     println!("{out}");
 }

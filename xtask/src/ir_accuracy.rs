@@ -1,6 +1,6 @@
 //! `cargo xtask ir-accuracy`: the accuracy of the secondary reflection's solutions against a
 //! converged analytic rule, on the parallel-cylinder surface (thesis sec. 5.4 facets, several
-//! exponents) and the twill, into the table of `docs/interreflection.md` (between its
+//! exponents) and the twill, into the table of `docs/science/interreflection.md` (between its
 //! `ir-accuracy` markers). Times are in the criterion benchmark
 //! (`cargo bench -p clothbake-core --bench eval -- secondary`), which runs the same settings.
 
@@ -201,15 +201,17 @@ pub fn run(root: &Path) {
         }
     }
     print!("{table}");
-    let path = root.join("docs/interreflection.md");
-    let doc = std::fs::read_to_string(&path).expect("docs/interreflection.md");
+    let path = root.join("docs/science/interreflection.md");
+    let doc = std::fs::read_to_string(&path).expect("docs/science/interreflection.md");
     let (begin, end) = ("<!-- ir-accuracy:begin -->", "<!-- ir-accuracy:end -->");
     match (doc.find(begin), doc.find(end)) {
         (Some(a), Some(b)) if a < b => {
             let new = format!("{}{begin}\n{table}{}", &doc[..a], &doc[b..]);
-            std::fs::write(&path, new).expect("write docs/interreflection.md");
+            std::fs::write(&path, new).expect("write docs/science/interreflection.md");
             println!("wrote the table into {}", path.display());
         }
-        _ => eprintln!("docs/interreflection.md has no ir-accuracy markers; table not written"),
+        _ => eprintln!(
+            "docs/science/interreflection.md has no ir-accuracy markers; table not written"
+        ),
     }
 }

@@ -1,5 +1,5 @@
 //! `cargo xtask lod`: the level-of-detail pictures against the ground-truth pictures, into the
-//! table of `docs/validation.md` (between its `lod-validation` markers).
+//! table of `docs/results/validation.md` (between its `lod-validation` markers).
 //!
 //! For each case (a flat swatch and a sphere; the twill, satin5, gingham and the wool twill
 //! preset; two lights) and each of six distances, from 32 pixels across a thread down to 0.1
@@ -165,7 +165,7 @@ pub fn run(root: &Path) {
         ("front", clothbake_core::Vec3::new(0.0, -0.5, 0.866)),
         ("side", clothbake_core::Vec3::new(0.8, 0.3, 0.52)),
     ];
-    // The default variant, the sliced one and sliced3d (docs/model.md), against the same
+    // The default variant, the sliced one and sliced3d (docs/science/model.md), against the same
     // truths.
     let variants = [Variant::Refined, Variant::Sliced, Variant::Sliced3d];
     let mut rows = String::new();
@@ -238,13 +238,13 @@ pub fn run(root: &Path) {
     writeln!(
         out,
         "<!-- lod-validation:begin -->\n## Levels of detail against the ground-truth pictures\n\n\
-         Written by `cargo xtask lod` (method: docs/spatial.md, \"Validation of the levels\"). \
+         Written by `cargo xtask lod` (method: docs/science/spatial.md, \"Validation of the levels\"). \
          Relative RMSE of the level-of-detail picture against the ground-truth picture (the \
          truth's own noise, in brackets, taken out), {RES} x {RES} pixels, {AA} x {AA} samples \
          a pixel, ambient 0, one bounce, Huo facets. Distances in pixels per period at the \
          image centre, from 32 pixels a thread (1) to 0.1 pixel a period (6), geometric \
          between; each case with the default variant (`refined`), with `sliced` and with `sliced3d` \
-         (docs/model.md), against the same truths. Worst: {:.1}% (refined), {:.1}% (sliced), \
+         (docs/science/model.md), against the same truths. Worst: {:.1}% (refined), {:.1}% (sliced), \
          {:.1}% (sliced3d). At 0.01 pixel a period, where every sample's footprint is a \
          period or more, the level-of-detail picture differs from the averaged render by at \
          most {:.1e} of its largest value (refined and sliced).\n\n\
@@ -257,6 +257,10 @@ pub fn run(root: &Path) {
         cells_table(root)
     )
     .unwrap();
-    crate::replace_section(&root.join("docs/validation.md"), "lod-validation", &out);
+    crate::replace_section(
+        &root.join("docs/results/validation.md"),
+        "lod-validation",
+        &out,
+    );
     println!("{out}");
 }

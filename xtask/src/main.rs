@@ -5,10 +5,10 @@
 //! * `install-capi PREFIX`: the C API's header, libraries and pkg-config file under PREFIX (see
 //!   `install_capi.rs`).
 //! * `ch5`: the comparisons of thesis sec. 5.4 (sphere, disk, convergence) into
-//!   `docs/interreflection-results.md`.
+//!   `docs/results/interreflection.md`.
 //! * `transport`: full light transport (every bounce, path-traced on the micro-geometry): the
 //!   perpendicular share of I_2 and the orders past the second per shipped fabric, the furnace
-//!   test and the orders at n = 1, into `docs/transport.md` (between its `transport` markers).
+//!   test and the orders at n = 1, into `docs/science/transport.md` (between its `transport` markers).
 //! * `figures`: the thesis's rendered scenes (Figs 4.5, 5.10, 5.11, 5.17), the weave up
 //!   close (`up-close`), the yarns against the truth and ThunderLoom (`yarns`) and `clothbake
 //!   plot`'s three kinds (`plots`) into `docs/figures/`.
@@ -16,25 +16,25 @@
 //!   Mitsuba 3 (draped over a ball under a sky, path traced) into `docs/gallery/` (see
 //!   `gallery.rs`).
 //! * `fitted`: the residuals of the fitted standard materials of every shipped fabric, into
-//!   `docs/export.md` (see `fitted.rs`).
+//!   `docs/guide/export.md` (see `fitted.rs`).
 //! * `lod`: the level-of-detail pictures (point, cells, period) against the ground-truth
-//!   pictures at six distances, into `docs/validation.md` (see `lod.rs`).
+//!   pictures at six distances, into `docs/results/validation.md` (see `lod.rs`).
 //! * `error-sources`: the model's error split into masking, shadowing and shading, into
-//!   docs/validation.md.
+//!   docs/results/validation.md.
 //! * `transmission`: the two-faced cloth's model against its ray tracer (both faces,
-//!   transmission, openness) into docs/validation.md (see `transmission.rs`).
+//!   transmission, openness) into docs/results/validation.md (see `transmission.rs`).
 //! * `validate-spatial`: the model per crossing cell against the truth sorted into the same
-//!   cells, written to `docs/validation-spatial.md`.
+//!   cells, written to `docs/results/validation-spatial.md`.
 //! * `validate`: holds the analytic model against the ray-traced ground truth for every shipped
-//!   fabric and writes the error tables to `docs/validation.md`.
+//!   fabric and writes the error tables to `docs/results/validation.md`.
 //! * `golden`: bakes every shipped fabric (`tables/*.json`) at the golden grid into
-//!   `tables/golden/<name>.bin` (see `clothbake_bake::golden` and `docs/baking.md`).
+//!   `tables/golden/<name>.bin` (see `clothbake_bake::golden` and `docs/guide/baking.md`).
 //! * `bench-bake [--bounces-2]`: times the default-grid bake of the twill with 1 and 2 threads
 //!   (and, with `--bounces-2`, once with the secondary reflection).
 //! * `loader-accuracy`: the loader's interpolation error on the twill for several grids, into
-//!   the table of `docs/loader.md` (between its `loader-accuracy` markers).
+//!   the table of `docs/reference/loader.md` (between its `loader-accuracy` markers).
 //! * `ir-accuracy`: the secondary reflection's analytic orders and two-level sampling settings
-//!   against a converged rule, into the table of `docs/interreflection.md`; with `--scan`, a grid
+//!   against a converged rule, into the table of `docs/science/interreflection.md`; with `--scan`, a grid
 //!   of sampling settings and analytic orders on the benchmark's surfaces, the parallel
 //!   cylinders and the twill (printed only).
 
@@ -143,9 +143,9 @@ fn validate() {
          channel-mean total intensity I = I_d + I_s, |analytic - traced| / traced; bias is the mean signed \
          relative difference; noise is the ground truth's own mean relative standard error.\n\n\
          Facets: rho_d 0.4, rho_s 0.3, n 10 (sec. 4.3). `refined`, `thesis` and `sliced` are the analytic \
-         variants (docs/model.md); `caps excluded` is the ground-truth convention the model is held to, `caps shaded` \
+         variants (docs/science/model.md); `caps excluded` is the ground-truth convention the model is held to, `caps shaded` \
          shows what flat yarn ends would add if they were averaged as yarn surface. The same model resolved \
-         per crossing cell of the period: docs/validation-spatial.md (`cargo xtask validate-spatial`).\n"
+         per crossing cell of the period: docs/results/validation-spatial.md (`cargo xtask validate-spatial`).\n"
     )
     .unwrap();
     for (bound, title) in [
@@ -256,7 +256,7 @@ fn validate() {
         )
         .unwrap();
     }
-    let path = root().join("docs/validation.md");
+    let path = root().join("docs/results/validation.md");
     // Keep the sections `cargo xtask transport`, `validate-spatial` and `lod` write between
     // markers.
     let old = std::fs::read_to_string(&path).unwrap_or_default();
@@ -368,7 +368,7 @@ fn bench_bake(bounces_2: bool) {
 }
 
 /// The loader's interpolation error against the analytic model (see
-/// `clothbake_tests::accuracy`), written between the markers of `docs/loader.md`.
+/// `clothbake_tests::accuracy`), written between the markers of `docs/reference/loader.md`.
 fn loader_accuracy() {
     use clothbake_loader::{Grid, Precision};
     use clothbake_tests::accuracy::{baked_brdf, measure};
@@ -419,20 +419,20 @@ fn loader_accuracy() {
         )
         .unwrap();
     }
-    let path = root().join("docs/loader.md");
-    let doc = std::fs::read_to_string(&path).expect("docs/loader.md");
+    let path = root().join("docs/reference/loader.md");
+    let doc = std::fs::read_to_string(&path).expect("docs/reference/loader.md");
     let (begin, end) = (
         "<!-- loader-accuracy:begin -->",
         "<!-- loader-accuracy:end -->",
     );
     let (Some(b), Some(e)) = (doc.find(begin), doc.find(end)) else {
-        eprintln!("docs/loader.md lacks the markers {begin} and {end}");
+        eprintln!("docs/reference/loader.md lacks the markers {begin} and {end}");
         std::process::exit(1);
     };
     let new = format!("{}{begin}\n{out}{}", &doc[..b], &doc[e..]);
     clothbake_loader::write_atomic_as(&path, "document", true, |w| {
         std::io::Write::write_all(w, new.as_bytes())
     })
-    .expect("write docs/loader.md");
+    .expect("write docs/reference/loader.md");
     println!("wrote {}", path.display());
 }

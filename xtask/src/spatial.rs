@@ -1,5 +1,5 @@
 //! `cargo xtask validate-spatial`: the model resolved per crossing cell against the ray-traced
-//! truth sorted into the same cells (docs/spatial.md), written to `docs/validation-spatial.md`.
+//! truth sorted into the same cells (docs/science/spatial.md), written to `docs/results/validation-spatial.md`.
 
 use clothbake_core::validate::direction_set;
 use clothbake_core::{AnalyticModel, Cell, Fabric, FacetModel, RayTracer};
@@ -26,7 +26,7 @@ pub fn run(root: &Path) {
          (`truth/patches.rs`); a cell's relative error is |model - truth| / truth of the \
          channel-mean I over the cell (cells with under {MIN_HITS} hits left out), the \
          coverage error is |c_model - c_truth| (absolute). Noise: the truth's mean relative \
-         standard error per cell. Definitions: docs/spatial.md.\n\n\
+         standard error per cell. Definitions: docs/science/spatial.md.\n\n\
          | fabric | cells | mean rel. err | worst cell | worst coverage err | noise |\n\
          |---|---|---|---|---|---|"
     )
@@ -71,17 +71,17 @@ pub fn run(root: &Path) {
         eprintln!("{name}: mean {:.4} worst {worst:.4}", sum / n as f64);
     }
     out.push_str(&rows);
-    let path = root.join("docs/validation-spatial.md");
+    let path = root.join("docs/results/validation-spatial.md");
     std::fs::write(&path, out).unwrap();
     eprintln!("wrote {}", path.display());
-    // The same table in docs/validation.md, between its `spatial-validation` markers.
+    // The same table in docs/results/validation.md, between its `spatial-validation` markers.
     crate::transport::write_between(
-        &root.join("docs/validation.md"),
+        &root.join("docs/results/validation.md"),
         "spatial-validation",
         &format!(
-            "## Per crossing cell (the spatial model, docs/spatial.md)\n\n\
+            "## Per crossing cell (the spatial model, docs/science/spatial.md)\n\n\
              Written by `cargo xtask validate-spatial` (details and method in \
-             docs/validation-spatial.md): {PAIRS} pairs up to 70 degrees, {SAMPLES} rays each, \
+             docs/results/validation-spatial.md): {PAIRS} pairs up to 70 degrees, {SAMPLES} rays each, \
              the truth's hits sorted into the crossing cells by its own rule.\n\n\
              | fabric | cells | mean rel. err | worst cell | worst coverage err | noise |\n\
              |---|---|---|---|---|---|\n{rows}"

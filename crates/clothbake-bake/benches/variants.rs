@@ -1,6 +1,6 @@
 //! Criterion benchmark of a bake with each analytic variant: the twill on a 16 x 32 x 16 x 32
 //! grid, direct reflection, one thread. `sliced3d` keeps the open arcs of the grid's directions
-//! (docs/baking.md), so that its bake costs a few times `refined`'s rather than its pairs'
+//! (docs/guide/baking.md), so that its bake costs a few times `refined`'s rather than its pairs'
 //! hundred times.
 
 use clothbake_bake::{bake, BakeOptions, Method};

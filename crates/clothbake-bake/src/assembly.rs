@@ -5,7 +5,7 @@
 //! again ([`Assembly::write_part`]), and at the end the symmetry copies are made in place and
 //! the buffer becomes the [`clothbake_loader::Table`]'s values ([`Assembly::into_values`]). So
 //! a bake holds its table once (12 bytes a cell, RGB f32; a spatial one 4 (3 + 2 K)), not
-//! rows, then a table assembled from them, then the writer's copies (docs/limits-output.md).
+//! rows, then a table assembled from them, then the writer's copies (docs/reference/limits-output.md).
 //!
 //! The buffer covers a range of rows (all of them for a table, a shard's for a shard), in the
 //! table's layout restricted to those rows: cell `c` of the range's `m` cells holds its RGB at

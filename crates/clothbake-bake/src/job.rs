@@ -595,7 +595,7 @@ fn check_values(done: &Assembly, baker: &Baker, job: &Job<'_>) -> Result<(), Job
                     wo.0,
                     wo.1
                 ),
-                "check the fabric's sizes and materials (docs/limits.md gives the ranges that \
+                "check the fabric's sizes and materials (docs/reference/limits.md gives the ranges that \
                  compute); nothing was written",
             ));
         }

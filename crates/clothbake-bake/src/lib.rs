@@ -6,7 +6,7 @@
 //! leaves [`directions`] (a row's incident cell, a cell's direction) and [`orbit`] (the
 //! symmetry orbits of the azimuth cells) serve it, [`spatial`] and [`transport`]; [`shard`],
 //! [`merge`] and [`checkpoint`] split a bake into shards, assemble them and resume an
-//! interrupted one (docs/cluster.md); [`job`] runs a whole bake (checkpoints, resume, shard or
+//! interrupted one (docs/guide/cluster.md); [`job`] runs a whole bake (checkpoints, resume, shard or
 //! table file, cancellation) for the CLI and Python, under the output's [`lock`] and after the
 //! [`memory`] check; [`settings`] checks and resolves the options as users give them;
 //! [`output`] checks outputs and writes tables with reproducible bytes; [`compare`] holds two

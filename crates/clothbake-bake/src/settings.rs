@@ -144,9 +144,9 @@ pub struct Settings {
     pub caps: Option<Caps>,
     /// The secondary-reflection settings.
     pub bounces: Bounces,
-    /// A spatially varying table (docs/spatial.md).
+    /// A spatially varying table (docs/science/spatial.md).
     pub spatial: bool,
-    /// The two-faced cloth over the sphere (docs/transmission.md): the grid's polar counts
+    /// The two-faced cloth over the sphere (docs/science/transmission.md): the grid's polar counts
     /// are per side.
     pub faces: Faces,
     /// A two-faced bake's eye rays per node of its path-traced rest.
@@ -156,7 +156,7 @@ pub struct Settings {
 /// The bounces and the secondary reflection's settings as given.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounces {
-    /// 1, 2, N > 2 or `clothbake_core::ALL_BOUNCES` (docs/transport.md).
+    /// 1, 2, N > 2 or `clothbake_core::ALL_BOUNCES` (docs/science/transport.md).
     pub bounces: u32,
     /// `Some(true)`: the two-level sampling; `Some(false)`: the analytic solution [default].
     pub sampled: Option<bool>,
@@ -315,7 +315,7 @@ impl Settings {
             ];
             if let Some((_, name)) = given.into_iter().find(|g| g.0) {
                 return Err(format!(
-                    "{} bakes the two-faced cloth's model (docs/transmission.md): the analytic \
+                    "{} bakes the two-faced cloth's model (docs/science/transmission.md): the analytic \
                      direct reflection with every other bounce path-traced, averaged over the \
                      period; drop {name}",
                     n.word("faces", "two")

@@ -4,7 +4,7 @@
 //! shard K of N of a [`split`] of the rows, baked by one process (`clothbake bake --shard K/N`),
 //! and `clothbake merge` assembles the shards into the table. A **checkpoint** holds the rows a
 //! bake (or a shard's bake) has finished so far, for `--resume`. Both are a [`Part`], stored
-//! in the loader's binary container (`clothbake_loader::container`, docs/table-format.md) of
+//! in the loader's binary container (`clothbake_loader::container`, docs/reference/table-format.md) of
 //! kind `shard` or `checkpoint`.
 //!
 //! The JSON header holds the shard index and count (`"shard"`; `null` for a checkpoint of a

@@ -1,5 +1,5 @@
-//! `bake --spatial`: what a spatially varying table adds to the averaged one (docs/spatial.md,
-//! docs/table-format.md): the period's layout ([`layout`]) and, per grid cell, each class's
+//! `bake --spatial`: what a spatially varying table adds to the averaged one (docs/science/spatial.md,
+//! docs/reference/table-format.md): the period's layout ([`layout`]) and, per grid cell, each class's
 //! diffuse and specular f_r and with the second bounce its neighbours' terms
 //! ([`class_values`]), packed three to a [`crate::Row`] entry after the averaged RGB.
 

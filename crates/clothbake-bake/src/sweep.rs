@@ -69,7 +69,7 @@ pub struct BakeOptions {
     pub bounces: u32,
     /// How I_2 is computed; used only when `bounces == 2`.
     pub secondary: SecondaryOptions,
-    /// A spatially varying table (docs/spatial.md): the classes of the period's cells beside
+    /// A spatially varying table (docs/science/spatial.md): the classes of the period's cells beside
     /// the average. Analytic model, one or two bounces.
     pub spatial: bool,
     /// A two-faced bake's eye rays per node of its path-traced rest
@@ -208,7 +208,7 @@ pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
         && (opts.spatial || opts.bounces != 1 || !matches!(opts.method, Method::Analytic { .. }))
     {
         return Err(BakeError::Invalid(
-            "--faces two bakes the two-faced cloth's model (docs/transmission.md): the analytic \
+            "--faces two bakes the two-faced cloth's model (docs/science/transmission.md): the analytic \
              direct reflection with every other bounce path-traced, averaged over the period; \
              drop --spatial, --bounces and --method raytrace"
                 .into(),
@@ -237,7 +237,7 @@ pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
         )),
         (n, _) => Err(BakeError::Invalid(format!(
             "{n} bounces is not supported; use --bounces 1 (direct reflection), 2 (direct and \
-             secondary reflection, thesis ch. 5) or all (every bounce, docs/transport.md)"
+             secondary reflection, thesis ch. 5) or all (every bounce, docs/science/transport.md)"
         ))),
     }
 }
@@ -478,7 +478,7 @@ fn batched(bsdf: Arc<dyn Bsdf + Send + Sync>) -> CellFn {
 }
 
 /// The most memory a bake gives to a [`Variant::Sliced3d`] model's open arcs kept for the
-/// grid's directions (docs/baking.md).
+/// grid's directions (docs/guide/baking.md).
 pub const OPEN_ARCS_BUDGET: usize = 256 << 20;
 
 /// Model `m` with the open arcs of every direction of grid `g` kept

@@ -1,5 +1,5 @@
 //! The multiple-bounce part of a full-transport bake (`--bounces N > 2`, `--bounces all`;
-//! docs/transport.md): orders 2 to N path-traced on the micro-geometry on a coarse direction
+//! docs/science/transport.md): orders 2 to N path-traced on the micro-geometry on a coarse direction
 //! grid and interpolated onto the table, whose direct term the analytic model gives per cell.
 //!
 //! * The part varies slowly with direction, so it is estimated on a coarse cell-centred grid

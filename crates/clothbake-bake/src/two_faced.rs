@@ -1,4 +1,4 @@
-//! The two-faced cloth as a [`Bsdf`] over the whole sphere (docs/transmission.md): no floor,
+//! The two-faced cloth as a [`Bsdf`] over the whole sphere (docs/science/transmission.md): no floor,
 //! the back the inverted weave, light through the gaps and through translucent yarns.
 //!
 //! * **Openness** (the straight-through lobe): in closed form, `clothbake_core::openness`.
@@ -312,7 +312,7 @@ mod tests {
     #[test]
     fn at_the_nodes_the_sum_is_the_ray_traced_whole() {
         // At a node the rest is exact up to its noise; what remains is the analytic direct
-        // reflection's own error (docs/validation.md) on the face seen.
+        // reflection's own error (docs/results/validation.md) on the face seen.
         let fabric = open_plain(0.8);
         let tf = TwoFaced::with_grid(
             &fabric,
@@ -345,7 +345,7 @@ mod tests {
             // The rest's nodes and the truth each carry their noise (16 384 and 65 536 rays:
             // the node's error is about twice the truth's); the model's direct reflection has
             // its own error, 3.7% and 10.7% of it at these two reflection pairs on this open
-            // weave (docs/transmission.md).
+            // weave (docs/science/transmission.md).
             let tol = 4.0 * err[1] * (1.0 + 2.0) + 0.12 * direct[1];
             eprintln!("{what}: {got:?} vs {want:?} +- {err:?} (direct {direct:?})");
             assert!(

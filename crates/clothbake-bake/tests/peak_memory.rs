@@ -2,7 +2,7 @@
 //! the table's size in memory). Measured as the largest number of heap bytes allocated at once
 //! during `job::run`, counted by this test binary's global allocator: deterministic (no
 //! resident-set noise), and the one test in its binary, so nothing else allocates meanwhile.
-//! Run with `--nocapture` to see the numbers (docs/performance.md quotes them).
+//! Run with `--nocapture` to see the numbers (docs/results/performance.md quotes them).
 
 use clothbake_bake::job::{run, Hooks, Job, Target};
 use clothbake_bake::output::Format;

@@ -71,7 +71,7 @@ fn compare(name: &str, paths_node: usize, paths_brute: usize, control: bool) -> 
 #[test]
 fn the_tables_multiple_bounce_part_matches_a_brute_force_path_trace() {
     // Without the control variate (the analytic second bounce) the parallel surface's
-    // interpolation error reaches 4.7% of I_1 (docs/transport.md); with it, 1%.
+    // interpolation error reaches 4.7% of I_1 (docs/science/transport.md); with it, 1%.
     let mut bad = Vec::new();
     for name in ["parallel", "twill"] {
         let rows = compare(name, 8192, 40_000, true);

@@ -11,7 +11,7 @@
 //! normal; `wi` points toward the light, `wo` toward the eye, both unit vectors
 //! ([`UnitVec3`]); values are linear RGB. A one-faced cloth (the thesis's, over its floor)
 //! reflects nothing at or below the horizon (cos theta <= [`HORIZON_COS`]); a two-faced one
-//! (docs/transmission.md) also reflects from its back (-Z) and transmits, and passes light
+//! (docs/science/transmission.md) also reflects from its back (-Z) and transmits, and passes light
 //! straight through its gaps ([`Bsdf::openness`]); within [`HORIZON_COS`] of the plane every
 //! direction gives zero.
 
@@ -45,7 +45,7 @@ impl BsdfSample {
 }
 
 /// Where on the cloth a reflectance is looked up: a point of the weave period and the part of
-/// the period one pixel covers (docs/spatial.md).
+/// the period one pixel covers (docs/science/spatial.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Footprint {
     /// Fraction of the period along the weft (+X); any finite value, wrapped.
@@ -59,7 +59,7 @@ pub struct Footprint {
 
 /// Footprint widths, in crossing cells, below which a footprint is answered by the point
 /// level alone (`POINT_UNTIL`) and from which by the cells alone (`CELLS_FROM`); between,
-/// the two blend smoothly (docs/spatial.md, "Levels of detail").
+/// the two blend smoothly (docs/science/spatial.md, "Levels of detail").
 pub const POINT_UNTIL: f64 = 1.0;
 /// See [`POINT_UNTIL`].
 pub const CELLS_FROM: f64 = 2.0;

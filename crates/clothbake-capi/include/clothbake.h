@@ -2,7 +2,7 @@
  *
  * Load a BRDF table baked by `clothbake`, look it up with quadrilinear interpolation and
  * importance-sample it. Link with libclothbake_capi.a (plus -lpthread -ldl -lm on Linux) or
- * libclothbake_capi.so. Guide: docs/loader.md.
+ * libclothbake_capi.so. Guide: docs/reference/loader.md.
  *
  * Directions are unit vectors in the cloth's local frame: +Z the normal, +X the weft, +Y the
  * warp; wi points toward the light, wo toward the eye. Values are f_r in 1/sr, RGB. Directions
@@ -46,7 +46,7 @@ int clothbake_eval(const clothbake_brdf *brdf, const float *wi, const float *wo,
 /* f_r at point (u, v) of the weave period (fractions, wrapped) through a footprint of side
  * `width` periods (0: the point; >= 1: clothbake_eval) into out[3], and the share of the
  * footprint in which the eye meets yarn into *coverage (unless NULL), at the footprint's level
- * of detail (docs/spatial.md): a table baked with --spatial (one bounce) carries its yarns and
+ * of detail (docs/science/spatial.md): a table baked with --spatial (one bounce) carries its yarns and
  * traces them under a crossing cell (unless opened with CLOTHBAKE_NO_POINT_LEVEL), shows its
  * crossing cells from two cells wide, and the average from a period; another answers
  * clothbake_eval and coverage 1. 0, or -1 on error. */

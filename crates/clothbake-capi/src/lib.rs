@@ -1,4 +1,4 @@
-//! The C ABI of the clothbake loader, declared in `include/clothbake.h` (see `docs/loader.md`).
+//! The C ABI of the clothbake loader, declared in `include/clothbake.h` (see `docs/reference/loader.md`).
 //!
 //! A table is opened into an opaque `clothbake_brdf` handle, looked up and sampled with the
 //! functions below, and closed. Every function checks its pointers and catches panics: no
@@ -19,7 +19,7 @@ pub const CLOTHBAKE_RECIPROCAL: u32 = 2;
 /// `clothbake_open` flag: do not build the sampling CDFs (saves 4 bytes a cell).
 pub const CLOTHBAKE_NO_SAMPLING: u32 = 4;
 /// `clothbake_open` flag: no point level (a spatial table that carries its yarns then answers
-/// every footprint under a period with its crossing cells, docs/spatial.md).
+/// every footprint under a period with its crossing cells, docs/science/spatial.md).
 pub const CLOTHBAKE_NO_POINT_LEVEL: u32 = 8;
 const ALL_FLAGS: u32 =
     CLOTHBAKE_F32 | CLOTHBAKE_RECIPROCAL | CLOTHBAKE_NO_SAMPLING | CLOTHBAKE_NO_POINT_LEVEL;

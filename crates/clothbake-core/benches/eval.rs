@@ -69,7 +69,7 @@ fn analytic(c: &mut Criterion) {
             })
         });
     }
-    // The variants side by side, one pair at a time (docs/model.md, "The sliced variant" and
+    // The variants side by side, one pair at a time (docs/science/model.md, "The sliced variant" and
     // "The sliced3d variant").
     for variant in [Variant::Refined, Variant::Sliced, Variant::Sliced3d] {
         let m = AnalyticModel::with_variant(&fabric, FacetModel::Huo, variant);

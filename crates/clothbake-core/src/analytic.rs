@@ -178,13 +178,13 @@ pub enum Variant {
     #[default]
     Refined,
     /// `refined`, with each piece's cross-section profile taken slice by slice along the piece
-    /// instead of once for its crossing row (docs/model.md, "The sliced variant"): the
+    /// instead of once for its crossing row (docs/science/model.md, "The sliced variant"): the
     /// neighbours' floats that reach into the piece from the next rows, seen end-on, and the
     /// crossing cylinder only where it is, at its true height there, in place of its
     /// equal-area rectangle along the whole piece. Slices where the profile is constant are
     /// exact; the slices under a crossing cylinder are split in [`SLICE_PARTS`] parts.
     Sliced,
-    /// `sliced`, with what hides each slice's side taken in three dimensions (docs/model.md,
+    /// `sliced`, with what hides each slice's side taken in three dimensions (docs/science/model.md,
     /// "The sliced3d variant"): the rays that leave the slice's arc toward the light or the eye
     /// are followed through the floats around the piece, each a finite cylinder, in place of
     /// the slice's 2-D profile of its own row. Pieces are one unit only where their
@@ -198,7 +198,7 @@ pub enum Variant {
 pub const SLICE_PARTS: usize = 4;
 
 /// The most cells (warp x weft threads) a period may have for [`Variant::Sliced3d`], whose
-/// preprocessing grows faster than the period (docs/limits.md): about a minute and two
+/// preprocessing grows faster than the period (docs/reference/limits.md): about a minute and two
 /// gigabytes at this size for a random period.
 pub const SLICED3D_MAX_CELLS: usize = 16_384;
 
@@ -216,7 +216,7 @@ pub fn check_variant(fabric: &Fabric, variant: Variant) -> Result<(), (String, S
                 w.n_warp(),
                 w.n_weft()
             ),
-            "use the variant sliced or refined for it (docs/limits.md)".to_string(),
+            "use the variant sliced or refined for it (docs/reference/limits.md)".to_string(),
         ));
     }
     Ok(())
@@ -266,7 +266,7 @@ pub struct AnalyticModel {
 }
 
 /// A class's reflection for one pair of directions, per unit diffuse albedo
-/// (docs/spatial.md): a cell of the class whose thread has albedo rho_d reflects
+/// (docs/science/spatial.md): a cell of the class whose thread has albedo rho_d reflects
 /// f_r = rho_d `diffuse` + `specular` (eqs 4.1, 4.11 restricted to the cell's piece). With the
 /// second bounce (eq. 5.15, sec. 5.4), its neighbours on the +c and -c sides, of albedos
 /// rho_+ and rho_-, add sum_k rho_k (`neighbour[k]` + rho_d `both[k]`), and `diffuse` and
@@ -301,7 +301,7 @@ pub struct CellClass {
     pub neighbours: [[f64; 3]; 2],
 }
 
-/// What the model answers at one point of the weave period (docs/spatial.md).
+/// What the model answers at one point of the weave period (docs/science/spatial.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LocalReflection {
     /// The intensity averaged over the visible yarn of the cell (eq. 4.11 restricted to the
@@ -1415,7 +1415,7 @@ impl AnalyticModel {
         &self.grid
     }
 
-    /// The reflection at point `at` of the period (docs/spatial.md): eq. 4.11 restricted to the
+    /// The reflection at point `at` of the period (docs/science/spatial.md): eq. 4.11 restricted to the
     /// unit over the cell containing `at`, with the cell's coverage. The coverage-weighted mean
     /// over the period of the local reflection is [`AnalyticModel::intensity_with`].
     pub fn intensity_at(
@@ -1719,7 +1719,7 @@ impl AnalyticModel {
     /// The model's share of the period's projected area, seen from `wo`, that is visible, faces
     /// the light `wi` and is lit: the sum of D_i l_vi times the projected width of the lit and
     /// visible arc (eqs 4.2-4.3), per unit projected area. With [`AnalyticModel::coverage`] it
-    /// splits the model's error into masking and shadowing (docs/model.md, "Where the error
+    /// splits the model's error into masking and shadowing (docs/science/model.md, "Where the error
     /// comes from"); 0 below the horizon.
     pub fn lit_coverage(&self, wi: UnitVec3, wo: UnitVec3) -> f64 {
         if !(wi.above_horizon() && wo.above_horizon()) {
@@ -2298,7 +2298,7 @@ mod tests {
         assert!(check_period(MAX_THREADS, 16).is_ok());
         let (problem, fix) = check_period(MAX_THREADS + 1, 1).unwrap_err();
         assert!(problem.contains("65537 warp threads"), "{problem}");
-        assert!(fix.contains("docs/limits.md"), "{fix}");
+        assert!(fix.contains("docs/reference/limits.md"), "{fix}");
         let (problem, _) = check_period(1025, 1024).unwrap_err();
         assert!(
             problem.contains(&format!("1049600 cells, more than the {MAX_CELLS}")),
@@ -2487,7 +2487,7 @@ mod tests {
 
     /// The sliced variant's masking against the ray tracer: where the crossing yarns lie far
     /// apart for their radius (the cotton poplin's wefts, 3.8 radii), the crossing row's
-    /// equal-area rectangle hides 8% too much of the cloth (docs/model.md); the slices take
+    /// equal-area rectangle hides 8% too much of the cloth (docs/science/model.md); the slices take
     /// the crossing cylinder only where it is and the neighbours' floats where they are.
     #[test]
     fn slices_see_what_the_micro_geometry_shows() {

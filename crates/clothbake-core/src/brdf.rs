@@ -39,7 +39,7 @@ impl Component {
 /// The analytic model of a fabric (any facet and variant) with a bounce setting, as a BSDF.
 /// Sampling is the trait's cos(theta_i)-weighted default: the model has no closed-form inverse.
 /// With the fabric's yarns ([`AnalyticBsdf::with_yarns`]) footprints smaller than a crossing
-/// cell are answered by the point level (docs/spatial.md, "Levels of detail").
+/// cell are answered by the point level (docs/science/spatial.md, "Levels of detail").
 pub struct AnalyticBsdf {
     model: AnalyticModel,
     secondary: Option<SecondaryOptions>,
@@ -133,7 +133,7 @@ impl AnalyticBsdf {
 
     /// The box filter of side `width` periods over the crossing cells: the cells' f_r
     /// weighted by their covered share times their coverage, and the mean coverage (thesis
-    /// units, docs/spatial.md).
+    /// units, docs/science/spatial.md).
     fn cells(&self, at: Footprint, width: f64, wi: UnitVec3, wo: UnitVec3) -> Local {
         let (mut num, mut den, mut area) = ([0.0; 3], 0.0, 0.0);
         for (cell, share) in self.cells_under(at, width) {

@@ -1,5 +1,5 @@
 //! The weave period's crossing cells: how finely the model resolves a position in the period
-//! (docs/spatial.md).
+//! (docs/science/spatial.md).
 //!
 //! Warp thread i lies at x = X_i, weft thread j at y = Y_j ([`crate::geometry`]). Cell (i, j) is
 //! the rectangle between the midpoints of neighbouring threads: x from (X_{i-1} + X_i) / 2 to

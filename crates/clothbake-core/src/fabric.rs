@@ -1,6 +1,6 @@
 //! Fabric description files (JSON) and their validation into a [`Fabric`].
 //!
-//! Schema (every length in the same arbitrary unit; see `docs/fabric-format.md`):
+//! Schema (every length in the same arbitrary unit; see `docs/reference/fabric-format.md`):
 //! ```json
 //! { "name": "twill", "pattern": [[1,1,0],[0,1,1],[1,0,1]],
 //!   "warp": { "radius": 1.5, "height": 0.0, "spacing": 3.1,
@@ -55,7 +55,7 @@ pub const MAX_LENGTH: f64 = 1e9;
 /// Most threads of one group in a period (pattern columns or rows).
 pub const MAX_THREADS: usize = 1 << 16;
 /// Most cells of a period (columns x rows): preprocessing and memory grow in proportion (a
-/// random 1024 x 1024 period takes about 10 s and 100 MB to preprocess; docs/limits.md).
+/// random 1024 x 1024 period takes about 10 s and 100 MB to preprocess; docs/reference/limits.md).
 pub const MAX_CELLS: usize = 1 << 20;
 
 /// A validated fabric: weave period, both yarn groups. Every invariant the model relies on holds:
@@ -304,7 +304,7 @@ impl Fabric {
             return Err(cx.err(
                 "",
                 format!("the fabric file {what}; expected an object {{\"pattern\": ..., \"warp\": ..., \"weft\": ...}}"),
-                "give a fabric file (docs/fabric-format.md), e.g. tables/twill.json",
+                "give a fabric file (docs/reference/fabric-format.md), e.g. tables/twill.json",
             ));
         }
         let de = &mut serde_json::Deserializer::from_str(text);
@@ -312,9 +312,9 @@ impl Fabric {
             let path = e.path().to_string();
             let inner = e.into_inner();
             let fix = if inner.to_string().contains("unknown field") {
-                "remove or rename the field (see docs/fabric-format.md)"
+                "remove or rename the field (see docs/reference/fabric-format.md)"
             } else if inner.to_string().contains("missing field") {
-                "add the field (see docs/fabric-format.md)"
+                "add the field (see docs/reference/fabric-format.md)"
             } else {
                 "fix the JSON syntax or the value's type"
             };
@@ -510,7 +510,7 @@ impl Fabric {
     /// The fabric's back seen from below, as a fabric of its own: the weave inverted
     /// ([`Weave::inverted`]), the same threads (the two-faced cloth mirrors the back's floats
     /// below z = 0, so from below their axes stand at the threads' heights;
-    /// docs/transmission.md). An error where the inverted weave's floats do not fit the
+    /// docs/science/transmission.md). An error where the inverted weave's floats do not fit the
     /// threads' given segment lengths.
     pub fn back(&self) -> Result<Fabric, FabricError> {
         Fabric::new(
@@ -518,7 +518,7 @@ impl Fabric {
             self.weave.inverted(),
             self.warp.clone(),
             self.weft.clone(),
-            &PlainNaming("the fabric's back (its weave inverted; docs/transmission.md)"),
+            &PlainNaming("the fabric's back (its weave inverted; docs/science/transmission.md)"),
         )
         .map(|f| f.with_notes(self.notes.clone()))
     }
@@ -727,7 +727,7 @@ impl Fabric {
 /// and [`MAX_CELLS`]; else what is wrong and how to fix it.
 pub fn check_period(columns: usize, rows: usize) -> Result<(), (String, String)> {
     let fix = format!(
-        "give one repeat of the weave, at most {MAX_THREADS} threads per group and {MAX_CELLS} cells (docs/limits.md)"
+        "give one repeat of the weave, at most {MAX_THREADS} threads per group and {MAX_CELLS} cells (docs/reference/limits.md)"
     );
     if columns > MAX_THREADS || rows > MAX_THREADS {
         let (n, what) = if columns > MAX_THREADS {

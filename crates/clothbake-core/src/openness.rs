@@ -1,4 +1,4 @@
-//! The openness of the two-faced cloth (docs/transmission.md): the share of the light from a
+//! The openness of the two-faced cloth (docs/science/transmission.md): the share of the light from a
 //! direction that passes straight through the gaps between the yarns, in closed form from the
 //! threads' cross-sections (the discs of the thesis's shadowing geometry, eqs 3.2-3.9).
 //!
@@ -12,7 +12,7 @@
 //! strips, `1 - sum(widths) / period` (at least 0), and the two groups block independently:
 //! the openness is the product of the two groups' shares. At normal incidence this is the
 //! geometric open area `(1 - d_warp / s_warp)(1 - d_weft / s_weft)` exactly; at an angle it
-//! neglects that a ray also runs along the threads (docs/transmission.md measures it against
+//! neglects that a ray also runs along the threads (docs/science/transmission.md measures it against
 //! the ray tracer).
 
 use crate::fabric::Fabric;

@@ -198,7 +198,7 @@ mod tests {
 
     #[test]
     fn the_period_mean_of_the_points_is_the_closed_form_on_parallel_cylinders() {
-        // Parallel cylinders are where the thesis's construction is exact (docs/validation.md:
+        // Parallel cylinders are where the thesis's construction is exact (docs/results/validation.md:
         // the model within 0.01% of the ray tracer): the point level's coverage-weighted period
         // mean must be the analytic average, and its mean coverage the model's C(wo).
         let f = Fabric::from_path(

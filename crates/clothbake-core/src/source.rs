@@ -36,7 +36,7 @@ impl Fabric {
             file: file.clone(),
             field: String::new(),
             problem: format!("the fabric file is not UTF-8 text: {e}"),
-            fix: "save it as UTF-8 JSON (see docs/fabric-format.md)".into(),
+            fix: "save it as UTF-8 JSON (see docs/reference/fabric-format.md)".into(),
         })?;
         Fabric::from_json_str(&text, &file)
     }
@@ -116,9 +116,9 @@ fn read_text_file(path: &Path, file: &str, wif: bool) -> Result<Vec<u8>, FabricE
                 bytes[at]
             ),
             if wif {
-                "give a WIF draft as text (docs/wif.md)"
+                "give a WIF draft as text (docs/reference/wif.md)"
             } else {
-                "give a JSON fabric file (docs/fabric-format.md)"
+                "give a JSON fabric file (docs/reference/fabric-format.md)"
             },
         ));
     }
@@ -146,7 +146,7 @@ fn too_large(file: &str, len: u64) -> FabricError {
             "the file is {len} bytes, more than the {} MiB a fabric file or draft may be",
             MAX_FILE_BYTES >> 20
         ),
-        fix: "give one repeat of the weave (docs/limits.md)".into(),
+        fix: "give one repeat of the weave (docs/reference/limits.md)".into(),
     }
 }
 

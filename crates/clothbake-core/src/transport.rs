@@ -1,4 +1,4 @@
-//! Full light transport (`--bounces N`, `--bounces all`; docs/transport.md): the direct
+//! Full light transport (`--bounces N`, `--bounces all`; docs/science/transport.md): the direct
 //! reflection I_1 from the analytic model (thesis eqs 4.1-4.11, exact on its own terms and
 //! smooth) plus every later bounce, orders 2 to N, estimated by the ground truth's path tracer
 //! ([`crate::truth::pathtracer`]) on the explicit micro-geometry: every yarn, parallel and
@@ -24,7 +24,7 @@ pub const ALL_BOUNCES: u32 = u32::MAX;
 
 /// The highest order `--bounces all` follows: Russian roulette ends nearly every path long
 /// before it (the orders past 20 carry under 1e-6 of I_1 on every shipped fabric,
-/// docs/transport.md).
+/// docs/science/transport.md).
 pub const MAX_ORDER: usize = 64;
 
 /// Default paths per direction pair of [`Transport::multiple`] on the command line.

@@ -1,7 +1,7 @@
 //! Weaving drafts in WIF (Weaving Information File, version 1.1) read into a [`Fabric`].
 //!
 //! A WIF is an INI-like text file: `[SECTION]` headers, `key=value` lines, `;` comment lines,
-//! names case-insensitive. What is read (the full account is `docs/wif.md`):
+//! names case-insensitive. What is read (the full account is `docs/reference/wif.md`):
 //!
 //! * **Pattern.** Warp end e (1-based) is on the shafts of `[THREADING] e=`; pick p lifts the
 //!   shafts of `[LIFTPLAN] p=`, or, without a liftplan, the union of the `[TIEUP]` shafts of the
@@ -341,7 +341,9 @@ impl<'a> Draft<'a> {
             section,
             Some(e.line),
             format!("{}: {what} is too large, at most {MAX_COUNT}", e.shown()),
-            format!("give {what} up to {MAX_COUNT}: one repeat of the weave (docs/limits.md)"),
+            format!(
+                "give {what} up to {MAX_COUNT}: one repeat of the weave (docs/reference/limits.md)"
+            ),
         )
     }
 
@@ -568,7 +570,7 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
             "",
             None,
             "this is not a WIF draft: it has no [WIF] section",
-            "give a Weaving Information File (version 1.1), or a JSON fabric file (docs/fabric-format.md)",
+            "give a Weaving Information File (version 1.1), or a JSON fabric file (docs/reference/fabric-format.md)",
         ));
     }
     let rising = d.boolean("WEAVING", "Rising Shed", true)?;
@@ -720,7 +722,7 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
                 "the draft has {ends} ends x {picks} picks = {} cells, more than the {MAX_DRAFT_CELLS} clothbake reads",
                 ends * picks
             ),
-            "give one repeat of the weave (docs/limits.md)",
+            "give one repeat of the weave (docs/reference/limits.md)",
         ));
     }
     let dd = drawdown(&threading, &lift, rising);
@@ -796,7 +798,7 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
     Ok(fabric.with_notes(warp_note.into_iter().chain(weft_note).collect()))
 }
 
-/// The private section a draft may carry its facet material in (docs/wif.md): WIF has no
+/// The private section a draft may carry its facet material in (docs/reference/wif.md): WIF has no
 /// field for rho_s and n, and other programs ignore `PRIVATE` sections.
 pub const MATERIAL_SECTION: &str = "PRIVATE CLOTHBAKE MATERIAL";
 
@@ -844,7 +846,7 @@ fn facet_material(d: &Draft<'_>) -> Result<FacetMaterial, WifError> {
                 MATERIAL_SECTION,
                 Some(e.line),
                 format!("key `{}` is not one clothbake reads", clip(&e.key)),
-                format!("use {} (docs/wif.md)", MATERIAL_KEYS.join(", ")),
+                format!("use {} (docs/reference/wif.md)", MATERIAL_KEYS.join(", ")),
             ));
         };
         let x = bare(&e.value).parse::<f64>().ok().filter(|x| x.is_finite());
@@ -1097,7 +1099,7 @@ fn colours(d: &Draft<'_>) -> Result<Vec<(usize, [f64; 3])>, WifError> {
 
 /// The clothbake yarn group of one period of threads: radii, centre-to-centre spacings,
 /// colours; and a note when yarns thicker than their spacing allows were packed
-/// ([`packed_radii`]: round yarns capped where neighbours meet; docs/wif.md).
+/// ([`packed_radii`]: round yarns capped where neighbours meet; docs/reference/wif.md).
 fn group(g: &str, t: &[Thread], unit: &(f64, String)) -> (YarnGroup, Option<String>) {
     let n = t.len();
     let spacing: Vec<f64> = (0..n)

@@ -31,7 +31,7 @@ pub struct Material {
     /// it gives back diffusely on the near side, in the same colour (the dye absorbs alike on
     /// both ways): t = tau rho_d ([`Material::transmittance`]). 0, the thesis's, lets nothing
     /// through. With tau > 0 the fabric must keep rho_d (1 + tau) + rho_s <= 1 in every
-    /// channel. Only the two-faced cloth (docs/transmission.md) shows it.
+    /// channel. Only the two-faced cloth (docs/science/transmission.md) shows it.
     pub translucency: f64,
 }
 
@@ -43,7 +43,7 @@ impl Material {
     /// transmitted light has the reflected light's colour. With Lewis facets the reflected
     /// share is at most rho_d + rho_s, so R + t <= rho_d (1 + tau) + rho_s <= 1 (checked on
     /// the fabric) at every incident direction, and the absorbed share goes to 0 as that sum
-    /// goes to 1 (docs/transmission.md).
+    /// goes to 1 (docs/science/transmission.md).
     pub fn transmittance(&self, albedo: [f64; 3]) -> [f64; 3] {
         albedo.map(|a| self.translucency * a)
     }

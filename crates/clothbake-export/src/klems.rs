@@ -1,6 +1,6 @@
 //! Daylighting export: any [`Bsdf`] as an LBNL/Radiance BSDF XML file on the Klems basis
 //! ("LBNL/Klems Full", 145 patches a hemisphere), and the datasheet figures fabric-shade makers
-//! publish. Conventions, quadrature and the Radiance round trip: docs/daylighting.md.
+//! publish. Conventions, quadrature and the Radiance round trip: docs/guide/daylighting.md.
 //!
 //! * [`RINGS`], [`Patch`], [`patch_of`]: the basis, with each patch's solid angle and
 //!   projected solid angle (Lambda) in closed form.
@@ -380,7 +380,7 @@ pub enum Band {
     /// CIE Y of the linear (Rec. 709) RGB: 0.2126 R + 0.7152 G + 0.0722 B.
     Visible,
     /// The mean of R, G and B: a grey stand-in for the solar band, which RGB albedos do not
-    /// resolve (docs/daylighting.md).
+    /// resolve (docs/guide/daylighting.md).
     Solar,
 }
 

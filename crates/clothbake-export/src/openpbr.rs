@@ -365,7 +365,7 @@ pub fn mtlx(m: &Fitted, name: &str, maps: Option<&[String; 3]>, periods_per_uv: 
     let _ = writeln!(s, "<?xml version=\"1.0\"?>");
     let _ = writeln!(
         s,
-        "<!-- clothbake {}: {} fitted as OpenPBR (docs/export.md) -->",
+        "<!-- clothbake {}: {} fitted as OpenPBR (docs/guide/export.md) -->",
         env!("CARGO_PKG_VERSION"),
         xml_escape(name).replace("--", "- -")
     );
@@ -463,7 +463,7 @@ pub fn usda(m: &Fitted, name: &str, maps: Option<&[String; 3]>, periods_per_uv: 
         s,
         "#usda 1.0\n(\n    defaultPrim = \"Cloth\"\n    metersPerUnit = 1\n    upAxis = \"Z\"\n    \
          doc = \"clothbake {}: {} fitted as OpenPBR, with a UsdPreviewSurface fallback \
-         (docs/export.md)\"\n)\n",
+         (docs/guide/export.md)\"\n)\n",
         env!("CARGO_PKG_VERSION"),
         name.replace(['"', '\\'], "'")
     );
@@ -631,7 +631,7 @@ pub fn blender(m: &Fitted, name: &str, periods_per_uv: f64) -> (String, Fitted) 
     });
     let sheen = list(&|p| [p.sheen_roughness, p.diffuse_roughness, 0.0, 1.0]);
     let src = format!(
-        r#""""The cloth material "{title}" fitted by clothbake {version} (docs/export.md).
+        r#""""The cloth material "{title}" fitted by clothbake {version} (docs/guide/export.md).
 
 Run inside Blender (`blender --python THIS.py`, or exec it in Blender's Python console): it
 builds a Principled BSDF material named "{title}" and assigns it to the selected objects.

@@ -2,7 +2,7 @@
 //! parameterization for efficient material acquisition and rendering"), as Mitsuba 3's
 //! `measured` BSDF (RGB flavour; spectral flavour in its spectral variants) and pbrt-v4's
 //! `measured` material (spectral flavour only) read it. Layout and parameterisation:
-//! `docs/export.md`.
+//! `docs/guide/export.md`.
 //!
 //! The file is a `tensor_file`: a header naming fields (name, element type, shape, offset) and
 //! their little-endian data. The reader interpolates, for the view direction v (its

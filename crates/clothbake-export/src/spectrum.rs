@@ -12,7 +12,7 @@
 //! spectrum 1 (to 1e-4). The projection is the one a spectral renderer uses to show a
 //! reflectance under its white light: the CIE 1931 2-degree colour matching functions times the
 //! D65 illuminant, integrated over 360-830 nm, normalised so that Y(1) = 1, then the XYZ to
-//! linear sRGB matrix. Docs: `docs/export.md` ("Spectral files").
+//! linear sRGB matrix. Docs: `docs/guide/export.md` ("Spectral files").
 //!
 //! Because the upsampling is linear, upsampling a BRDF's RGB output equals evaluating the model
 //! with the upsampled albedos wavelength by wavelength wherever the model is linear in its

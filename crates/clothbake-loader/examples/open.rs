@@ -1,5 +1,5 @@
 //! Opens a table file `n` times (default 1) and prints each open's wall time: a target for
-//! `perf record` and `/usr/bin/time` (docs/performance.md, "Opening a table").
+//! `perf record` and `/usr/bin/time` (docs/reference/benchmarks.md, "Opening a table").
 //!
 //! `cargo run --release -p clothbake-loader --example open -- twill.exr [n]`
 

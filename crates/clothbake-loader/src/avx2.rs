@@ -455,7 +455,7 @@ pub(crate) unsafe fn batch<V: Lane>(
     // prefetched before this group's gathers, so that random pairs' memory reads overlap (a
     // hint: no effect on the values). Measured on f32 tables (two lines a tile), the pipeline
     // made random batches 1.1x faster but batches in cache 1.12x slower (the held corners),
-    // so f32 batches are not pipelined (docs/performance.md).
+    // so f32 batches are not pipelined (docs/reference/benchmarks.md).
     const GROUP: usize = 4;
     /// The corners of pairs `k..k + GROUP`, or `None` when one is off the table's domain or the
     /// lookup is symmetrised (then each pair goes through `eval`).

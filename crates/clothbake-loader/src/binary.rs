@@ -1,6 +1,6 @@
 //! The binary table: a [`Table`] in the binary container (kind `table`, the [`Metadata`] as
 //! the JSON header, the values as f32), and the read-only reader of version-1 tables (bincode
-//! header). `docs/table-format.md` describes both byte by byte.
+//! header). `docs/reference/table-format.md` describes both byte by byte.
 
 use std::path::Path;
 
@@ -11,7 +11,7 @@ use crate::error::TableError;
 use crate::table::{check_format_version, Metadata, Table};
 
 /// Writes a table in the binary format (a container of kind `table`, see
-/// `docs/table-format.md`), atomically.
+/// `docs/reference/table-format.md`), atomically.
 pub fn write_binary(path: &Path, table: &Table, overwrite: bool) -> Result<(), TableError> {
     table.validate().map_err(|e| e.unwritable(path))?;
     let header = serde_json::to_value(&table.meta).map_err(|e| TableError::Unwritable {
@@ -63,7 +63,7 @@ mod legacy {
     const FIXED_LEN: u64 = PREFIX_LEN + 8 + 4;
 
     /// bincode settings of the header: fixed-width little-endian integers, strings as a u64
-    /// length and UTF-8 bytes (see `docs/table-format.md`).
+    /// length and UTF-8 bytes (see `docs/reference/table-format.md`).
     fn bincode_options() -> impl Options {
         bincode::DefaultOptions::new()
             .with_fixint_encoding()

@@ -1,5 +1,5 @@
 //! The binary container: one checksummed file layout for binary tables, the baker's shards
-//! and its checkpoints (`docs/table-format.md` describes it byte by byte).
+//! and its checkpoints (`docs/reference/table-format.md` describes it byte by byte).
 //!
 //! ```text
 //! magic "CLTHBAKE" (8) | version u32 (4) | kind tag, ASCII, zero-padded (16)

@@ -1,5 +1,5 @@
 //! The OpenEXR table: one RGB image of half or float samples, the [`Metadata`] in header
-//! attributes (`docs/table-format.md`). Written byte-reproducibly ([`write_exr`]), read
+//! attributes (`docs/reference/table-format.md`). Written byte-reproducibly ([`write_exr`]), read
 //! without trusting the decoder not to panic ([`read_exr`]).
 
 use std::io::{self, Cursor, Write};
@@ -732,7 +732,7 @@ mod exr_io {
             };
             c.check_crc(planes_crc(c.meta_json, &planes))?;
             // The averaged RGB, interleaved, then each class's values (diffuse, specular, ...)
-            // cell by cell (see `docs/table-format.md`).
+            // cell by cell (see `docs/reference/table-format.md`).
             let lanes = meta.class_lanes();
             let halves: Option<Vec<&[half::f16]>> = planes
                 .iter()
@@ -1283,7 +1283,7 @@ mod exr_io {
     }
 }
 
-/// Writes a table as an OpenEXR image (see `docs/table-format.md`), atomically.
+/// Writes a table as an OpenEXR image (see `docs/reference/table-format.md`), atomically.
 ///
 /// One RGB layer of f16 or f32 samples, `n_phi_i * n_phi_o` wide and `n_theta_i * n_theta_o`
 /// high: pixel `(pi * n_phi_o + po, ti * n_theta_o + to)` holds cell `(ti, pi, to, po)`. The

@@ -10,7 +10,7 @@ use crate::error::TableError;
 
 /// Which light a table holds: reflection off the one face of the thesis's cloth over its
 /// floor, or the two-faced cloth's reflection and transmission over the whole sphere
-/// (docs/transmission.md, docs/table-format.md).
+/// (docs/science/transmission.md, docs/reference/table-format.md).
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[serde(rename_all = "lowercase")]
 pub enum Faces {
@@ -91,7 +91,7 @@ impl Grid {
     }
 
     /// The one-faced grid of one side's hemisphere: a two-faced grid's polar counts halved
-    /// (the grid of each of its blocks, `docs/table-format.md`); a one-faced grid itself.
+    /// (the grid of each of its blocks, `docs/reference/table-format.md`); a one-faced grid itself.
     pub const fn side(self) -> Grid {
         match self.faces {
             Faces::One => self,

@@ -4,10 +4,10 @@
 //! [`Grid`], its [`Metadata`] and RGB values) is read with [`read_table`] from either format:
 //! OpenEXR ([`mod@exr`]) or the checksummed binary file ([`write_binary`]), which is one kind
 //! of the binary [`mod@container`] that also holds the baker's shards and checkpoints; see
-//! `docs/table-format.md`. Files are written atomically ([`write_atomic_as`]).
+//! `docs/reference/table-format.md`. Files are written atomically ([`write_atomic_as`]).
 //! [`mod@stored`] keeps half-float tables half in memory. [`mod@lookup`] interpolates them
 //! ([`Brdf::eval`]) and [`mod@sampling`] importance-samples them ([`Brdf::sample`]); see
-//! `docs/loader.md`. A two-faced table (reflection and transmission over the sphere,
+//! `docs/reference/loader.md`. A two-faced table (reflection and transmission over the sphere,
 //! [`Faces::Two`]) opens as a [`TwoFacedBrdf`]; [`Lookup::open`] opens either kind.
 
 pub mod angles;

@@ -1,7 +1,7 @@
 //! Render-time lookup: [`Brdf`], quadrilinear interpolation of a baked table.
 //!
 //! Directions are local-frame vectors (z up, +X weft, +Y warp), `wi` toward the light and `wo`
-//! toward the eye; values are `f_r` in 1/sr, RGB. The rules (also in `docs/loader.md`):
+//! toward the eye; values are `f_r` in 1/sr, RGB. The rules (also in `docs/reference/loader.md`):
 //!
 //! * **Azimuth** (either direction): linear between the two nearest cell centres, periodic:
 //!   below the first centre (`phi < 180 / n_phi` degrees) and above the last one, cells
@@ -67,7 +67,7 @@ pub struct Options {
     /// cell, are built on the first call. Without it `sample` and `pdf` give a zero pdf.
     pub sampling: bool,
     /// Answer footprints under two crossing cells at the point level where the table carries
-    /// its period's yarns (a spatial table of one bounce; docs/spatial.md). Off: the crossing
+    /// its period's yarns (a spatial table of one bounce; docs/science/spatial.md). Off: the crossing
     /// cells answer every footprint under a period, as in a table without yarns.
     pub point_level: bool,
 }
@@ -371,7 +371,7 @@ impl Brdf {
         Some((l.f.map(|x| x as f32), l.coverage as f32))
     }
 
-    /// f_r through a footprint of the weave period (docs/spatial.md): at (u, v) in period
+    /// f_r through a footprint of the weave period (docs/science/spatial.md): at (u, v) in period
     /// fractions (wrapped), over a square of side `width` periods, at the level of detail
     /// [`Footprint::level`] gives it. A spatial table that carries its yarns answers
     /// footprints under a crossing cell at the point level (the yarns traced), blends it with
@@ -599,7 +599,7 @@ impl Brdf {
     /// Samples an incident direction for `wo` with `u1, u2` uniform in [0, 1): the density is
     /// piecewise constant per unit solid angle over the table's incident cells, proportional
     /// to `f_r cos theta_i` at the cell centres of the outgoing cell holding `wo` (see
-    /// `docs/loader.md`). The weight is `eval(wi, wo) cos theta_i / pdf`.
+    /// `docs/reference/loader.md`). The weight is `eval(wi, wo) cos theta_i / pdf`.
     pub fn sample(&self, wo: [f32; 3], u1: f32, u2: f32) -> Sample {
         let none = Sample {
             wi: [0.0, 0.0, 1.0],

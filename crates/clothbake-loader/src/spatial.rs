@@ -5,13 +5,13 @@
 //!
 //! A spatial table holds, beside the averaged RGB table, two values per grid cell and class:
 //! f_r of the class's diffuse term at unit albedo (D) and of its specular term (S), after the
-//! averaged values, class by class, cell by cell, D then S (`docs/table-format.md`). A cell of
+//! averaged values, class by class, cell by cell, D then S (`docs/reference/table-format.md`). A cell of
 //! the period whose class is `k` and whose thread has diffuse albedo rho_d reflects
 //! `rho_d D_k + S_k` (with the second bounce six values: its neighbours of albedos rho_+ and
 //! rho_- add `rho_+ (N+ + rho_d B+) + rho_- (N- + rho_d B-)`); its coverage c(x; wo) is the
 //! class's visible share of the period ([`Spatial::visible`], tabulated over the outgoing
 //! directions) over the cell's share of the period's area. The coverage-weighted mean of the
-//! cells' f_r is the averaged table (docs/spatial.md).
+//! cells' f_r is the averaged table (docs/science/spatial.md).
 
 use serde::{Deserialize, Serialize};
 

@@ -2,7 +2,7 @@
 //! period through a footprint: its classes' values held in node tables of the averaged
 //! lookup's kind, the cell of a point found from uniform bins, classes that are mirror images
 //! of others held once, and each class's coverage interpolated over the outgoing directions.
-//! The layout it reads is [`crate::spatial`]'s (docs/spatial.md).
+//! The layout it reads is [`crate::spatial`]'s (docs/science/spatial.md).
 
 use crate::angles::{above_horizon, has_value, theta_phi};
 #[cfg(target_arch = "x86_64")]

@@ -8,7 +8,7 @@ use crate::grid::Grid;
 use crate::spatial::Spatial;
 
 /// Version of the table description: the [`Metadata`] record, the grid layout and the OpenEXR
-/// format (`docs/table-format.md`), of one-faced tables. Readers reject versions they do not
+/// format (`docs/reference/table-format.md`), of one-faced tables. Readers reject versions they do not
 /// know. The binary container has a version of its own, [`crate::CONTAINER_VERSION`].
 pub const FORMAT_VERSION: u32 = 1;
 
@@ -62,7 +62,7 @@ pub(crate) fn first_unphysical(values: &[f32]) -> Option<usize> {
 /// What a table holds and how it was made. Stored in both formats.
 ///
 /// The field order is part of the version-1 binary format, which the loader still reads (see
-/// `docs/table-format.md`): do not reorder.
+/// `docs/reference/table-format.md`): do not reorder.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct Metadata {
     /// Version of the table description: [`FORMAT_VERSION`], or [`TWO_FACED_VERSION`] for a
@@ -90,12 +90,12 @@ pub struct Metadata {
     pub spatial: Option<Spatial>,
     /// For a spatial table of one bounce, the period's yarns (`clothbake_point::Period`,
     /// checked on reading by its one constructor): with them the loader answers footprints
-    /// under two crossing cells at the point level (docs/spatial.md). Absent elsewhere.
+    /// under two crossing cells at the point level (docs/science/spatial.md). Absent elsewhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub yarns: Option<clothbake_point::Period>,
     /// For a two-faced table ([`crate::Faces::Two`]), the openness at each incident cell
     /// centre of the sphere grid, `ti * n_phi_i + pi`: the share of the light from there that
-    /// passes straight through the gaps (docs/transmission.md), each in [0, 1]. Absent from
+    /// passes straight through the gaps (docs/science/transmission.md), each in [0, 1]. Absent from
     /// one-faced tables.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub openness: Option<Vec<f32>>,

@@ -1,6 +1,6 @@
 //! The lookup of a two-faced table ([`TwoFacedBrdf`]): reflection and transmission over the
 //! whole sphere, and the openness, the light that passes straight through the gaps
-//! (docs/transmission.md, docs/table-format.md "Two-faced tables").
+//! (docs/science/transmission.md, docs/reference/table-format.md "Two-faced tables").
 //!
 //! A two-faced table is stored, baked, sharded and compared on one grid whose polar axes cover
 //! the sphere ([`crate::Faces::Two`]). The lookup cuts it into four **blocks**, each a

@@ -1,4 +1,4 @@
-//! The binary container (`docs/table-format.md`): round trips checked against the documented
+//! The binary container (`docs/reference/table-format.md`): round trips checked against the documented
 //! layout, parsed here byte by byte, and every kind of damage giving a clear error without a
 //! panic or a large allocation.
 
@@ -81,7 +81,7 @@ fn exact(c: &Container) -> (ContainerKind, &serde_json::Value, Vec<u32>) {
     (c.kind, &c.header, bits(&c.values))
 }
 
-/// The file as `docs/table-format.md` describes it, assembled here without the loader.
+/// The file as `docs/reference/table-format.md` describes it, assembled here without the loader.
 fn assemble(version: u32, tag: &[u8], header: &[u8], values: &[f32]) -> Vec<u8> {
     let mut b = b"CLTHBAKE".to_vec();
     b.extend(version.to_le_bytes());

@@ -25,7 +25,7 @@ fn golden() -> Vec<PathBuf> {
     v
 }
 
-/// Reads a version-1 table by `docs/table-format.md`: magic, version 1, header length H, the
+/// Reads a version-1 table by `docs/reference/table-format.md`: magic, version 1, header length H, the
 /// metadata (fixed-width integers, strings as a u64 length and UTF-8), the value count N, the
 /// values, and a CRC-32 of everything before it.
 fn parse_v1(b: &[u8]) -> Table {

@@ -1,5 +1,5 @@
 //! `Brdf::open` reads an averaged half-float OpenEXR table from the file's lines straight into
-//! the lookup's nodes (docs/performance.md, "Opening a table"). These tests hold it to the
+//! the lookup's nodes (docs/reference/benchmarks.md, "Opening a table"). These tests hold it to the
 //! path it replaced, the stored samples (`read_table_stored`) given to `Brdf::from_stored`:
 //! the same lookups, pdfs and samples bit for bit, the same table read back, and the same
 //! refusal, word for word, of damaged files and unphysical values.

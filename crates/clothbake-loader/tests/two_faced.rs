@@ -1,4 +1,4 @@
-//! Two-faced tables (docs/table-format.md, "Two-faced tables"): the sphere grid, the four
+//! Two-faced tables (docs/reference/table-format.md, "Two-faced tables"): the sphere grid, the four
 //! blocks the lookup cuts it into, the openness, sampling over the sphere, both file formats
 //! and the checks.
 

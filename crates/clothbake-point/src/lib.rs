@@ -1,6 +1,6 @@
 //! clothbake-point: woven cloth's reflection at one point of the weave period, from its yarns.
 //!
-//! The finest of clothbake's three levels of detail (docs/spatial.md): a point, the crossing
+//! The finest of clothbake's three levels of detail (docs/science/spatial.md): a point, the crossing
 //! cell (spatial tables) and the period (the averaged table). At a point x of the cloth's
 //! reference plane, f(x; wi, wo) is the BTF a camera measures of a cloth sample: the radiance
 //! that leaves the yarns along the eye ray crossing the reference plane at x toward `wo`, per
@@ -182,7 +182,7 @@ impl Yarns {
     }
 
     /// What the point (u, v) (period fractions, wrapped) shows toward `wo` lit from `wi`
-    /// (docs/spatial.md, "The point level").
+    /// (docs/science/spatial.md, "The point level").
     pub fn look(&self, u: f64, v: f64, wi: UnitVec3, wo: UnitVec3) -> Look {
         if !wi.above_horizon() {
             return Look::NONE;

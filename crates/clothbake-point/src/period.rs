@@ -1,6 +1,6 @@
 //! One weave period's yarns as a renderer needs them: each yarn segment a horizontal circular
 //! cylinder with its finish, cut by the floor z = 0, the period tiling the plane
-//! (docs/geometry.md, thesis ch. 2). A [`Period`] is built by one checked constructor and is
+//! (docs/science/geometry.md, thesis ch. 2). A [`Period`] is built by one checked constructor and is
 //! serialisable, so that a table can carry it beside its values.
 
 use crate::finish::{Facet, Finish};
@@ -216,7 +216,7 @@ impl Period {
     }
 
     /// The height of the reference plane, the plane a renderer's mesh of the cloth stands for:
-    /// halfway between the floor and the top of the highest yarn (docs/spatial.md, "The
+    /// halfway between the floor and the top of the highest yarn (docs/science/spatial.md, "The
     /// reference plane").
     pub fn reference_height(&self) -> f64 {
         0.5 * self.top()

@@ -100,7 +100,7 @@ fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) ->
 /// res: (n_theta_i, n_phi_i, n_theta_o, n_phi_o) cells, default (32, 64, 32, 64).
 /// bounces: 1 (default), or 2 to add the secondary reflection (thesis ch. 5; minutes at full
 /// res), or N from 3 to 64 or "all": every bounce, path-traced from the second on over the
-/// analytic second bounce on a coarse grid (docs/transport.md; about 5 minutes at full res).
+/// analytic second bounce on a coarse grid (docs/science/transport.md; about 5 minutes at full res).
 /// facet: "huo" (default) or "lewis". progress: True prints the percentage done to stderr (on
 /// a terminal one line redrawn in place, else a line every 10%); a
 /// callable is called as progress(done, total) (cells evaluated) and stops the bake by
@@ -114,9 +114,9 @@ fn table_format(output: &Path, format: Option<&str>, precision: Option<&str>) ->
 /// caps "excluded" or "shaded"). With bounces=2: secondary "analytic" (orders: "default",
 /// "fast" or "T,B,A") or "raytrace" (sampling: "N,STEP,L0,exact|area"); kernel
 /// "radiometric" (default) or "thesis". spatial: True tabulates the weave up close beside the
-/// average (docs/spatial.md; analytic model, bounces=1 or 2); look it up with Table.eval_at(wi, wo, uv,
+/// average (docs/science/spatial.md; analytic model, bounces=1 or 2); look it up with Table.eval_at(wi, wo, uv,
 /// width). faces: "one" (default) or "two", the two-faced cloth over the sphere
-/// (docs/transmission.md; res's polar counts per side; paths: eye rays per node of its
+/// (docs/science/transmission.md; res's polar counts per side; paths: eye rays per node of its
 /// path-traced rest, default 8192), returned as a TwoFaced.
 /// Returns the Table (a TwoFaced for faces="two"; None for a shard).
 #[pyfunction]

@@ -27,7 +27,7 @@ pub fn facet_model(name: &str) -> PyResult<FacetModel> {
 }
 
 /// Reads a bounce count: absent (1), 1, 2, a whole number N from 3 to 64, or "all"
-/// (`ALL_BOUNCES`; docs/transport.md).
+/// (`ALL_BOUNCES`; docs/science/transport.md).
 pub fn bounces_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<u32> {
     let Some(obj) = obj else {
         return Ok(1);
@@ -40,7 +40,7 @@ pub fn bounces_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<u32> {
         return Ok(ALL_BOUNCES);
     }
     Err(PyValueError::new_err(format!(
-        "bounces: {obj}; use 1 (direct reflection), 2 (+ the secondary reflection of thesis ch. 5), a whole number N from 3 to 64 or \"all\" (every bounce, path-traced from the second on; docs/transport.md)"
+        "bounces: {obj}; use 1 (direct reflection), 2 (+ the secondary reflection of thesis ch. 5), a whole number N from 3 to 64 or \"all\" (every bounce, path-traced from the second on; docs/science/transport.md)"
     )))
 }
 
@@ -101,7 +101,7 @@ fn parts(r: &Reflection, wi: UnitVec3) -> [[f64; 3]; 4] {
 #[pymethods]
 impl PyFabric {
     /// Reads a fabric from a file path or from a dict of the fabric-file schema
-    /// (docs/fabric-format.md). Raises ValueError naming the file (or `<dict>`) and the field.
+    /// (docs/reference/fabric-format.md). Raises ValueError naming the file (or `<dict>`) and the field.
     #[new]
     fn new(source: &Bound<'_, PyAny>) -> PyResult<Self> {
         let py = source.py();
@@ -157,13 +157,13 @@ impl PyFabric {
     /// bounces: 1 (default), or 2 to add the secondary reflection (thesis ch. 5; analytic
     /// only), or N from 3 to 64 or "all": the analytic direct term plus orders 2 to N
     /// path-traced on the micro-geometry, `samples` paths a pair, seeded from `seed` and the
-    /// pair (docs/transport.md); "secondary" of `split=True` is then that multiple-bounce part.
+    /// pair (docs/science/transport.md); "secondary" of `split=True` is then that multiple-bounce part.
     /// facet: "huo" (default, eqs 4.6 and 4.8) or "lewis" (energy conserving).
     /// split: also return the diffuse, specular and secondary parts, each as f_r in 1/sr.
     /// uv: points of the weave period, (N, 2) or (2,), in period fractions (u along the weft
     /// +X, v along the warp +Y, any finite numbers, wrapped; analytic only): f_r seen through
     /// a footprint there instead of the period's average, through the model's BSDF
-    /// (`Bsdf::local`, docs/spatial.md). width: the footprint's side in periods, one number
+    /// (`Bsdf::local`, docs/science/spatial.md). width: the footprint's side in periods, one number
     /// or one a row (default 0, the point itself; 1 or more, the period). level: "auto" (default), the footprint's level of
     /// detail: with one bounce the yarns traced up close (the point level), the crossing cells
     /// from two cells wide, the period from a period; or "cells", the crossing cells as a
@@ -393,7 +393,7 @@ impl PyFabric {
 
     /// f_r(wi, wo) in 1/sr for one pair of unit vectors given as 3 floats each (fabric frame,
     /// analytic model, direct reflection): the scalar path renderers call per sample.
-    /// The fabric's two-faced cloth (docs/transmission.md): no floor, light through the gaps
+    /// The fabric's two-faced cloth (docs/science/transmission.md): no floor, light through the gaps
     /// and through translucent yarns (the materials' `translucency`), the back the inverted
     /// weave (facet "huo" by default, as everywhere; "lewis" conserves energy, which light
     /// through the cloth makes worth having); its model's coarse grid is path-traced here (about 25 s on two cores at the

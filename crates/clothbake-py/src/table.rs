@@ -121,10 +121,10 @@ fn narrow(r: &[[f64; 3]]) -> Vec<[f32; 3]> {
 
 #[pymethods]
 impl PyTable {
-    /// Opens a table file (OpenEXR or binary, docs/table-format.md). `reciprocal=True`
+    /// Opens a table file (OpenEXR or binary, docs/reference/table-format.md). `reciprocal=True`
     /// symmetrises every lookup, 0.5 (f(wi, wo) + f(wo, wi)). `point_level=False` makes a
     /// spatial table that carries its yarns answer every footprint under a period with its
-    /// crossing cells (docs/spatial.md). Raises FileNotFoundError for a missing file and
+    /// crossing cells (docs/science/spatial.md). Raises FileNotFoundError for a missing file and
     /// ValueError for a file that is not a valid table.
     #[staticmethod]
     #[pyo3(signature = (path, reciprocal=false, point_level=true))]
@@ -235,7 +235,7 @@ impl PyTable {
         }
     }
 
-    /// f_r at points of the weave period through a footprint (docs/spatial.md): `uv` (N, 2)
+    /// f_r at points of the weave period through a footprint (docs/science/spatial.md): `uv` (N, 2)
     /// or (2,) in period fractions (u along the weft, v along the warp, wrapped), `width` the
     /// side of the square each lookup covers, in periods (0: the point at uv; 1 or more: the
     /// averaged table), answered at its level of detail: a table baked with `spatial=True`

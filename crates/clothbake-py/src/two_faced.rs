@@ -1,4 +1,4 @@
-//! `Fabric.two_faced()`: the two-faced cloth (docs/transmission.md) from Python: f over the
+//! `Fabric.two_faced()`: the two-faced cloth (docs/science/transmission.md) from Python: f over the
 //! whole sphere (reflection off either face, transmission) and the openness, one pair at a time
 //! or in batches.
 
@@ -13,13 +13,13 @@ use pyo3::prelude::*;
 use std::path::PathBuf;
 
 /// The two-faced cloth of a fabric: no floor, light through the gaps and through translucent
-/// yarns, the back the inverted weave (docs/transmission.md). `eval` gives f (1/sr, RGB) for
+/// yarns, the back the inverted weave (docs/science/transmission.md). `eval` gives f (1/sr, RGB) for
 /// directions anywhere on the sphere (reflection where `wi` and `wo` are on one side,
 /// transmission across), `openness` the share of the light from a direction that passes
 /// straight through the gaps (a delta toward -wi, not in `eval`).
 ///
 /// `TwoFaced.open(path)` opens a two-faced table (baked with `--faces two`) with the same
-/// methods, looked up through the loader (docs/table-format.md, "Two-faced tables").
+/// methods, looked up through the loader (docs/reference/table-format.md, "Two-faced tables").
 #[pyclass(name = "TwoFaced", module = "clothbake", frozen)]
 pub struct PyTwoFaced {
     /// The model (`Fabric.two_faced`) or a table's lookup (`TwoFaced.open`).

@@ -50,7 +50,7 @@ def test_split_terms_add_up_and_horizon_is_zero(twill_path):
 
 
 def test_every_bounce_adds_to_the_analytic_second_bounce(twill_path):
-    # docs/transport.md: the direct term plus path-traced orders 2 to N. On the parallel surface
+    # docs/science/transport.md: the direct term plus path-traced orders 2 to N. On the parallel surface
     # I_2 is the thesis's analytic second bounce (no perpendicular pairs), so the path-traced
     # part of orders 2 to N lies above it by the orders past the second.
     fab = clothbake.Fabric(twill_path.parent / "parallel.json")
@@ -69,7 +69,7 @@ def test_every_bounce_adds_to_the_analytic_second_bounce(twill_path):
 
 
 def test_points_of_the_period_average_to_the_period(twill_path):
-    """docs/spatial.md: the coverage-weighted mean of the crossing cells' f_r over the period
+    """docs/science/spatial.md: the coverage-weighted mean of the crossing cells' f_r over the period
     is the average."""
     fab = clothbake.Fabric(twill_path)
     n = 30  # 10 x 10 points in each of the twill's 3 x 3 equal cells
@@ -81,7 +81,7 @@ def test_points_of_the_period_average_to_the_period(twill_path):
     assert "diffuse" not in s
     c = s["coverage"]
     # Light is attributed where the yarn lies, so a yarn seen over a neighbour's cell can
-    # exceed 1 slightly (docs/spatial.md); the period mean cannot exceed 1 here.
+    # exceed 1 slightly (docs/science/spatial.md); the period mean cannot exceed 1 here.
     assert c.shape == (len(uv),) and (c > 0).all() and (c < 1.05).all() and c.mean() <= 1.0
     mean = (c[:, None] * s["brdf"]).sum(axis=0) / c.sum()
     np.testing.assert_allclose(mean, fab.eval(wi[:1], wo[:1])[0], rtol=1e-9)
@@ -102,7 +102,7 @@ def test_points_of_the_period_average_to_the_period(twill_path):
 
 
 def test_the_yarns_up_close_average_to_the_ray_tracer(twill_path):
-    """docs/spatial.md, the point level: at a point the yarns are traced (coverage 0 in a gap,
+    """docs/science/spatial.md, the point level: at a point the yarns are traced (coverage 0 in a gap,
     1 on yarn), and the coverage-weighted mean over the period is the ground truth's average
     (the ray tracer, an independent code), within its noise and the grid's."""
     fab = clothbake.Fabric(twill_path)
@@ -197,7 +197,7 @@ def test_analytic_against_ray_traced_ground_truth(twill_path):
     wi, wo = dirs([30, 50], [0, 90]), dirs([45, 20], [180, 250])
     a = fab.eval(wi, wo)
     rt = fab.eval(wi, wo, method="raytrace", samples=40000, seed=7)
-    # docs/validation.md: the twill's worst error is 4.1%; 40 000 rays add about 1%.
+    # docs/results/validation.md: the twill's worst error is 4.1%; 40 000 rays add about 1%.
     np.testing.assert_allclose(a, rt, rtol=0.08)
 
 
@@ -425,7 +425,7 @@ def test_bad_bake_options_name_the_option(twill_path, kwargs, words):
 
 
 def test_a_period_too_large_for_sliced3d_is_refused(twill_path):
-    """docs/limits.md: sliced3d takes periods of at most 16 384 cells; bake and two_faced refuse
+    """docs/reference/limits.md: sliced3d takes periods of at most 16 384 cells; bake and two_faced refuse
     a larger one before any work, naming the variant and the fix; sliced takes it."""
     d = json.loads(twill_path.read_text())
     n = 129
@@ -525,7 +525,7 @@ def test_eval_samples_are_bounded(twill_path):
 
 
 def test_the_two_faced_cloth_transmits_and_passes_light_through_its_gaps():
-    # An open plain weave (r/s = 0.25) of translucent yarns (docs/transmission.md).
+    # An open plain weave (r/s = 0.25) of translucent yarns (docs/science/transmission.md).
     from conftest import OPEN_PLAIN
 
     fab = clothbake.Fabric(OPEN_PLAIN)

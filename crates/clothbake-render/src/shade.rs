@@ -26,13 +26,13 @@
 //! * where `wo` is at or below the local horizon (the back of the surface) V = 0. There are no
 //!   cast shadows between parts of the scene.
 //! * with `render --periods N`, f_r is looked up through the pixel's footprint of the weave
-//!   period (`Bsdf::local`, docs/spatial.md), for the sun and the sky alike: a spatial table or
+//!   period (`Bsdf::local`, docs/science/spatial.md), for the sun and the sky alike: a spatial table or
 //!   the model shows the weave where a pixel covers less than a period, and the average beyond.
 //!   The cloth is drawn opaque (the coverage of the gaps is not applied), so a distant render
 //!   equals the averaged one; with `--gaps` every value is scaled by the coverage c of its
 //!   footprint (the cloth over black: `V c`), the directional coverage C(wo) without `--periods`
 //!   (1 for an averaged table). Where a footprint is under a crossing cell, the model with one
-//!   bounce answers the point level (docs/spatial.md): a sample whose eye ray meets a gap has
+//!   bounce answers the point level (docs/science/spatial.md): a sample whose eye ray meets a gap has
 //!   c = 0; without `--gaps` a pixel averages the samples that meet yarn (times the share of its
 //!   samples that meet the surface), so the gaps close up within a pixel and show black only
 //!   where a pixel sees nothing but gap.
@@ -49,7 +49,7 @@ pub struct Shader {
     bsdf: Box<dyn Bsdf>,
     /// Whether the gaps between the yarns show: the value is scaled by the coverage.
     gaps: bool,
-    /// Whether the BSDF is a two-faced cloth's (docs/transmission.md): lit and seen from
+    /// Whether the BSDF is a two-faced cloth's (docs/science/transmission.md): lit and seen from
     /// either side, transmitting, and showing what lies behind it through its openness.
     two_faced: bool,
 }
@@ -64,7 +64,7 @@ impl Shader {
         }
     }
 
-    /// The two-faced cloth of `fabric` (`render --faces two`; docs/transmission.md): its
+    /// The two-faced cloth of `fabric` (`render --faces two`; docs/science/transmission.md): its
     /// model (`clothbake_bake::two_faced::TwoFaced`, the rest's nodes path-traced now, in
     /// parallel), lit and seen from either side. An error where the fabric's back is not a
     /// valid fabric.
@@ -98,7 +98,7 @@ impl Shader {
     /// The analytic model of `fabric`; `secondary` adds I_2 (two bounces). [`Component::Secondary`]
     /// and [`Component::SecondarySpecular`] need `secondary`. With one bounce the model carries
     /// the fabric's yarns, so footprints under a crossing cell show the point level
-    /// (docs/spatial.md); with two, the crossing cell is the finest level (a single trace has
+    /// (docs/science/spatial.md); with two, the crossing cell is the finest level (a single trace has
     /// no I_2).
     pub fn model(
         fabric: &Fabric,
@@ -266,7 +266,7 @@ impl Bsdf for Truth {
 
 /// The sun's angular radius, radians: 6 degrees, wider than the real sun's 0.27 on purpose (a
 /// hazy sun with its aureole), so that the penumbra where it sets spans several pixels of a
-/// picture's curved surfaces and the terminator is soft instead of a crease (docs/render.md).
+/// picture's curved surfaces and the terminator is soft instead of a crease (docs/guide/render.md).
 pub const SUN_RADIUS: f64 = 6.0 * std::f64::consts::PI / 180.0;
 
 /// The ground's radiance as a share of the sky's (a ground of albedo about 0.2).

@@ -188,7 +188,7 @@ fn brightness_follows_the_physics() {
 }
 
 /// Pixel (i, j) recomputed from the camera's documented conventions, the plane z = 0, the sun
-/// and sky of docs/render.md and the analytic model, without the renderer's camera, scene,
+/// and sky of docs/guide/render.md and the analytic model, without the renderer's camera, scene,
 /// frame or shading code.
 #[test]
 fn swatch_pixels_equal_the_model_at_their_directions() {
@@ -304,7 +304,7 @@ fn the_terminator_has_no_seam() {
             continue;
         }
         let n = unit(eye + d * (-b - disc.sqrt()));
-        // Sphere frame (docs/render.md): weft east = Z x N, warp = N x weft.
+        // Sphere frame (docs/guide/render.md): weft east = Z x N, warp = N x weft.
         let east = unit(Vec3::new(0.0, 0.0, 1.0).cross(n));
         let north = n.cross(east);
         let to = |v: Vec3| Vec3::new(v.dot(east), v.dot(north), v.dot(n));

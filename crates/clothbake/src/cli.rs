@@ -28,16 +28,16 @@ pub use clothbake_bake::settings::{DEFAULT_SAMPLES, DEFAULT_SEED};
     after_help = "Without a subcommand, `clothbake --weave FILE [options]` bakes a table: the options of \
                   `clothbake bake`, listed by `clothbake bake --help`. Angles are in degrees: theta from \
                   the macro normal +Z (0 to 90), phi from +X (the weft direction) toward +Y (the warp \
-                  direction). Fabric files: see docs/fabric-format.md and `clothbake fabrics`; baking: \
-                  docs/baking.md."
+                  direction). Fabric files: see docs/reference/fabric-format.md and `clothbake fabrics`; baking: \
+                  docs/guide/baking.md."
 )]
 pub struct Cli {
     /// What to do; without a subcommand clothbake bakes the fabric given with --weave.
     #[command(subcommand)]
     pub command: Option<Command>,
 
-    /// Fabric description to bake into a BRDF table (JSON, see docs/fabric-format.md, or a
-    /// WIF weaving draft, *.wif, see docs/wif.md), or a shipped fabric's name (`clothbake
+    /// Fabric description to bake into a BRDF table (JSON, see docs/reference/fabric-format.md, or a
+    /// WIF weaving draft, *.wif, see docs/reference/wif.md), or a shipped fabric's name (`clothbake
     /// fabrics`), e.g. twill.
     #[arg(long, value_name = "FILE")]
     pub weave: Option<PathBuf>,
@@ -63,7 +63,7 @@ pub enum Command {
     /// variants (spectral), or the isotropic MERL binary (averaged over rotations about the
     /// normal).
     Export(ExportArgs),
-    /// Merge the shard files of a bake (`bake --shard K/N`) into the table (docs/cluster.md).
+    /// Merge the shard files of a bake (`bake --shard K/N`) into the table (docs/guide/cluster.md).
     Merge(MergeArgs),
     /// Render a picture (PNG, optionally EXR) of cloth shaded with a table or the model.
     Render(RenderArgs),
@@ -123,8 +123,8 @@ pub fn subcommand_names() -> Vec<String> {
 /// `clothbake bake`.
 #[derive(Args, Debug)]
 pub struct BakeCmd {
-    /// Fabric description to bake (JSON, see docs/fabric-format.md, or a WIF draft, *.wif, see
-    /// docs/wif.md), e.g. tables/twill.json, or a shipped fabric's name (`clothbake fabrics`).
+    /// Fabric description to bake (JSON, see docs/reference/fabric-format.md, or a WIF draft, *.wif, see
+    /// docs/reference/wif.md), e.g. tables/twill.json, or a shipped fabric's name (`clothbake fabrics`).
     #[arg(long, value_name = "FILE")]
     pub weave: PathBuf,
 
@@ -141,7 +141,7 @@ pub struct BakeOpts {
     #[arg(short = 'o', long, value_name = "PATH")]
     pub output: Option<PathBuf>,
 
-    /// Grid: cells of theta_i, phi_i, theta_o, phi_o (cell-centred; see docs/table-format.md).
+    /// Grid: cells of theta_i, phi_i, theta_o, phi_o (cell-centred; see docs/reference/table-format.md).
     #[arg(long, value_name = "NTI,NPI,NTO,NPO", value_parser = parse_res, default_value = "32,64,32,64")]
     pub res: Option<Grid>,
 
@@ -158,7 +158,7 @@ pub struct BakeOpts {
     pub facet: FacetArg,
 
     /// Analytic variant: eq. 3.6 on the rectangle top as printed (thesis) or averaged over the
-    /// arc's true heights (see docs/model.md) [default: refined].
+    /// arc's true heights (see docs/science/model.md) [default: refined].
     #[arg(long, value_enum)]
     pub variant: Option<VariantArg>,
 
@@ -183,7 +183,7 @@ pub struct BakeOpts {
     #[command(flatten)]
     pub bounces: BounceArgs,
 
-    /// Also tabulate the weave up close (docs/spatial.md): each class of the period's crossing
+    /// Also tabulate the weave up close (docs/science/spatial.md): each class of the period's crossing
     /// cells beside the average, so that renderers show the weave below one period per pixel
     /// (render --periods, Brdf::eval_at). Analytic model, --bounces 1 or 2.
     #[arg(long)]
@@ -191,12 +191,12 @@ pub struct BakeOpts {
 
     /// `one` face over the thesis's floor (reflection only), or the `two`-faced cloth (no
     /// floor: light through the gaps and translucent yarns, the back the inverted weave;
-    /// docs/transmission.md): a table over the whole sphere, --res's polar counts per side.
+    /// docs/science/transmission.md): a table over the whole sphere, --res's polar counts per side.
     #[arg(long, value_enum, default_value_t = Faces::One)]
     pub faces: Faces,
 
     /// With --faces two: eye rays per node of the path-traced rest (the light through and
-    /// between the yarns; docs/transmission.md) [default: 8192]. Its noise falls as 1/sqrt(N).
+    /// between the yarns; docs/science/transmission.md) [default: 8192]. Its noise falls as 1/sqrt(N).
     #[arg(long, value_name = "N", value_parser = parse_paths)]
     pub paths: Option<usize>,
 
@@ -343,10 +343,10 @@ pub struct InfoArgs {
                   averaged over rotations about the normal (--phi-samples angles) and over \
                   swapping light and eye; the spread lost is printed. The RGL file keeps the \
                   anisotropy. --klems writes the daylighting file and prints the datasheet \
-                  (docs/daylighting.md). See docs/export.md."
+                  (docs/guide/daylighting.md). See docs/guide/export.md."
 )]
 pub struct ExportArgs {
-    /// Export the analytic model of this fabric (JSON, see docs/fabric-format.md, or a WIF
+    /// Export the analytic model of this fabric (JSON, see docs/reference/fabric-format.md, or a WIF
     /// draft), e.g. tables/twill.json, or a shipped fabric's name. Give this or --table.
     #[arg(long, value_name = "FILE")]
     pub weave: Option<PathBuf>,
@@ -372,7 +372,7 @@ pub struct ExportArgs {
     /// Write an LBNL/Radiance BSDF XML file on the Klems basis (145 x 145: front and back
     /// reflection and transmission, Visible and Solar) for daylighting tools (Radiance,
     /// WINDOW), and print the datasheet figures (openness, transmittance, reflectance at
-    /// normal incidence). See docs/daylighting.md.
+    /// normal incidence). See docs/guide/daylighting.md.
     #[arg(long, value_name = "OUT.xml")]
     pub klems: Option<PathBuf>,
 
@@ -382,7 +382,7 @@ pub struct ExportArgs {
 
     /// With --weave: `one` face over the thesis's floor (reflection only), or the `two`-faced
     /// cloth (no floor: light through the gaps and translucent yarns, the back the inverted
-    /// weave; docs/transmission.md), which only --klems can hold.
+    /// weave; docs/science/transmission.md), which only --klems can hold.
     #[arg(long, value_enum, default_value_t = Faces::One)]
     pub faces: Faces,
 
@@ -423,7 +423,7 @@ pub struct ExportArgs {
     #[arg(long, value_enum)]
     pub facet: Option<FacetArg>,
 
-    /// Analytic variant (see docs/model.md) [default: refined].
+    /// Analytic variant (see docs/science/model.md) [default: refined].
     #[arg(long, value_enum)]
     pub variant: Option<VariantArg>,
 
@@ -528,8 +528,8 @@ pub struct DiffArgs {
 /// `clothbake eval`.
 #[derive(Args, Debug)]
 pub struct EvalArgs {
-    /// Fabric description (JSON, see docs/fabric-format.md, or a WIF draft, *.wif, see
-    /// docs/wif.md), e.g. tables/twill.json, or a shipped fabric's name (`clothbake fabrics`).
+    /// Fabric description (JSON, see docs/reference/fabric-format.md, or a WIF draft, *.wif, see
+    /// docs/reference/wif.md), e.g. tables/twill.json, or a shipped fabric's name (`clothbake fabrics`).
     #[arg(long, value_name = "FILE")]
     pub weave: PathBuf,
 
@@ -545,7 +545,7 @@ pub struct EvalArgs {
 
     /// The cloth: `one` face over the thesis's opaque floor (reflection only), or `two` faces
     /// and no floor: light through the gaps and translucent yarns, the back the inverted weave
-    /// (docs/transmission.md). With `two`, f covers the whole sphere and every bounce, and the
+    /// (docs/science/transmission.md). With `two`, f covers the whole sphere and every bounce, and the
     /// report adds the openness along --wi.
     #[arg(long, value_enum, default_value_t = Faces::One)]
     pub faces: Faces,
@@ -586,13 +586,13 @@ pub struct EvalArgs {
 
     /// A point of the weave period, U,V in period fractions (U along the weft +X, V along the
     /// warp +Y; any finite numbers, wrapped): the reflection of the yarn over that crossing
-    /// instead of the period's average, with its coverage (docs/spatial.md). Analytic only.
+    /// instead of the period's average, with its coverage (docs/science/spatial.md). Analytic only.
     #[arg(long, value_name = "U,V", value_parser = parse_period_point, allow_hyphen_values = true)]
     pub at: Option<clothbake_core::PeriodPoint>,
 
     /// With --at: the side of the footprint around the point, in periods (0: the point itself;
     /// 1 or more: the whole period). The footprint's level of detail answers: the yarns traced
-    /// at the point (one bounce), the crossing cells, or the period (docs/spatial.md).
+    /// at the point (one bounce), the crossing cells, or the period (docs/science/spatial.md).
     #[arg(long, value_name = "W", value_parser = parse_width, requires = "at", allow_hyphen_values = true)]
     pub width: Option<f64>,
 
@@ -603,7 +603,7 @@ pub struct EvalArgs {
     /// directional_coverage, and with --at also at ([u, v]), cell ([warp, weft]), on_top ("warp"
     /// or "weft") and coverage. With --bounces N > 2 or all: orders (I_1, I_2, ...) and
     /// orders_std_err, I_2_parallel, I_2_perpendicular, I_2_split_std_err, I_multiple,
-    /// I_multiple_std_err, paths, seed and converged (docs/transport.md).
+    /// I_multiple_std_err, paths, seed and converged (docs/science/transport.md).
     #[arg(long)]
     pub json: bool,
 }
@@ -625,12 +625,12 @@ pub struct MaterialArgs {
 
     /// Translucency tau in [0, 1]: the yarn's diffuse transmittance as a share of its diffuse
     /// albedo (t = tau rho_d, with rho_d (1 + tau) + rho_s <= 1); only the two-faced cloth shows
-    /// it (docs/transmission.md).
+    /// it (docs/science/transmission.md).
     #[arg(long, value_name = "X", value_parser = parse_translucency, allow_hyphen_values = true)]
     pub translucency: Option<f64>,
 }
 
-/// Yarn sizes for a WIF draft, in place of its `[WARP]` / `[WEFT]` sizes (docs/wif.md).
+/// Yarn sizes for a WIF draft, in place of its `[WARP]` / `[WEFT]` sizes (docs/reference/wif.md).
 #[derive(Args, Debug, Default, Clone, Copy, PartialEq)]
 pub struct DraftArgs {
     /// WIF drafts only: yarn radius in mm of every thread, replacing the draft's Thickness
@@ -670,7 +670,7 @@ pub fn parse_length(s: &str) -> Result<f64, String> {
     Ok(x)
 }
 
-/// Which cloth: the thesis's over its floor, or the two-faced one (docs/transmission.md).
+/// Which cloth: the thesis's over its floor, or the two-faced one (docs/science/transmission.md).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Faces {
     /// One face over the thesis's opaque floor.
@@ -724,10 +724,10 @@ pub enum VariantArg {
     /// Eq. 3.6 averaged over the arc (default).
     Refined,
     /// Refined, with the side profiles taken slice by slice along each piece: closer to the
-    /// ground truth (docs/model.md), about 2.5x the cost.
+    /// ground truth (docs/science/model.md), about 2.5x the cost.
     Sliced,
     /// Sliced, with what hides each slice's side taken in 3-D through the floats around the
-    /// piece: the closest to the ground truth (docs/model.md); a bake takes 3 to 13 times as
+    /// piece: the closest to the ground truth (docs/science/model.md); a bake takes 3 to 13 times as
     /// long, one pair at a time about 200 times.
     Sliced3d,
 }
@@ -764,9 +764,9 @@ impl From<CapsArg> for Caps {
 /// `--format` values.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FormatArg {
-    /// OpenEXR image (docs/table-format.md).
+    /// OpenEXR image (docs/reference/table-format.md).
     Exr,
-    /// The checksummed binary file, f32 (docs/table-format.md).
+    /// The checksummed binary file, f32 (docs/reference/table-format.md).
     Bin,
 }
 
@@ -795,7 +795,7 @@ pub struct BounceArgs {
     /// 1: direct reflection; 2: adds the secondary reflection I_2 between neighbouring parallel
     /// threads (thesis ch. 5; much slower); N (3 to 64) or all: the direct term plus every
     /// bounce from the second to N path-traced on the micro-geometry, every yarn
-    /// (docs/transport.md). With `eval --method raytrace` the path tracer estimates every order.
+    /// (docs/science/transport.md). With `eval --method raytrace` the path tracer estimates every order.
     #[arg(long, value_name = "1|2|N|all", value_parser = parse_bounces, default_value = "1")]
     pub bounces: u32,
 
@@ -812,7 +812,7 @@ pub struct BounceArgs {
     /// With --bounces 2 (analytic): the quadrature orders, `default` (11,5,3: about 0.6% mean
     /// error of I_2), `fast` (7,3,3: under 2%, about 1.5 times faster) or THETA,BETA,AXIAL:
     /// Gauss-Legendre nodes along C1 and across C2 in all, along the axis per lobe panel
-    /// (docs/interreflection.md) [default: default].
+    /// (docs/science/interreflection.md) [default: default].
     #[arg(long, value_name = "default|fast|T,B,A", value_parser = parse_orders)]
     pub orders: Option<Orders>,
 
@@ -1119,11 +1119,11 @@ pub fn parse_threads(s: &str) -> Result<usize, String> {
 }
 
 /// Parses `--bounces 1|2|N|all`: 1 the direct reflection, 2 the thesis's analytic second
-/// bounce, N > 2 or `all` the direct term plus the path-traced orders 2 to N (docs/transport.md).
+/// bounce, N > 2 or `all` the direct term plus the path-traced orders 2 to N (docs/science/transport.md).
 pub fn parse_bounces(s: &str) -> Result<u32, String> {
     const FIX: &str = "give 1 (direct reflection), 2 (direct and the thesis's secondary \
                        reflection, ch. 5), a whole number N from 3 to 64 or `all` (every \
-                       bounce, path-traced from the second on; docs/transport.md)";
+                       bounce, path-traced from the second on; docs/science/transport.md)";
     match s.trim() {
         "all" => Ok(clothbake_core::ALL_BOUNCES),
         t => match t.parse::<u32>() {
@@ -1146,7 +1146,7 @@ pub struct ModelArgs {
     pub facet: FacetArg,
 
     /// Analytic variant: eq. 3.6 on the rectangle top as printed (thesis) or averaged over the
-    /// arc's true heights (refined, the default; see docs/model.md).
+    /// arc's true heights (refined, the default; see docs/science/model.md).
     #[arg(long, value_enum, default_value_t = VariantArg::Refined)]
     pub variant: VariantArg,
 }
@@ -1154,7 +1154,7 @@ pub struct ModelArgs {
 /// Where the BRDF of `render` and `plot` comes from, and the model's options.
 #[derive(Args, Debug, Clone)]
 pub struct BrdfArgs {
-    /// Shade with the analytic model of this fabric (JSON, see docs/fabric-format.md, a WIF
+    /// Shade with the analytic model of this fabric (JSON, see docs/reference/fabric-format.md, a WIF
     /// draft, or a shipped fabric's name).
     #[arg(long, value_name = "FILE")]
     pub weave: Option<PathBuf>,
@@ -1229,7 +1229,7 @@ pub enum TonemapArg {
                   a white Lambertian surface facing it shows 1; facing up it shows rho_a in the sky's \
                   light). V = 0 where the eye sees the back of the surface. \
                   PNG: x = exposure * V, clamped to [0, 1] (or x / (1 + x) with --tonemap reinhard), \
-                  sRGB-encoded to 8 bits. EXR: V itself, f32. World: +Z up. See docs/render.md."
+                  sRGB-encoded to 8 bits. EXR: V itself, f32. World: +Z up. See docs/guide/render.md."
 )]
 pub struct RenderArgs {
     /// The BRDF: --weave FILE (the model) or --table FILE.
@@ -1280,12 +1280,12 @@ pub struct RenderArgs {
     /// the fabric's explicit yarns, tiled over the surface in its tangent frame, with a shadow
     /// ray through the same yarns; with --bounces N (or all), a path a point with every bounce
     /// up to N between the yarns. The reference every level of detail is measured against
-    /// (docs/spatial.md).
+    /// (docs/science/spatial.md).
     #[arg(long)]
     pub truth: bool,
 
     /// With --weave: the `two`-faced cloth (no floor: light through the gaps and translucent
-    /// yarns, the back the inverted weave; docs/transmission.md), lit and seen from either
+    /// yarns, the back the inverted weave; docs/science/transmission.md), lit and seen from either
     /// side: a --light below the cloth backlights it, and the gaps show what lies behind.
     #[arg(long, value_enum, default_value_t = Faces::One)]
     pub faces: Faces,
@@ -1348,7 +1348,7 @@ pub enum PlotKind {
                   mean of R, G, B. Slices: x is theta_o in the plane of incidence, negative on the \
                   light's side (phi_o = phi_i), positive on the mirror side (phi_o = phi_i + 180). \
                   Hemisphere: x = theta_o cos phi_o, y = theta_o sin phi_o (degrees). Polar: radius f_r, \
-                  angle phi_o, one curve per --theta-o. See docs/render.md."
+                  angle phi_o, one curve per --theta-o. See docs/guide/render.md."
 )]
 pub struct PlotArgs {
     /// The BRDFs: --weave FILE and/or --table FILE, two sources at most.

@@ -90,7 +90,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
             } else {
                 model.intensity_with(wi, wo, secondary.as_ref())
             };
-            // With --at, the footprint through the BSDF (docs/spatial.md): f_r and coverage
+            // With --at, the footprint through the BSDF (docs/science/spatial.md): f_r and coverage
             // from one call, at the level of detail its width asks for.
             let seen = at.map(|(p, _)| {
                 let fp = Footprint {

@@ -3,7 +3,7 @@
 //! pbrt-v4 and Mitsuba's spectral variants), a MERL binary, a Klems BSDF XML for daylighting
 //! tools (with the datasheet figures), and/or fitted standard materials
 //! (glTF, MaterialX, USD, Blender: `fitted_cmd`), each written atomically.
-//! Formats and conventions: `docs/export.md`.
+//! Formats and conventions: `docs/guide/export.md`.
 
 use crate::bake_cmd::preflight;
 use crate::cli::{ExportArgs, Faces};
@@ -97,7 +97,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
                 .map_err(|e| CliError::line(format!("cannot start {threads} threads: {e}")))?
                 .install(|| tf.prepare());
             let source = format!(
-                "fabric {}; the two-faced cloth (docs/transmission.md): analytic direct reflection \
+                "fabric {}; the two-faced cloth (docs/science/transmission.md): analytic direct reflection \
                  (facet {}, variant {}) and openness, the rest path-traced on a coarse grid",
                 fabric.name(),
                 facet_name(facet),
@@ -113,7 +113,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             let variant_name = model.variant().name();
             let analytic = AnalyticBsdf::new(model, secondary);
             let (u_edges, v_edges) = analytic.model().cells().edge_fractions();
-            // Full transport: the analytic terms plus the path-traced orders (docs/transport.md).
+            // Full transport: the analytic terms plus the path-traced orders (docs/science/transport.md).
             let full = (args.bounces.bounces > 2).then(|| {
                 clothbake_bake::transport::FullTransport::new(
                     &fabric,
@@ -289,7 +289,7 @@ fn write_all(
             rgl::Colour::Rgb => "RGB (linear sRGB)".to_string(),
             rgl::Colour::Spectral => format!(
                 "spectral, {} wavelengths {}-{} nm, linear upsampling of linear sRGB \
-                 (docs/export.md)",
+                 (docs/guide/export.md)",
                 w.len(),
                 w[0],
                 w[w.len() - 1]
@@ -353,7 +353,7 @@ fn write_all(
             name: name.to_string(),
             comment: format!(
                 "clothbake {}: {source}; Klems entries averaged over {n} x {n} points of each \
-                 patch (docs/daylighting.md)",
+                 patch (docs/guide/daylighting.md)",
                 env!("CARGO_PKG_VERSION"),
                 n = args.klems_samples
             ),

@@ -168,7 +168,7 @@ pub fn list() -> String {
     out.push_str(
         "\nREPEAT: warp x weft threads of one period. Use a name wherever a fabric file goes, \
          e.g. `clothbake --weave twill` (a file of that name in the current folder comes first); \
-         the files are in tables/ of the source (docs/fabric-format.md, docs/wif.md).\n",
+         the files are in tables/ of the source (docs/reference/fabric-format.md, docs/reference/wif.md).\n",
     );
     out
 }

@@ -1,5 +1,5 @@
 //! `clothbake export --gltf/--mtlx/--usd/--blender`: fitted standard materials
-//! (docs/export.md, "Fitted materials").
+//! (docs/guide/export.md, "Fitted materials").
 
 use crate::cli::ExportArgs;
 use crate::error::CliError;
@@ -184,7 +184,7 @@ pub fn write(
     }
     let _ = writeln!(
         summary,
-        "fitted in {:.1} s (what the residuals measure: docs/export.md, \"Fitted materials\")",
+        "fitted in {:.1} s (what the residuals measure: docs/guide/export.md, \"Fitted materials\")",
         start.elapsed().as_secs_f64()
     );
     Ok(summary)

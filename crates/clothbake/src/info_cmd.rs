@@ -47,7 +47,7 @@ fn spatial_lines(s: &mut String, sp: &clothbake_loader::Spatial) {
     let (nx, ny) = sp.dims();
     let _ = writeln!(
         s,
-        "spatial    {} class{} over {nx} x {ny} crossing cells (warp x weft; docs/spatial.md); \
+        "spatial    {} class{} over {nx} x {ny} crossing cells (warp x weft; docs/science/spatial.md); \
          each cell shows its class's f_r at its thread's albedo{}",
         sp.classes,
         if sp.classes == 1 { "" } else { "es" },
@@ -121,7 +121,7 @@ pub fn run(args: &InfoArgs) -> Result<String, CliError> {
     if let Some(y) = &m.yarns {
         let _ = writeln!(
             s,
-            "yarns      {} yarn segments of the period: footprints under a crossing cell trace them (the point level, docs/spatial.md)",
+            "yarns      {} yarn segments of the period: footprints under a crossing cell trace them (the point level, docs/science/spatial.md)",
             y.yarns().len()
         );
     }
@@ -172,7 +172,7 @@ fn two_faced_lines(s: &mut String, t: &Table) {
     let openness = t.meta.openness.as_deref().unwrap_or_default();
     let _ = writeln!(
         s,
-        "faces      two (docs/transmission.md): theta 0 to 90 from the front (+Z), 90 to 180 from \
+        "faces      two (docs/science/transmission.md): theta 0 to 90 from the front (+Z), 90 to 180 from \
          the back; each side {} polar cells; the openness (light straight through the gaps) \
          per incident cell",
         g.n_theta_i / 2

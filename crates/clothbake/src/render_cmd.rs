@@ -34,7 +34,7 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
     )?;
     let variant = crate::eval_cmd::checked_variant(weave, &fabric, b.model.variant)?;
     if b.bounces.bounces > 2 {
-        // Full transport: the analytic terms plus the path-traced orders (docs/transport.md),
+        // Full transport: the analytic terms plus the path-traced orders (docs/science/transport.md),
         // whole only.
         if component != Component::Total {
             return Err(CliError::new(

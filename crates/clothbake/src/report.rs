@@ -16,7 +16,7 @@ pub struct Raytrace {
     pub samples: usize,
 }
 
-/// Coverage of the analytic model (docs/spatial.md).
+/// Coverage of the analytic model (docs/science/spatial.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Local {
     /// C(wo): the visible yarn's projected area per unit projected area of the period.
@@ -65,7 +65,7 @@ pub struct Transport {
 impl Transport {
     /// Whether the orders die out: orders 16 and up carry at most 0.1% of I_1 (channel means).
     /// Facets that reflect more than they receive (the thesis's sec. 5.4 material at n = 1,
-    /// docs/transport.md) make the series diverge, and the truncated sum means little.
+    /// docs/science/transport.md) make the series diverge, and the truncated sum means little.
     pub fn converged(&self) -> bool {
         let m = |v: &[f64; 3]| (v[0] + v[1] + v[2]) / 3.0;
         let tail: f64 = self.orders.iter().skip(15).map(m).sum();
@@ -226,7 +226,7 @@ impl Report<'_> {
             let _ = writeln!(
                 s,
                 "note    the orders do not die out (orders 16 and up carry over 0.1% of I_1): these \
-                 facets reflect more than they receive, the sum is truncated (docs/transport.md)"
+                 facets reflect more than they receive, the sum is truncated (docs/science/transport.md)"
             );
         }
         let _ = writeln!(s, "{:8}{:>12} {:>12} {:>12}", "", "R", "G", "B");

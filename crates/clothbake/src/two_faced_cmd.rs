@@ -1,4 +1,4 @@
-//! `clothbake eval --faces two`: the two-faced cloth (docs/transmission.md) for one light and
+//! `clothbake eval --faces two`: the two-faced cloth (docs/science/transmission.md) for one light and
 //! one eye direction anywhere on the sphere: f (reflection on either face, or transmission) and
 //! the openness along the light.
 

@@ -234,7 +234,7 @@ fn invalid_fabric_names_the_field() {
     );
     fails(
         &eval(&p, &["--wi", "30,0", "--wo", "30,180"]),
-        &["warp.colour", "docs/fabric-format.md"],
+        &["warp.colour", "docs/reference/fabric-format.md"],
     );
 
     let p = temp_fabric("syntax", "{\"pattern\": [[1]],\n");
@@ -374,7 +374,7 @@ fn bounces_2_reports_the_four_components() {
 /// `--orders` and `--sampling` reach the secondary reflection: on the parallel surface every
 /// setting lands near the converged analytic value (adaptive along C1, 24-point rules, given as
 /// --orders 64,64,16), each within the worst error of its row in the accuracy table of
-/// docs/interreflection.md (2.8% default, 5.7% fast, 8-10% for the two sampling settings, with
+/// docs/science/interreflection.md (2.8% default, 5.7% fast, 8-10% for the two sampling settings, with
 /// a margin), and each differs from it (the flags are not ignored).
 #[test]
 fn orders_and_sampling_flags_set_the_secondary_reflection() {
@@ -894,7 +894,7 @@ fn open_plain(name: &str) -> PathBuf {
 
 #[test]
 fn the_two_faced_cloth_answers_on_the_whole_sphere() {
-    // An open plain weave with translucent yarns (docs/transmission.md): the model (analytic
+    // An open plain weave with translucent yarns (docs/science/transmission.md): the model (analytic
     // direct reflection and openness, the rest path-traced at coarse nodes) against the ray
     // tracer of the two-faced micro-geometry, at nodes of the rest's grid (polar angles 18 k
     // from each side's normal, azimuths 22.5 + 45 k; straight through is one), and the

@@ -1,5 +1,5 @@
 //! `clothbake export --gltf --mtlx --usd --blender`: every shipped fabric exports to all four
-//! targets, the residuals it prints are the table of docs/export.md (written by `cargo xtask
+//! targets, the residuals it prints are the table of docs/guide/export.md (written by `cargo xtask
 //! fitted` from the same library calls: the table must be current), and bad requests are
 //! refused before any work.
 
@@ -50,9 +50,10 @@ fn residual_cell(line: &str) -> String {
 
 #[test]
 fn every_shipped_fabric_exports_to_all_four_targets_with_the_documented_residuals() {
-    let docs =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/export.md"))
-            .unwrap();
+    let docs = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/guide/export.md"),
+    )
+    .unwrap();
     let fabrics = shipped();
     assert!(fabrics.len() >= 13, "{fabrics:?}");
     for path in fabrics {
@@ -92,7 +93,7 @@ fn every_shipped_fabric_exports_to_all_four_targets_with_the_documented_residual
             .lines()
             .find(|l| l.starts_with(&format!("| {file} |")))
             .unwrap_or_else(|| {
-                panic!("docs/export.md has no row for {file}: run cargo xtask fitted")
+                panic!("docs/guide/export.md has no row for {file}: run cargo xtask fitted")
             });
         let cols: Vec<&str> = row.split('|').map(str::trim).collect();
         let line = |what: &str| {

@@ -389,7 +389,7 @@ fn small_table() -> Table {
     .unwrap()
 }
 
-/// Small spatial tables (docs/spatial.md), baked: the gingham's colour map with one bounce,
+/// Small spatial tables (docs/science/spatial.md), baked: the gingham's colour map with one bounce,
 /// the twill with the second bounce (side terms, mirror images held once).
 fn spatial_tables() -> Vec<Table> {
     [("gingham.wif", 1), ("twill.json", 2)]
@@ -432,7 +432,7 @@ fn use_table(t: Table) {
                 for width in [0.0, 0.3, 0.999, 2.0, f64::NAN] {
                     let f = b.eval_at(wi, wo, x, y, width);
                     assert!(ok(f), "{f:?} at {x}, {y}, {width}");
-                    // Slightly above 1 is possible (docs/spatial.md): no upper bound here.
+                    // Slightly above 1 is possible (docs/science/spatial.md): no upper bound here.
                     let c = b.coverage_at(wo, x, y, width);
                     assert!(c.is_finite() && c >= 0.0, "{c} at {x}, {y}, {width}");
                 }
@@ -560,7 +560,7 @@ fn run_table_exr() {
     );
 }
 
-/// A version-1 binary table (bincode header), by `docs/table-format.md`.
+/// A version-1 binary table (bincode header), by `docs/reference/table-format.md`.
 fn v1_table(t: &Table) -> Vec<u8> {
     fn string(out: &mut Vec<u8>, s: &str) {
         out.extend_from_slice(&(s.len() as u64).to_le_bytes());

@@ -1,6 +1,6 @@
 //! A replay of issue 18's family of hostile inputs, wider than its examples: magnitudes, sizes,
 //! special files, outputs that are inputs, malformed drafts and tables, options past their
-//! ranges. Every case must answer as docs/limits.md promises: exit 2, one line on stderr
+//! ranges. Every case must answer as docs/reference/limits.md promises: exit 2, one line on stderr
 //! naming what is wrong, nothing on stdout, nothing written in the folder, no special file
 //! replaced, within seconds; and no case's process may grow past 1 GB.
 #![cfg(unix)]
@@ -650,7 +650,7 @@ fn peak_rss(dir: &Path, args: &[&str]) -> (i32, u64) {
     (libc::WEXITSTATUS(status), ru.ru_maxrss as u64 * 1024)
 }
 
-/// An export stays within the memory bound docs/limits-output.md states, written out here:
+/// An export stays within the memory bound docs/reference/limits-output.md states, written out here:
 /// 64 MiB for the program, 16 bytes a texel of the slices held (and 64 a slice), 192 bytes a
 /// texel of each worker's slice, 1 MiB + 64 KiB of buffers; MERL 80 bytes a cell of its
 /// 90 x 90 x 180 and 144 bytes a rotation per worker. The spectral file alone (26 f32 a texel)
@@ -699,7 +699,7 @@ fn an_export_keeps_its_memory_bound() {
 
 /// A container file (binary table, shard, checkpoint) with its kind set to `kind`, its header
 /// JSON changed by `edit` and its values by `values`, its lengths and CRC made right again
-/// (layout: docs/table-format.md).
+/// (layout: docs/reference/table-format.md).
 fn rewrite_container(
     bytes: &[u8],
     kind: &str,
@@ -869,7 +869,7 @@ fn a_draft_with_cr_line_endings_reads_like_lf() {
     assert_eq!(a.replace("lf.wif", "cr.wif"), b);
 }
 
-/// A period larger than `--variant sliced3d` takes (docs/limits.md: 16 384 cells) is refused by
+/// A period larger than `--variant sliced3d` takes (docs/reference/limits.md: 16 384 cells) is refused by
 /// every command that builds the model, with one line naming the file, the variant, the size
 /// and the fix, before any work on it; the same period is evaluated with the other variants.
 #[test]

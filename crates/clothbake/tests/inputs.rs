@@ -1,6 +1,6 @@
 //! The binary's input side: weaving drafts as weavers write them (yarns thicker than their
-//! spacing, packed), the size flags, and bounded reading of `--weave` (docs/wif.md,
-//! docs/limits.md).
+//! spacing, packed), the size flags, and bounded reading of `--weave` (docs/reference/wif.md,
+//! docs/reference/limits.md).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -127,7 +127,7 @@ fn a_period_beyond_the_limits_is_refused_in_one_line() {
             "inputs-big-period.json",
             "field `pattern`",
             "2049 x 512 = 1049088 cells, more than the 1048576",
-            "docs/limits.md",
+            "docs/reference/limits.md",
         ],
     );
 }
@@ -198,7 +198,7 @@ fn special_and_oversized_files_are_refused_before_reading() {
         &[
             "inputs-big.json",
             "2147483648 bytes, more than the 16 MiB",
-            "docs/limits.md",
+            "docs/reference/limits.md",
         ],
     );
     std::fs::remove_file(&big).unwrap();
@@ -221,7 +221,7 @@ fn draft_counts_too_large_say_so() {
                 &format!("inputs-threads-{}.wif", n.len()),
                 "[WARP] line 4",
                 &format!("Threads={n}: the number of warp ends is too large, at most 65536"),
-                "docs/limits.md",
+                "docs/reference/limits.md",
             ],
         );
     }
@@ -247,7 +247,7 @@ fn binary_data_is_not_a_text_draft() {
         assert!(line.len() < 250, "{line}");
     }
     let line = fails_with(&eval_path(&temp("noise.wif")), 2, &["not a text WIF draft"]);
-    assert!(line.contains("docs/wif.md"), "{line}");
+    assert!(line.contains("docs/reference/wif.md"), "{line}");
 }
 
 #[test]
@@ -274,7 +274,12 @@ fn a_json_top_level_that_is_not_an_object_is_named() {
         fails_with(
             &eval_path(&p),
             2,
-            &[name, what, "expected an object", "docs/fabric-format.md"],
+            &[
+                name,
+                what,
+                "expected an object",
+                "docs/reference/fabric-format.md",
+            ],
         );
     }
 }

@@ -1,4 +1,4 @@
-//! The shell examples of README.md and of every docs/*.md run in order in a fresh folder, as a
+//! The shell examples of README.md and of every docs/**/*.md run in order in a fresh folder, as a
 //! new user would run them from a fresh clone: every line of every ```sh or ```bash block of
 //! the file, with the built `clothbake` first on PATH and `tables/` of the repository beside
 //! them (read only). One test per file, each in its own folder.
@@ -179,41 +179,51 @@ macro_rules! doc_test {
 }
 
 doc_test! {
-    docs_baking: "docs/baking.md", 5;
-    docs_cli: "docs/cli.md", 20;
-    docs_cluster: "docs/cluster.md", 4;
-    docs_daylighting: "docs/daylighting.md", 2;
-    docs_export: "docs/export.md", 6;
-    docs_fabric_format: "docs/fabric-format.md", 1;
-    docs_render: "docs/render.md", 9;
-    docs_transport: "docs/transport.md", 1;
-    docs_wif: "docs/wif.md", 3;
+    docs_baking: "docs/guide/baking.md", 5;
+    docs_cli: "docs/reference/cli.md", 20;
+    docs_cluster: "docs/guide/cluster.md", 4;
+    docs_daylighting: "docs/guide/daylighting.md", 2;
+    docs_export: "docs/guide/export.md", 6;
+    docs_fabric_format: "docs/reference/fabric-format.md", 1;
+    docs_render: "docs/guide/render.md", 9;
+    docs_transport: "docs/science/transport.md", 1;
+    docs_wif: "docs/reference/wif.md", 3;
 }
 
 /// The documents whose blocks all need what a test cannot have, each with the reason its
 /// markers give; the test below keeps this list and docs/ in step.
-const NOTHING_TO_RUN: [&str; 2] = ["docs/loader.md", "docs/python.md"];
+const NOTHING_TO_RUN: [&str; 2] = ["docs/reference/loader.md", "docs/guide/python.md"];
 
 #[test]
 fn every_document_with_shell_blocks_is_run_or_listed() {
     let tested = [
-        "docs/baking.md",
-        "docs/cli.md",
-        "docs/cluster.md",
-        "docs/daylighting.md",
-        "docs/export.md",
-        "docs/fabric-format.md",
-        "docs/render.md",
-        "docs/transport.md",
-        "docs/wif.md",
+        "docs/guide/baking.md",
+        "docs/reference/cli.md",
+        "docs/guide/cluster.md",
+        "docs/guide/daylighting.md",
+        "docs/guide/export.md",
+        "docs/reference/fabric-format.md",
+        "docs/guide/render.md",
+        "docs/science/transport.md",
+        "docs/reference/wif.md",
     ];
-    let mut with_blocks = Vec::new();
-    for e in std::fs::read_dir(repo().join("docs")).unwrap() {
+    // docs/ and its sections (guide/, reference/, science/, results/, ...), one level down.
+    let docs = repo().join("docs");
+    let mut pages = Vec::new();
+    for e in std::fs::read_dir(&docs).unwrap() {
         let p = e.unwrap().path();
+        if p.is_dir() {
+            pages.extend(std::fs::read_dir(&p).unwrap().map(|e| e.unwrap().path()));
+        } else {
+            pages.push(p);
+        }
+    }
+    let mut with_blocks = Vec::new();
+    for p in pages {
         if p.extension().is_some_and(|x| x == "md") {
             let text = std::fs::read_to_string(&p).unwrap();
             if text.contains("```sh") || text.contains("```bash") {
-                let doc = format!("docs/{}", p.file_name().unwrap().to_string_lossy());
+                let doc = format!("docs/{}", p.strip_prefix(&docs).unwrap().display());
                 let runs = !commands(&text).is_empty();
                 with_blocks.push((doc, runs));
             }

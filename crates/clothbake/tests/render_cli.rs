@@ -344,7 +344,7 @@ fn periods_show_the_weave_up_close_and_the_average_from_afar() {
         spread(&a)
     );
     // --gaps: each pixel times the coverage of its footprint, at most a little over 1 (a tall
-    // yarn seen over its neighbour's cell, docs/spatial.md) and well under 1 where the eye
+    // yarn seen over its neighbour's cell, docs/science/spatial.md) and well under 1 where the eye
     // meets the floor between yarns; without --periods, the directional coverage C(wo).
     for periods in [Some("12"), None] {
         let plain = swatch_pixels(&table, periods, "plain");

@@ -1,4 +1,4 @@
-//! `--bounces N|all` on the command line (docs/transport.md): what eval reports, its
+//! `--bounces N|all` on the command line (docs/science/transport.md): what eval reports, its
 //! determinism, its agreement with the thesis's analytic second bounce where that is the whole
 //! of I_2, and the refusals.
 

@@ -10,7 +10,7 @@
 //! away from the crossing cylinder's axis, past a neighbour's float end it meets the next row,
 //! and past the end of the crossing float over its own thread it escapes where that thread
 //! dives under the neighbour. Here the ray from a point of the arc is followed through the
-//! floats around the piece, each a finite cylinder with flat ends (docs/model.md, "Geometry"):
+//! floats around the piece, each a finite cylinder with flat ends (docs/science/model.md, "Geometry"):
 //! the other threads of its group, its own thread's other floats and every float of the
 //! crossing group, the whole period repeated as far as a ray 2 degrees above the horizon can
 //! travel below the highest yarn top. The piece's own float is left out (a ray leaving the arc

@@ -103,7 +103,7 @@ impl AnalyticModel {
     }
 
     /// The part of each slice's cross-section that faces `w`, lies above the floor and is
-    /// hidden by no float around it (docs/model.md, "The sliced3d variant"), for every slice
+    /// hidden by no float around it (docs/science/model.md, "The sliced3d variant"), for every slice
     /// of a [`Variant::Sliced3d`] model; empty for the other variants and below the horizon.
     pub fn open_arcs(&self, w: UnitVec3) -> OpenArcs {
         let mut out = OpenArcs {

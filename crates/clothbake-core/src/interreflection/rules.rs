@@ -36,7 +36,7 @@ pub struct Orders {
 }
 
 /// Cheaper orders for percent-level accuracy (under 2% mean error of I_2 on the table of
-/// `docs/interreflection.md`): the analytic side of the comparison with the two-level
+/// `docs/science/interreflection.md`): the analytic side of the comparison with the two-level
 /// sampling at equal accuracy.
 pub const ORDERS_FAST: Orders = Orders {
     theta: 7,

@@ -20,7 +20,7 @@ pub struct Finish {
     pub specular: f64,
     /// Specular exponent n.
     pub exponent: f64,
-    /// Diffuse transmittance through the yarn, RGB (docs/transmission.md; 0 for opaque yarn).
+    /// Diffuse transmittance through the yarn, RGB (docs/science/transmission.md; 0 for opaque yarn).
     pub transmittance: [f64; 3],
 }
 
@@ -109,7 +109,7 @@ impl RayTracer {
         RayTracer::from_description(&Description::of(fabric), Terms::of(facet))
     }
 
-    /// The tracer of the fabric's two-faced cloth (docs/transmission.md): its front as
+    /// The tracer of the fabric's two-faced cloth (docs/science/transmission.md): its front as
     /// [`RayTracer::new`] builds it, its back the inverted weave mirrored below z = 0, no
     /// floor, every surface shaded (caps and the flat undersides included) and translucent
     /// yarns transmitting.

@@ -1,4 +1,4 @@
-//! The truth's own facet terms, written from the thesis and docs/model.md independently of the
+//! The truth's own facet terms, written from the thesis and docs/science/model.md independently of the
 //! model's `facet` module. Intensities are the thesis's (pi times radiance, for unit light):
 //!
 //! * Huo (thesis eqs 4.6 and 4.8): `I_d = rho_d N.L`, `I_s = rho_s (N.H)^n` with

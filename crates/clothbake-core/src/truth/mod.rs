@@ -7,7 +7,7 @@
 //!
 //! * [`description`]: the one file that reads a [`Fabric`](crate::fabric::Fabric) (and the
 //!   model's facet selector), copying it into the plain [`Description`];
-//! * [`yarns`]: segment placement and extents (thesis ch. 2, `docs/geometry.md`);
+//! * [`yarns`]: segment placement and extents (thesis ch. 2, `docs/science/geometry.md`);
 //! * [`facets`]: Huo's terms (eqs 4.6, 4.8) and Lewis's modified Phong;
 //! * [`intersect`]: cylinder, cap-slab and floor intervals of one segment;
 //! * [`cells`]: the acceleration cells over one period and the walk over the tiling;

@@ -1,5 +1,5 @@
 //! The ground truth resolved over the weave period: [`RayTracer::render_cells`] sorts every
-//! counted hit of the direct estimate into the crossing cell it belongs to (docs/spatial.md),
+//! counted hit of the direct estimate into the crossing cell it belongs to (docs/science/spatial.md),
 //! by rules of its own written from the docs, not from the model's code.
 //!
 //! A hit on the float of thread t (warp or weft) at coordinate y along the thread's axis

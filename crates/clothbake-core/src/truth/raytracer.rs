@@ -276,7 +276,7 @@ impl RayTracer {
         })
     }
 
-    /// The reference plane's height, where a renderer's mesh of the cloth lies (docs/spatial.md,
+    /// The reference plane's height, where a renderer's mesh of the cloth lies (docs/science/spatial.md,
     /// "The reference plane"): halfway between the floor and the top of the highest yarn.
     pub fn reference_height(&self) -> f64 {
         0.5 * self.yarns.top()
@@ -308,7 +308,7 @@ impl RayTracer {
         Vec3::new(u.rem_euclid(1.0) * px, v.rem_euclid(1.0) * py, z_ref) + wo.get() * back
     }
 
-    /// The masking and shadowing shares of the period seen from `wo` (docs/model.md, "Where
+    /// The masking and shadowing shares of the period seen from `wo` (docs/science/model.md, "Where
     /// the error comes from"): the fraction of its projected area where the eye meets counted
     /// yarn (the coverage), and where that yarn also faces the light `wi` and is lit. From
     /// `samples` stratified rays, deterministic for a given `seed`; zeros when a direction is

@@ -1,4 +1,4 @@
-//! Light through the two-faced cloth (docs/transmission.md): the ground truth of its openness,
+//! Light through the two-faced cloth (docs/science/transmission.md): the ground truth of its openness,
 //! of its reflection from either face and of its transmission.
 //!
 //! The cloth is [`RayTracer::two_faced`]'s: the front floats above z = 0, the inverted weave's

@@ -1,5 +1,5 @@
 //! The truth's own micro-geometry, built from a [`Description`] by the rules of thesis ch. 2 as
-//! `docs/geometry.md` states them (written here independently of the model's `geometry`):
+//! `docs/science/geometry.md` states them (written here independently of the model's `geometry`):
 //!
 //! * the floor is z = 0; each yarn is a circular cylinder of its thread's radius with its axis
 //!   horizontal at the thread's height, cut by the floor;
@@ -11,7 +11,7 @@
 //!   of b+1, `[P_{a-1} + r_{a-1}, P_{b+1} - r_{b+1}]` in unwrapped coordinates, or a given
 //!   length centred in that room; a thread that is never under is one endless cylinder, one that
 //!   is never on top does not appear;
-//! * the two-faced cloth (docs/transmission.md) has no floor: its back is built by the same
+//! * the two-faced cloth (docs/science/transmission.md) has no floor: its back is built by the same
 //!   rules from the inverted weave (a thread's floats under its crossing threads), mirrored
 //!   below z = 0 (axis at minus the thread's height, cut by z <= 0).
 

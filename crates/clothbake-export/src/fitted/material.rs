@@ -78,7 +78,7 @@ impl Fitted {
                     .collect();
                 // Each cell's f_r times its coverage, over the period's coverage
                 // sum_k a_k c_k: the texels' area-weighted mean is then the averaged f_r,
-                // which is that coverage-weighted mean (docs/spatial.md). A material has no
+                // which is that coverage-weighted mean (docs/science/spatial.md). A material has no
                 // gaps: a cell whose yarn covers half its area shows half its f_r.
                 let locals: Vec<(Samples, Vec<f64>)> = centres
                     .par_iter()

@@ -1,7 +1,7 @@
 //! Fitted standard materials: the parametric materials that tools without table lookups
 //! render (glTF 2.0 viewers, OpenPBR in MaterialX and USD, Blender's Principled BSDF), with
 //! parameters fitted to a cloth's BRDF and, over one weave period, to each crossing cell
-//! (docs/export.md, "Fitted materials").
+//! (docs/guide/export.md, "Fitted materials").
 //!
 //! A material is a base colour (Lambertian diffuse under a dielectric specular layer of index
 //! 1.5, anisotropic GGX) under a sheen layer. The cloth model's non-diffuse reflection is

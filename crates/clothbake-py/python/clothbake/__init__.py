@@ -6,7 +6,7 @@ toward the eye; directions are unit vectors, arrays of shape (N, 3). f_r is in 1
 * :class:`Fabric`: a fabric file (or dict) and its BRDF from the analytic model.
 * :class:`Table`: a baked table with interpolated lookup and importance sampling.
 * :class:`TwoFaced` (``Fabric.two_faced()``): the two-faced cloth, light through the gaps and
-  the yarns: f over the whole sphere and the openness (docs/transmission.md).
+  the yarns: f over the whole sphere and the openness (docs/science/transmission.md).
 * :func:`bake`: bake a Fabric into a Table in memory, or into a table or shard file (checkpoints, resume).
 * :mod:`clothbake.mitsuba`: a Mitsuba 3 BSDF plugin (``register()``).
 """

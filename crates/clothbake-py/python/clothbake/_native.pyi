@@ -46,13 +46,13 @@ class Fabric:
         """f_r of one pair (analytic, direct reflection), 1/sr."""
     def two_faced(self, facet: str = "huo", variant: str = "refined",
                   nodes: Tuple[int, int] = (5, 8), paths: int = 8192) -> "TwoFaced":
-        """The two-faced cloth (docs/transmission.md); its coarse grid path-traced now."""
+        """The two-faced cloth (docs/science/transmission.md); its coarse grid path-traced now."""
     def eval1_at(self, wi: Vec3, wo: Vec3, u: float, v: float, width: float = 0.0,
                  facet: str = "huo") -> Tuple[Vec3, float]:
         """(f_r, coverage) of one pair through a footprint at (u, v), every level of detail."""
 
 class TwoFaced:
-    """The two-faced cloth: f over the whole sphere and the openness (docs/transmission.md)."""
+    """The two-faced cloth: f over the whole sphere and the openness (docs/science/transmission.md)."""
     @staticmethod
     def open(path: Union[str, "os.PathLike[str]"], reciprocal: bool = False) -> "TwoFaced":
         """Opens a two-faced table (baked with --faces two); ValueError for a one-faced one."""

@@ -6,7 +6,7 @@ baked table: interpolated lookup and the loader's importance sampling) or
 directly; cosine-weighted sampling). Optional parameters: ``facet`` ("huo" | "lewis", weave
 only), ``two_sided`` (bool, default True), ``periods`` (float: weave periods per unit of the
 surface's UV). With ``periods`` each lookup is at the point (u, v) * periods of the weave period
-through its footprint, at the footprint's level of detail (docs/spatial.md): with ``weave=``
+through its footprint, at the footprint's level of detail (docs/science/spatial.md): with ``weave=``
 the yarns are traced up close (round yarns, highlights along the floats, shadows, gaps), the
 crossing cells answer from two cells wide and the average from a period; a table baked with
 ``spatial=True`` / ``--spatial`` (one bounce) carries its yarns and answers alike, another
@@ -29,7 +29,7 @@ and eye on opposite sides give zero (no transmission).
 
 Two faces and transmission: ``faces="two"`` with ``weave=`` (or ``table=``, a table baked with
 ``clothbake --faces two``) draws the two-faced cloth
-(docs/transmission.md: no floor, light through the gaps and through translucent yarns, the back
+(docs/science/transmission.md: no floor, light through the gaps and through translucent yarns, the back
 the inverted weave): ``eval`` gives reflection off either face and transmission across, and a
 null lobe passes the ray straight through with the openness O along the eye's direction (a
 delta, as Mitsuba's null-scattering BSDFs do: sampled with probability O, weight 1). The
