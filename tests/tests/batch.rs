@@ -17,7 +17,7 @@ use clothbake_tests::probe;
 /// more grazing pair, two below the horizon, and a count that is not a multiple of four.
 fn pairs(seed: u64) -> Vec<(UnitVec3, UnitVec3)> {
     let mut p = random_pairs(2001, seed);
-    p.extend(clothbake_core::validate::edge_pairs());
+    p.extend(clothbake_core::directions::edge_pairs());
     let d = UnitVec3::from_degrees;
     p.push((d(89.9999, 10.0), d(30.0, 190.0)));
     let below = d(95.0, 10.0);

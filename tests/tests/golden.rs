@@ -10,8 +10,9 @@
 
 use clothbake_bake::compare::compare;
 use clothbake_bake::golden::{bake_golden, golden_path, shipped_fabrics, GRID, TOLERANCE};
-use clothbake_core::{Fabric, FacetModel, RayTracer, UnitVec3};
+use clothbake_core::{Fabric, FacetModel, UnitVec3};
 use clothbake_loader::read_table;
+use clothbake_truth::RayTracer;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 

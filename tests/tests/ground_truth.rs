@@ -3,8 +3,10 @@
 //! for directions up to 70 degrees from the normal). The full table is `docs/results/validation.md`
 //! (`cargo xtask validate`).
 
-use clothbake_core::validate::{compare_with, direction_set};
-use clothbake_core::{Caps, Fabric, FacetModel, Variant};
+use clothbake_core::directions::direction_set;
+use clothbake_core::{Fabric, FacetModel, Variant};
+use clothbake_tests::validate::compare_with;
+use clothbake_truth::Caps;
 use std::path::Path;
 
 const TABLES: [&str; 6] = ["plain", "basket", "twill", "twill31", "satin5", "parallel"];

@@ -5,7 +5,7 @@
 //! same to every channel) and as light as measured indigo denim, a filament satin's highlight stands out from its diffuse reflection more
 //! than any plain weave's, and the woollen twill's least.
 
-use clothbake_core::validate::direction_set;
+use clothbake_core::directions::direction_set;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3};
 use clothbake_tests::fixtures::{root, tables};
 

@@ -3,9 +3,10 @@
 //! truth per crossing cell, and what it shows of each weave.
 
 use clothbake_core::{
-    AnalyticModel, Cell, Fabric, FacetModel, LocalReflection, PeriodPoint, RayTracer,
-    SecondaryOptions, UnitVec3,
+    AnalyticModel, Cell, Fabric, FacetModel, LocalReflection, PeriodPoint, SecondaryOptions,
+    UnitVec3,
 };
+use clothbake_truth::RayTracer;
 use std::collections::HashMap;
 use std::path::Path;
 

@@ -1,8 +1,9 @@
 //! Per-yarn colour: the analytic model and the ray-traced ground truth honour warp, weft and
 //! per-thread albedos, channel by channel.
 
-use clothbake_core::validate::direction_set;
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, Group, RayTracer, UnitVec3};
+use clothbake_core::directions::direction_set;
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, Group, UnitVec3};
+use clothbake_truth::RayTracer;
 use std::path::Path;
 
 fn load(name: &str) -> Fabric {

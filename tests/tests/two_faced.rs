@@ -2,8 +2,9 @@
 //! ones a fabric-shade maker publishes, against the ground truth's light paths.
 
 use clothbake_bake::two_faced::{TwoFaced, MAX_BOUNCES};
-use clothbake_core::{Fabric, FacetModel, RayTracer, UnitVec3, Variant};
+use clothbake_core::{Fabric, FacetModel, UnitVec3, Variant};
 use clothbake_export::klems::Datasheet;
+use clothbake_truth::RayTracer;
 
 fn open_plain(tau: f64, h: f64) -> Fabric {
     let m = format!(

@@ -325,8 +325,8 @@ fn packed_drafts_match_the_ground_truth() {
     // The model on packed yarns (round, touching) against the ray tracer of the same geometry,
     // as tests/tests/ground_truth.rs does for the shipped fabrics (docs/reference/wif.md has the numbers:
     // mean 0.5-0.9%, worst 2-4%).
-    use clothbake_core::validate::compare;
-    let pairs = clothbake_core::validate::direction_set(48, 70.0);
+    use clothbake_tests::validate::compare;
+    let pairs = clothbake_core::directions::direction_set(48, 70.0);
     for name in ["herringbone8.wif", "advancing12.wif"] {
         let f = test_draft(name);
         for facet in [FacetModel::Huo, FacetModel::Lewis] {

@@ -16,11 +16,11 @@
 //!   for the reproduction, and the full ranges for the corrected numbers.
 
 use clothbake_core::interreflection::{Orders, Ranges, Sampling};
-use clothbake_core::pathtrace::PathOptions;
 use clothbake_core::{
-    AnalyticModel, Fabric, FacetModel, Kernel, RayTracer, SecondaryMethod, SecondaryOptions,
-    UnitVec3, Vec3,
+    AnalyticModel, Fabric, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, UnitVec3, Vec3,
 };
+use clothbake_truth::pathtracer::PathOptions;
+use clothbake_truth::RayTracer;
 use std::fmt::Write as _;
 
 /// The parallel-cylinder surface of thesis sec. 5.4 (r 1, d 2, rho_d 0.4) with specular
@@ -284,9 +284,9 @@ fn disk_reading(out: &mut String, light: Light, radius: f64, reading: Reading) {
 }
 
 fn convergence(out: &mut String, root: &std::path::Path) {
-    writeln!(out, "\n## Convergence of inter-reflection (path tracer, radiometric, huo facets)\n\nI_k / I_1 for bounce orders k = 2..6, averaged over 8 direction pairs up to 60 degrees (`validate::direction_set`), 40 000 paths each; rho_d 0.4, rho_s 0.3 (sec. 4.3) for the twill, rho_d 0.4, rho_s 0.7 (sec. 5.4) for the parallel cylinders.\n").unwrap();
+    writeln!(out, "\n## Convergence of inter-reflection (path tracer, radiometric, huo facets)\n\nI_k / I_1 for bounce orders k = 2..6, averaged over 8 direction pairs up to 60 degrees (`directions::direction_set`), 40 000 paths each; rho_d 0.4, rho_s 0.3 (sec. 4.3) for the twill, rho_d 0.4, rho_s 0.7 (sec. 5.4) for the parallel cylinders.\n").unwrap();
     writeln!(out, "| surface | n | I_2/I_1 | I_3/I_1 | I_4/I_1 | I_5/I_1 | I_6/I_1 |\n|---|---|---|---|---|---|---|").unwrap();
-    let pairs = clothbake_core::validate::direction_set(8, 60.0);
+    let pairs = clothbake_core::directions::direction_set(8, 60.0);
     for (name, rho_s) in [("parallel", 0.7), ("twill", 0.3)] {
         for n in [1.0, 4.0, 10.0, 40.0] {
             let f = if name == "parallel" {

@@ -4,8 +4,9 @@
 //! fabric, into docs/results/validation.md between the `error-sources` markers.
 
 use clothbake_bake::golden::fabric_files;
-use clothbake_core::validate::direction_set;
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, RayTracer, UnitVec3, Variant};
+use clothbake_core::directions::direction_set;
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, UnitVec3, Variant};
+use clothbake_truth::RayTracer;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -5,8 +5,9 @@
 //! crates/clothbake/tests/export_fitted_cli.rs holds the table to the command's output.
 
 use clothbake_core::{AnalyticBsdf, AnalyticModel, Fabric, FacetModel};
+use clothbake_export::fits::Fits;
 use clothbake_export::fitted::fit::Residual;
-use clothbake_export::fitted::material::{Cells, Fits, Source};
+use clothbake_export::fitted::material::{Cells, Source};
 use clothbake_export::fitted::microfacet::Albedos;
 use clothbake_export::fitted::IOR;
 use clothbake_tests::fixtures::shipped_files;

@@ -4,8 +4,8 @@
 //! `ir-accuracy` markers). Times are in the criterion benchmark
 //! (`cargo bench -p clothbake-core --bench eval -- secondary`), which runs the same settings.
 
+use clothbake_core::directions::secondary_direction_set;
 use clothbake_core::interreflection::{Orders, Ranges, Sampling};
-use clothbake_core::validate::secondary_direction_set;
 use clothbake_core::{
     AnalyticModel, Fabric, FacetModel, Kernel, SecondaryMethod, SecondaryOptions,
 };

@@ -88,7 +88,7 @@ fn max_diff(a: &Image, b: &Image) -> f64 {
 fn cells_table(root: &Path) -> String {
     use clothbake_core::rng::Rng;
     use clothbake_core::{AnalyticModel, Cell};
-    let pairs = clothbake_core::validate::direction_set(12, 70.0);
+    let pairs = clothbake_core::directions::direction_set(12, 70.0);
     let mut rows = String::new();
     for path in clothbake_bake::golden::fabric_files(&root.join("tables")).expect("tables") {
         let f = Fabric::from_path(&path).expect("shipped fabric");

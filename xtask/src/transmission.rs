@@ -8,9 +8,10 @@
 
 use clothbake_bake::sweep::{bake, BakeOptions, DEFAULT_GRID};
 use clothbake_bake::two_faced::{TwoFaced, MAX_BOUNCES};
-use clothbake_core::validate::direction_set;
-use clothbake_core::{Bsdf, Fabric, FacetModel, Material, RayTracer, UnitVec3, Variant};
+use clothbake_core::directions::direction_set;
+use clothbake_core::{Bsdf, Fabric, FacetModel, Material, UnitVec3, Variant};
 use clothbake_loader::{Options, TwoFacedBrdf};
+use clothbake_truth::RayTracer;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;

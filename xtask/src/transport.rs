@@ -3,10 +3,11 @@
 //! second, the furnace test, and the convergence of the orders on the parallel surface.
 
 use clothbake_bake::golden::fabric_files;
-use clothbake_core::transport::{Transport, ALL_BOUNCES};
-use clothbake_core::validate::direction_set;
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, PathOptions, PlainNaming, RayTracer};
+use clothbake_bake::transport::{Transport, ALL_BOUNCES};
+use clothbake_core::directions::direction_set;
+use clothbake_core::{AnalyticModel, Fabric, FacetModel, PlainNaming};
 use clothbake_core::{Kernel, UnitVec3};
+use clothbake_truth::{PathOptions, RayTracer};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::fmt::Write as _;
@@ -43,7 +44,7 @@ fn fabrics(out: &mut String, root: &Path) {
     writeln!(
         out,
         "### Every shipped fabric\n\n{PAIRS} direction pairs up to {BOUND} degrees \
-         (`validate::direction_set({PAIRS}, {BOUND})`), {PATHS} paths each, Huo facets with each \
+         (`directions::direction_set({PAIRS}, {BOUND})`), {PATHS} paths each, Huo facets with each \
          fabric's own material, radiometric kernel, all bounces (roulette from order 4). I_1 is \
          the analytic direct term; I_2 and I_3+ (orders 3 and up) are path-traced; values are \
          channel means. `perp. share` is the perpendicular part of I_2 summed over the pairs over \

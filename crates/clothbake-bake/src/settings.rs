@@ -4,8 +4,9 @@
 
 use crate::sweep::{check_options, BakeOptions, Method, DEFAULT_GRID};
 use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
-use clothbake_core::{Caps, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, Variant};
+use clothbake_core::{FacetModel, Kernel, SecondaryMethod, SecondaryOptions, Variant};
 use clothbake_loader::{Faces, Grid};
+use clothbake_truth::Caps;
 
 /// The most worker threads a command starts (`--threads`): far more than cores gains nothing
 /// (the work is CPU-bound) and a pool of 100 000 threads takes minutes to start, during which
@@ -156,7 +157,7 @@ pub struct Settings {
 /// The bounces and the secondary reflection's settings as given.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounces {
-    /// 1, 2, N > 2 or `clothbake_core::ALL_BOUNCES` (docs/science/transport.md).
+    /// 1, 2, N > 2 or `clothbake_bake::transport::ALL_BOUNCES` (docs/science/transport.md).
     pub bounces: u32,
     /// `Some(true)`: the two-level sampling; `Some(false)`: the analytic solution [default].
     pub sampled: Option<bool>,
@@ -216,10 +217,7 @@ impl Bounces {
                      every order from the second on is path-traced on the micro-geometry \
                      (radiometric kernel); drop {} or use {}",
                     f(name),
-                    n.number(
-                        "bounces",
-                        &clothbake_core::transport::bounces_name(self.bounces)
-                    ),
+                    n.number("bounces", &crate::transport::bounces_name(self.bounces)),
                     f(name),
                     n.number("bounces", "2")
                 ));

@@ -18,11 +18,12 @@ use crate::two_faced::TwoFaced;
 use clothbake_core::interreflection::{Orders, Ranges, Sampling};
 use clothbake_core::symmetry::Symmetry;
 use clothbake_core::{
-    AnalyticBsdf, AnalyticModel, Bsdf, Caps, ClassTerms, Fabric, FacetModel, RayTracer,
-    SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, ClassTerms, Fabric, FacetModel, SecondaryMethod,
+    SecondaryOptions, UnitVec3, Variant,
 };
 use clothbake_loader::spatial::value_index;
 use clothbake_loader::{Faces, Grid, Metadata, Table};
+use clothbake_truth::{Caps, RayTracer};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -64,7 +65,7 @@ pub struct BakeOptions {
     /// Evaluation method.
     pub method: Method,
     /// Bounces: 1 (direct reflection I_1 only), 2 (I_1 + the secondary reflection I_2), or more
-    /// (`clothbake_core::ALL_BOUNCES` for all): I_1 plus the path-traced orders 2 to N
+    /// (`clothbake_bake::transport::ALL_BOUNCES` for all): I_1 plus the path-traced orders 2 to N
     /// ([`crate::transport`]).
     pub bounces: u32,
     /// How I_2 is computed; used only when `bounces == 2`.
@@ -138,7 +139,7 @@ impl BakeOptions {
         }
         v["bounces"] = json!(self.bounces);
         if self.bounces > 2 {
-            v["bounces"] = json!(clothbake_core::transport::bounces_name(self.bounces));
+            v["bounces"] = json!(crate::transport::bounces_name(self.bounces));
             v["transport"] = crate::transport::describe(&self.grid, self.bounces);
         }
         if self.bounces == 2 {

@@ -15,14 +15,14 @@
 //!   indices (seeded by its direction pair), computed once, on first use or in parallel by
 //!   [`TwoFaced::prepare`]; with Lewis facets (reciprocal) a node and its reciprocal are one.
 
+use crate::transport::pair_seed;
 use clothbake_core::openness::openness;
-use clothbake_core::transport::pair_seed;
 use clothbake_core::{two_sided_pdf, two_sided_sample, BsdfSample};
 use clothbake_core::{
-    AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FabricError, FacetModel, RayTracer, Rgb, UnitVec3,
-    Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FabricError, FacetModel, Rgb, UnitVec3, Variant,
 };
 use clothbake_loader::Axis;
+use clothbake_truth::RayTracer;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, Ordering};

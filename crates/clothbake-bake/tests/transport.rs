@@ -6,10 +6,12 @@
 
 use clothbake_bake::sweep::DEFAULT_GRID;
 use clothbake_bake::transport::Multiple;
+use clothbake_bake::transport::ALL_BOUNCES;
 use clothbake_core::rng::Rng;
-use clothbake_core::{AnalyticModel, Fabric, FacetModel, PathOptions, RayTracer};
-use clothbake_core::{UnitVec3, ALL_BOUNCES};
+use clothbake_core::UnitVec3;
+use clothbake_core::{AnalyticModel, Fabric, FacetModel};
 use clothbake_loader::Grid;
+use clothbake_truth::{PathOptions, RayTracer};
 use rayon::prelude::*;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;

@@ -14,7 +14,11 @@
 //! (docs/science/transmission.md) also reflects from its back (-Z) and transmits, and passes light
 //! straight through its gaps ([`Bsdf::openness`]); within [`HORIZON_COS`] of the plane every
 //! direction gives zero.
+//!
+//! [`rng`] is the deterministic random stream (SplitMix64) the model's samplers and the ground
+//! truth both draw from, so that a seed gives the same numbers everywhere.
 
+pub mod rng;
 pub mod vec3;
 
 pub use vec3::{half_vector, UnitVec3, Vec3, HORIZON_COS};

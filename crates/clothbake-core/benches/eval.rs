@@ -6,13 +6,13 @@
 //! `cargo xtask ir-accuracy` tabulates), by `secondary` and `secondary_vs_sampling`. The point
 //! level's look at a random point of the period for each random pair: `point_look`.
 
+use clothbake_core::directions::secondary_direction_set;
 use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
 use clothbake_core::rng::Rng;
-use clothbake_core::validate::secondary_direction_set;
 use clothbake_core::{
-    AnalyticModel, Fabric, FacetModel, Kernel, RayTracer, SecondaryMethod, SecondaryOptions,
-    UnitVec3, Variant,
+    AnalyticModel, Fabric, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
 };
+use clothbake_truth::RayTracer;
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::path::Path;

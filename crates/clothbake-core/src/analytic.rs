@@ -2028,9 +2028,9 @@ mod tests {
             r#"{"pattern": [[1]], "warp": {"radius": 1, "spacing": 2}, "weft": {"radius": 1, "spacing": 2}}"#,
         );
         let m = AnalyticModel::new(&f, FacetModel::Huo);
-        let t = crate::truth::RayTracer::new(&f, FacetModel::Huo);
+        let t = clothbake_truth::RayTracer::new(&f, FacetModel::Huo);
         let n = 100_000;
-        for (wi, wo) in crate::validate::direction_set(12, 70.0) {
+        for (wi, wo) in crate::directions::direction_set(12, 70.0) {
             let (seen, lit) = t.visible_and_lit(wi, wo, n, 3);
             // Binomial standard errors bound the stratified estimate's.
             let tol = |p: f64| 4.0 * (p * (1.0 - p) / n as f64).sqrt() + 1e-4;
@@ -2357,7 +2357,7 @@ mod tests {
             UnitVec3::from_spherical(mu.acos(), std::f64::consts::TAU * rng.next_f64())
         };
         let mut pairs: Vec<(UnitVec3, UnitVec3)> = (0..300).map(|_| (dir(), dir())).collect();
-        pairs.extend(crate::validate::edge_pairs());
+        pairs.extend(crate::directions::edge_pairs());
         let bits = |r: &Reflection| (r.i_d.map(f64::to_bits), r.i_s.map(f64::to_bits));
         let (mut compared, mut sliced) = (0, 0);
         for (name, fabric) in &fabrics {
@@ -2496,10 +2496,10 @@ mod tests {
             "/../../tables/cotton-poplin.json"
         );
         let f = Fabric::from_path(std::path::Path::new(path)).unwrap();
-        let t = crate::truth::RayTracer::new(&f, FacetModel::Huo);
+        let t = clothbake_truth::RayTracer::new(&f, FacetModel::Huo);
         let refined = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Refined);
         let sliced = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced);
-        let pairs = crate::validate::direction_set(24, 70.0);
+        let pairs = crate::directions::direction_set(24, 70.0);
         let (mut e_refined, mut e_sliced) = (0.0, 0.0);
         for &(wi, wo) in &pairs {
             let (seen, _) = t.visible_and_lit(wi, wo, 20_000, 9);

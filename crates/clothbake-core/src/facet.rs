@@ -7,7 +7,6 @@
 use crate::lanes::Real;
 use crate::vec3::Vec3;
 use crate::yarn::Material;
-use serde::{Deserialize, Serialize};
 
 /// The intensity a facet reflects: `diffuse` times the RGB albedo, plus `specular`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -25,47 +24,25 @@ pub trait Facet: Send + Sync {
     fn intensity(&self, m: &Material, n: Vec3, l: Vec3, e: Vec3) -> FacetIntensity;
 }
 
-/// The selectable facet models.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum FacetModel {
-    /// The thesis's Phong-like terms: I_d = rho_d N.L (eq. 4.6), I_s = rho_s (N.H)^n (eq. 4.8).
-    /// Neither reciprocal nor energy conserving (Lewis 1993).
-    #[default]
-    Huo,
-    /// Lewis's modified Phong (the thesis's future-work item): f = rho_d / pi +
-    /// rho_s (n + 2) / (2 pi) (R.E)^n, reciprocal, and energy conserving when rho_d + rho_s <= 1.
-    Lewis,
-}
+/// The selectable facet models (the selector the ground truth reads too).
+pub use clothbake_fabric::FacetModel;
 
-impl FacetModel {
-    /// Name as used on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            FacetModel::Huo => "huo",
-            FacetModel::Lewis => "lewis",
-        }
+/// [`Facet::intensity`] of `model` from the three cosines N.L, N.E and L.E of unit vectors
+/// alone, for integrands that have them at hand (the secondary reflection's axial lines).
+#[inline]
+pub fn intensity_cos(model: FacetModel, m: &Material, nl: f64, ne: f64, le: f64) -> FacetIntensity {
+    if nl <= 0.0 || ne <= 0.0 {
+        return FacetIntensity::default();
     }
-}
-
-impl FacetModel {
-    /// [`Facet::intensity`] from the three cosines N.L, N.E and L.E of unit vectors alone, for
-    /// integrands that have them at hand (the secondary reflection's axial lines).
-    #[inline]
-    pub fn intensity_cos(&self, m: &Material, nl: f64, ne: f64, le: f64) -> FacetIntensity {
-        if nl <= 0.0 || ne <= 0.0 {
-            return FacetIntensity::default();
-        }
-        FacetIntensity {
-            diffuse: nl,
-            specular: CosineFacet::new(*self, m).specular(nl, ne, le),
-        }
+    FacetIntensity {
+        diffuse: nl,
+        specular: CosineFacet::new(model, m).specular(nl, ne, le),
     }
 }
 
 impl Facet for FacetModel {
     fn intensity(&self, m: &Material, n: Vec3, l: Vec3, e: Vec3) -> FacetIntensity {
-        self.intensity_cos(m, n.dot(l), n.dot(e), l.dot(e))
+        intensity_cos(*self, m, n.dot(l), n.dot(e), l.dot(e))
     }
 }
 

@@ -1,6 +1,10 @@
-//! clothbake-core: the BRDF of woven cloth derived from its yarn geometry, after
-//! Gang Huo, *Local Illumination Models from Surface Geometry* (UBC, 1993), chapters 2-4,
-//! with an exact ray tracer of the same micro-geometry as ground truth.
+//! clothbake-core: the analytic BRDF of woven cloth derived from its yarn geometry, after
+//! Gang Huo, *Local Illumination Models from Surface Geometry* (UBC, 1993), chapters 2-5.
+//!
+//! The fabric it reads is `clothbake-fabric`'s (re-exported here: [`fabric`], [`weave`],
+//! [`yarn`], [`wif`], [`source`], [`reflect`]). The ground truth it is measured against,
+//! `clothbake-truth`, is a crate this one cannot see (and that cannot see it): only the tests
+//! hold the two side by side.
 //!
 //! Frame: +X weft direction, +Y warp direction, +Z macro normal. `wi` points toward the light,
 //! `wo` toward the eye. Quantities follow the thesis: the reflected *intensity* I for unit incident
@@ -11,7 +15,7 @@ pub mod analytic;
 pub mod arc;
 pub mod brdf;
 pub mod cells;
-pub mod fabric;
+pub mod directions;
 pub mod facet;
 pub mod geometry;
 pub mod interreflection;
@@ -19,19 +23,14 @@ pub mod lanes;
 pub mod openness;
 pub mod point;
 pub mod quad;
-pub mod reflect;
-pub mod rng;
 pub mod shadowing;
-pub mod source;
 pub mod symmetry;
-pub mod transport;
 pub mod trig;
-pub mod truth;
 mod unit_index;
-pub mod validate;
-pub mod weave;
-pub mod wif;
-pub mod yarn;
+
+pub use clothbake_bsdf::rng;
+pub use clothbake_fabric::reflection as reflect;
+pub use clothbake_fabric::{fabric, source, weave, wif, yarn};
 
 pub use analytic::{
     check_variant, AnalyticModel, CellClass, ClassTerms, LocalReflection, SecondaryMethod,
@@ -48,10 +47,6 @@ pub use facet::{Facet, FacetIntensity, FacetModel};
 pub use geometry::Geometry;
 pub use interreflection::{Kernel, Secondary};
 pub use reflect::{intensity_to_brdf, Reflection};
-pub use transport::{Transport, ALL_BOUNCES};
-/// The path tracer under its former module name.
-pub use truth::pathtracer as pathtrace;
-pub use truth::{Caps, Estimate, PathEstimate, PathOptions, RayTracer};
 pub use vec3::{UnitVec3, Vec3};
 pub use weave::{Group, Weave};
 pub use wif::{WifError, WifOptions};

@@ -234,7 +234,7 @@ mod tests {
     /// The truth's openness of the same cloth (independent geometry and ray casting).
     fn truth(json: &str, w: UnitVec3) -> f64 {
         let f = Fabric::from_json_str(json, "t").unwrap();
-        crate::truth::RayTracer::two_faced(&f, crate::facet::FacetModel::Lewis)
+        clothbake_truth::RayTracer::two_faced(&f, crate::facet::FacetModel::Lewis)
             .openness(w, 40_000, 3)
     }
 

@@ -74,8 +74,8 @@ mod tests {
     use super::*;
     use crate::facet::Facet as _;
     use crate::rng::Rng;
-    use crate::truth::RayTracer;
     use crate::vec3::UnitVec3;
+    use clothbake_truth::RayTracer;
     use std::path::Path;
 
     fn shipped() -> Vec<(String, Fabric)> {
@@ -119,7 +119,7 @@ mod tests {
                     let (wi, wo) = (direction(&mut rng), direction(&mut rng));
                     let (o, d) = y.eye_ray(u, v, wo).unwrap();
                     // The truth starts its rays on its own top plane: move along the same line.
-                    let o = o + d * ((o.z - rt.z_top) / -d.z);
+                    let o = o + d * ((o.z - rt.top()) / -d.z);
                     assert_eq!(d, -wo.get());
                     let look = y.look(u, v, wi, wo);
                     let truth = rt.shade(o, wi, wo);

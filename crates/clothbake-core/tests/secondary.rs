@@ -2,11 +2,11 @@
 //! solution against the two-level ray-traced sampling and the path tracer, convergence, symmetry.
 
 use clothbake_core::interreflection::{Orders, Ranges, Sampling};
-use clothbake_core::pathtrace::PathOptions;
 use clothbake_core::{
-    AnalyticModel, Fabric, FacetModel, Kernel, RayTracer, SecondaryMethod, SecondaryOptions,
-    UnitVec3,
+    AnalyticModel, Fabric, FacetModel, Kernel, SecondaryMethod, SecondaryOptions, UnitVec3,
 };
+use clothbake_truth::pathtracer::PathOptions;
+use clothbake_truth::RayTracer;
 
 /// The thesis's surface (d = 2, r = 1, h = 0) with its sec. 5.4 facets (rho_d 0.4, rho_s 0.7).
 fn pf(n: f64) -> Fabric {

@@ -10,11 +10,15 @@
 //!   transmission) for daylighting tools, and the datasheet figures of a fabric shade.
 //! * [`merl`]: the 90 x 90 x 180 half/difference-angle binary of the MERL database. Isotropic
 //!   only: the cloth's BRDF is averaged over rotations about the normal.
+//! * [`fitted`]: analytic materials fitted to the cloth (glTF's, OpenPBR's), per crossing cell;
+//!   [`gltf`] and [`openpbr`] write them (glTF 2.0, MaterialX, USD, a Blender module), and
+//!   [`fits`] fits both families as their files hold them, with their residuals.
 //!
 //! Both sample a [`Bsdf`]'s f_r (wi toward the light, wo toward the eye, in 1/sr, RGB): the
 //! analytic model as the baker evaluates it (`clothbake_core::AnalyticBsdf`) or a baked table
 //! (`clothbake_loader::Brdf`).
 
+pub mod fits;
 pub mod fitted;
 pub mod gltf;
 pub mod klems;

@@ -2,14 +2,16 @@
 //! the `clothbake bake` command runs: in memory, or into a table or shard file with
 //! checkpoints and resume.
 
-use crate::fabric::{bounces_arg, facet_model, PyFabric};
+use crate::args::{bad, bounces_arg, choice, facet_model, VARIANTS};
+use crate::fabric::PyFabric;
 use crate::table::{table_err, PyTable};
 use clothbake_bake::job::{self, Hooks, Job, JobError, Target};
 use clothbake_bake::output::Format;
 use clothbake_bake::settings::{parse_orders, parse_sampling, Bounces, Naming, Settings};
 use clothbake_bake::shard::parse_shard_id_as;
-use clothbake_core::{Caps, Kernel, Variant};
+use clothbake_core::{Kernel, Variant};
 use clothbake_loader::{Grid, Precision, StoredTable};
+use clothbake_truth::Caps;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use std::io::Write;
@@ -17,42 +19,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::Duration;
-
-fn bad(option: &str, msg: impl std::fmt::Display) -> PyErr {
-    PyValueError::new_err(format!("{option}: {msg}"))
-}
-
-/// One of `words` (`name=` must be one of them), or the error naming the option.
-fn choice<T: Copy>(name: &str, value: Option<&str>, words: &[(&str, T)]) -> PyResult<Option<T>> {
-    let Some(v) = value else { return Ok(None) };
-    match words.iter().find(|(w, _)| *w == v) {
-        Some(&(_, t)) => Ok(Some(t)),
-        None => Err(bad(
-            name,
-            format!(
-                "{v:?} is not one of {}; give one of them",
-                words
-                    .iter()
-                    .map(|(w, _)| format!("{w:?}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        )),
-    }
-}
-
-/// The analytic variants by name (`variant=`).
-const VARIANTS: &[(&str, Variant)] = &[
-    ("refined", Variant::Refined),
-    ("thesis", Variant::Thesis),
-    ("sliced", Variant::Sliced),
-    ("sliced3d", Variant::Sliced3d),
-];
-
-/// The analytic variant named `name`, or the error naming `variant=` and the choices.
-pub(crate) fn variant_of(name: &str) -> PyResult<Variant> {
-    Ok(choice("variant", Some(name), VARIANTS)?.expect("a name was given"))
-}
 
 /// The table format of `output` from `format=` and `precision=` (default: from the
 /// extension, `.bin` binary, anything else EXR; EXR precision f16).

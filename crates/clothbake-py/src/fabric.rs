@@ -1,48 +1,21 @@
 //! `clothbake.Fabric`: a validated fabric description and its BRDF from the analytic model
 //! (thesis ch. 3-4, ch. 5 with two bounces) or the ray-traced ground truth.
 
+use crate::args::{bounces_arg, facet_model};
 use crate::vectors::{
     check_footprint, check_unit, period_rows, same_len, to_array, to_array1, unit_rows, widths,
 };
+use clothbake_bake::transport::Transport;
 use clothbake_core::{
     intensity_to_brdf, AnalyticBsdf, AnalyticModel, Bsdf, Component, Fabric, FacetModel, Footprint,
-    Local, PeriodPoint, RayTracer, Reflection, SecondaryOptions, Transport, UnitVec3, Vec3,
-    ALL_BOUNCES,
+    Local, PeriodPoint, Reflection, SecondaryOptions, UnitVec3, Vec3,
 };
+use clothbake_truth::RayTracer;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use rayon::prelude::*;
 use std::sync::OnceLock;
-
-/// Parses a facet model name (`"huo"`, `"lewis"`).
-pub fn facet_model(name: &str) -> PyResult<FacetModel> {
-    match name {
-        "huo" => Ok(FacetModel::Huo),
-        "lewis" => Ok(FacetModel::Lewis),
-        other => Err(PyValueError::new_err(format!(
-            "facet: {other:?} is not a facet model; use \"huo\" (the thesis's, eqs 4.6, 4.8) or \"lewis\" (energy conserving)"
-        ))),
-    }
-}
-
-/// Reads a bounce count: absent (1), 1, 2, a whole number N from 3 to 64, or "all"
-/// (`ALL_BOUNCES`; docs/science/transport.md).
-pub fn bounces_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<u32> {
-    let Some(obj) = obj else {
-        return Ok(1);
-    };
-    if let Ok(n) = obj.extract::<i64>() {
-        if (1..=64).contains(&n) {
-            return Ok(n as u32);
-        }
-    } else if obj.extract::<String>().is_ok_and(|s| s == "all") {
-        return Ok(ALL_BOUNCES);
-    }
-    Err(PyValueError::new_err(format!(
-        "bounces: {obj}; use 1 (direct reflection), 2 (+ the secondary reflection of thesis ch. 5), a whole number N from 3 to 64 or \"all\" (every bounce, path-traced from the second on; docs/science/transport.md)"
-    )))
-}
 
 /// A woven fabric (weave pattern, yarn geometry, facet materials), validated.
 #[pyclass(name = "Fabric", module = "clothbake", frozen)]
@@ -408,7 +381,7 @@ impl PyFabric {
         nodes: (u32, u32),
         paths: usize,
     ) -> PyResult<crate::two_faced::PyTwoFaced> {
-        crate::two_faced::PyTwoFaced::build(py, self, facet, variant, nodes, paths)
+        crate::two_faced::PyTwoFaced::build(py, &self.fabric, facet, variant, nodes, paths)
     }
 
     #[pyo3(signature = (wi, wo, facet="huo"))]

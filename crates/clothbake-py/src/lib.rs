@@ -5,6 +5,7 @@
 //! Frame everywhere: +X weft, +Y warp, +Z macro normal; `wi` toward the light, `wo` toward
 //! the eye; f_r in 1/sr, RGB.
 
+mod args;
 mod bake;
 mod fabric;
 mod table;

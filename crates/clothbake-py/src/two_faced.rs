@@ -2,11 +2,11 @@
 //! whole sphere (reflection off either face, transmission) and the openness, one pair at a time
 //! or in batches.
 
-use crate::fabric::{facet_model, PyFabric};
+use crate::args::{facet_model, variant_of};
 use crate::table::table_err;
 use crate::vectors::{check_unit, same_len, to_array, to_array1, unit_rows};
 use clothbake_bake::two_faced::TwoFaced;
-use clothbake_core::{Bsdf, UnitVec3, Vec3};
+use clothbake_core::{Bsdf, Fabric, UnitVec3, Vec3};
 use clothbake_loader::{Options, TableError, TwoFacedBrdf};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -52,7 +52,7 @@ impl PyTwoFaced {
     /// (without the GIL).
     pub fn build(
         py: Python<'_>,
-        fabric: &PyFabric,
+        fabric: &Fabric,
         facet: &str,
         variant: &str,
         nodes: (u32, u32),
@@ -69,16 +69,16 @@ impl PyTwoFaced {
             )));
         }
         let facet = facet_model(facet)?;
-        let variant = crate::bake::variant_of(variant)?;
-        clothbake_core::check_variant(&fabric.fabric, variant).map_err(|(problem, fix)| {
+        let variant = variant_of(variant)?;
+        clothbake_core::check_variant(fabric, variant).map_err(|(problem, fix)| {
             PyValueError::new_err(format!("variant: {problem}; {fix}"))
         })?;
-        let cloth = TwoFaced::with_grid(&fabric.fabric, facet, variant, nodes, paths)
+        let cloth = TwoFaced::with_grid(fabric, facet, variant, nodes, paths)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         py.detach(|| cloth.prepare());
         Ok(PyTwoFaced {
             cloth: Box::new(cloth),
-            name: fabric.fabric.name().to_string(),
+            name: fabric.name().to_string(),
         })
     }
 }

@@ -39,9 +39,10 @@
 
 pub use clothbake_core::Component;
 use clothbake_core::{
-    AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FacetModel, Footprint, Local, RayTracer,
-    SecondaryOptions, UnitVec3, Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FacetModel, Footprint, Local, SecondaryOptions,
+    UnitVec3, Variant,
 };
+use clothbake_truth::RayTracer;
 
 /// What a picture shades with: a [`Bsdf`] (the analytic model or a baked table, through the
 /// one interface).
@@ -135,7 +136,7 @@ impl Shader {
         fabric: &Fabric,
         facet: FacetModel,
         seed: u64,
-        paths: Option<clothbake_core::PathOptions>,
+        paths: Option<clothbake_truth::PathOptions>,
     ) -> Shader {
         Shader::new(Box::new(Truth {
             rt: RayTracer::new(fabric, facet),
@@ -187,7 +188,7 @@ struct Truth {
     rt: RayTracer,
     seed: u64,
     /// Every bounce up to its `max_bounces`, a path a point; `None`: one bounce.
-    paths: Option<clothbake_core::PathOptions>,
+    paths: Option<clothbake_truth::PathOptions>,
     /// The smallest crossing cell's side, about, in periods.
     cell: f64,
 }

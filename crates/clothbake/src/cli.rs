@@ -11,8 +11,9 @@ pub use clothbake_bake::settings::{parse_orders, parse_sampling};
 use clothbake_bake::settings::{Bounces, Naming};
 use clothbake_bake::shard::{parse_shard_id, ShardId};
 use clothbake_core::interreflection::{Orders, Sampling};
-use clothbake_core::{Caps, FacetModel, Kernel, SecondaryOptions, UnitVec3, Variant};
+use clothbake_core::{FacetModel, Kernel, SecondaryOptions, UnitVec3, Variant};
 use clothbake_loader::Grid;
+use clothbake_truth::Caps;
 use std::path::PathBuf;
 
 pub use clothbake_bake::settings::{DEFAULT_SAMPLES, DEFAULT_SEED};
@@ -1125,7 +1126,7 @@ pub fn parse_bounces(s: &str) -> Result<u32, String> {
                        reflection, ch. 5), a whole number N from 3 to 64 or `all` (every \
                        bounce, path-traced from the second on; docs/science/transport.md)";
     match s.trim() {
-        "all" => Ok(clothbake_core::ALL_BOUNCES),
+        "all" => Ok(clothbake_bake::transport::ALL_BOUNCES),
         t => match t.parse::<u32>() {
             Ok(n @ 1..=64) => Ok(n),
             _ => Err(format!("`{t}` bounces is not supported; {FIX}")),
@@ -1646,7 +1647,10 @@ mod tests {
         assert!(parse_bounces("0").unwrap_err().contains("give 1"));
         assert!(parse_bounces("65").unwrap_err().contains("give 1"));
         assert_eq!(parse_bounces("3").unwrap(), 3);
-        assert_eq!(parse_bounces(" all").unwrap(), clothbake_core::ALL_BOUNCES);
+        assert_eq!(
+            parse_bounces(" all").unwrap(),
+            clothbake_bake::transport::ALL_BOUNCES
+        );
         assert_eq!(parse_bounces("2").unwrap(), 2);
         assert!(parse_tolerance("-1").is_err());
         assert!(parse_tolerance("inf").is_err());

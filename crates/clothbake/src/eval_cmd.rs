@@ -3,13 +3,15 @@
 use crate::cli::{DraftArgs, EvalArgs, Faces, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
 use crate::report::{self, Report};
+use clothbake_bake::transport::Transport;
 use clothbake_core::interreflection::Ranges;
-use clothbake_core::pathtrace::PathOptions;
 use clothbake_core::{
-    AnalyticBsdf, AnalyticModel, Bsdf, Caps, Component, Fabric, FabricError, FacetModel, Footprint,
-    Level, PlainNaming, RayTracer, Reflection, Secondary, SecondaryMethod, SecondaryOptions,
-    Transport, UnitVec3, Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, Component, Fabric, FabricError, FacetModel, Footprint,
+    Level, PlainNaming, Reflection, Secondary, SecondaryMethod, SecondaryOptions, UnitVec3,
+    Variant,
 };
+use clothbake_truth::pathtracer::PathOptions;
+use clothbake_truth::{Caps, RayTracer};
 use std::path::Path;
 
 /// Runs `clothbake eval` and returns the text to print on stdout.
@@ -185,7 +187,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
         1 => "1 bounce".to_string(),
         n if n > 2 => format!(
             "{} bounces (orders 2 and up path-traced, radiometric kernel)",
-            clothbake_core::transport::bounces_name(n)
+            clothbake_bake::transport::bounces_name(n)
         ),
         n => format!("{n} bounces"),
     };

@@ -3,7 +3,8 @@
 
 use crate::cli::ExportArgs;
 use crate::error::CliError;
-use clothbake_export::fitted::material::{Fits, Fitted, Source};
+use clothbake_export::fits::Fits;
+use clothbake_export::fitted::material::{Fitted, Source};
 use clothbake_export::fitted::microfacet::Albedos;
 use clothbake_export::fitted::IOR;
 use clothbake_export::{self as export, gltf, openpbr};

@@ -41,7 +41,7 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
                 format!(
                     "--component {} with --bounces {}: full transport is drawn whole",
                     component_name(b.component),
-                    clothbake_core::transport::bounces_name(b.bounces.bounces)
+                    clothbake_bake::transport::bounces_name(b.bounces.bounces)
                 ),
                 "use --component total, or --bounces 2 for the secondary reflection's parts",
             ));
@@ -152,9 +152,9 @@ fn truth_shader(a: &RenderArgs) -> Result<Shader, CliError> {
     }
     // Every bounce up to --bounces N (all: the highest order full transport follows), a
     // path a point, with Russian roulette and the radiometric kernel as full transport has.
-    let paths = (b.bounces.bounces > 1).then(|| clothbake_core::PathOptions {
-        max_bounces: (b.bounces.bounces as usize).min(clothbake_core::transport::MAX_ORDER),
-        ..clothbake_core::PathOptions::default()
+    let paths = (b.bounces.bounces > 1).then(|| clothbake_truth::PathOptions {
+        max_bounces: (b.bounces.bounces as usize).min(clothbake_bake::transport::MAX_ORDER),
+        ..clothbake_truth::PathOptions::default()
     });
     let fabric = apply_material(
         crate::fabrics::read(weave, &Default::default())?,

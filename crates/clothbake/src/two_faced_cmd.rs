@@ -6,7 +6,8 @@ use crate::cli::{EvalArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
 use crate::eval_cmd::load_fabric;
 use clothbake_bake::two_faced::{TwoFaced, MAX_BOUNCES};
-use clothbake_core::{Bsdf, FacetModel, RayTracer, UnitVec3};
+use clothbake_core::{Bsdf, FacetModel, UnitVec3};
+use clothbake_truth::RayTracer;
 use serde_json::json;
 
 /// What the pair (wi, wo) measures on the two-faced cloth.

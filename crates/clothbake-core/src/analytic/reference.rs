@@ -384,7 +384,7 @@ mod tests {
             UnitVec3::from_spherical(mu.acos(), std::f64::consts::TAU * rng.next_f64())
         };
         let mut out: Vec<_> = (0..n).map(|_| (dir(), dir())).collect();
-        out.extend(crate::validate::edge_pairs());
+        out.extend(crate::directions::edge_pairs());
         out
     }
 

@@ -46,6 +46,8 @@ mod rules;
 mod sampling;
 
 pub use analytic::analytic;
+/// The kernel and the components of I_2 are shared with the ground truth (clothbake-fabric).
+pub use clothbake_fabric::reflection::{Kernel, Secondary};
 pub use peak::peak;
 pub use rules::{Orders, Ranges, ORDERS_FAST};
 pub use sampling::{two_level_sampling, Sampling};
@@ -57,65 +59,6 @@ use crate::vec3::Vec3;
 use crate::yarn::Material;
 use peak::{shift_near, wrap};
 use std::f64::consts::PI;
-
-/// Weight of the second bounce (see the module documentation).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Kernel {
-    /// As printed: facet intensities times the projected solid angle (N_i . w) dw.
-    Thesis,
-    /// The rendering equation: facet intensities times dw / pi.
-    #[default]
-    Radiometric,
-}
-
-impl Kernel {
-    /// The kernel's name, as the command line and the tables' options spell it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Kernel::Thesis => "thesis",
-            Kernel::Radiometric => "radiometric",
-        }
-    }
-}
-
-/// The four components of the secondary reflection (thesis intensity units), RGB.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Secondary {
-    /// Specular at P_j, then specular at P_i.
-    pub ss: [f64; 3],
-    /// Specular at P_j, then diffuse at P_i.
-    pub sd: [f64; 3],
-    /// Diffuse at P_j, then specular at P_i.
-    pub ds: [f64; 3],
-    /// Diffuse at both.
-    pub dd: [f64; 3],
-}
-
-impl Secondary {
-    /// I_2 = I_ss + I_sd + I_ds + I_dd (eq. 5.15).
-    pub fn total(&self) -> [f64; 3] {
-        std::array::from_fn(|k| self.ss[k] + self.sd[k] + self.ds[k] + self.dd[k])
-    }
-    /// `self += w * o`.
-    pub fn add_scaled(&mut self, o: &Secondary, w: f64) {
-        for k in 0..3 {
-            self.ss[k] += w * o.ss[k];
-            self.sd[k] += w * o.sd[k];
-            self.ds[k] += w * o.ds[k];
-            self.dd[k] += w * o.dd[k];
-        }
-    }
-    /// Every component times `w`.
-    pub fn scaled(mut self, w: f64) -> Secondary {
-        for c in [&mut self.ss, &mut self.sd, &mut self.ds, &mut self.dd] {
-            for x in c.iter_mut() {
-                *x *= w;
-            }
-        }
-        self
-    }
-}
 
 /// One pair of adjacent parallel cylinders and everything the integrals need.
 #[derive(Clone, Copy, Debug)]

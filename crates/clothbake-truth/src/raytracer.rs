@@ -33,8 +33,8 @@ use super::estimate::{estimate, ratio_and_error, BatchSums, Estimate, BATCHES};
 use super::facets::{Shading, Terms};
 use super::intersect::{segment_entry, Surface};
 use super::yarns::{Cylinder, Yarns};
-use crate::rng::Rng;
-use crate::vec3::{UnitVec3, Vec3};
+use clothbake_bsdf::rng::Rng;
+use clothbake_bsdf::vec3::{UnitVec3, Vec3};
 
 /// First sample count of [`RayTracer::render_to_error`] (before doubling).
 const FIRST_ROUND: usize = 16 * 256;
@@ -76,11 +76,11 @@ pub(crate) struct Hit {
 
 /// A yarn hit resolved to its point, outward normal, segment and physical copy.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Contact {
+pub struct Contact {
     /// The hit point (unwrapped coordinates).
-    pub(crate) point: Vec3,
+    pub point: Vec3,
     /// Outward unit normal.
-    pub(crate) normal: Vec3,
+    pub normal: Vec3,
     /// Index of the segment in [`Yarns::cylinders`].
     pub(crate) seg: u32,
     /// Identity of the physical segment copy (to skip it when leaving the surface).
@@ -209,7 +209,7 @@ impl RayTracer {
     }
 
     /// The segment a contact lies on.
-    pub(crate) fn cylinder(&self, c: &Contact) -> &Cylinder {
+    pub fn cylinder(&self, c: &Contact) -> &Cylinder {
         &self.yarns.cylinders[c.seg as usize]
     }
 
@@ -244,7 +244,7 @@ impl RayTracer {
 
     /// Shading of one primary ray from `o` along `-wo`: `None` for an uncounted hit, otherwise
     /// the facet intensity at the first yarn hit (zero when shadowed) and the hit.
-    pub(crate) fn shade(&self, o: Vec3, wi: UnitVec3, wo: UnitVec3) -> Option<(Shading, Contact)> {
+    pub fn shade(&self, o: Vec3, wi: UnitVec3, wo: UnitVec3) -> Option<(Shading, Contact)> {
         let c = self.first_contact(o, -wo.get())?;
         let s = self
             .terms
@@ -369,6 +369,11 @@ impl RayTracer {
         }
     }
 
+    /// The height of the plane the primary rays start from, just above the highest yarn.
+    pub fn top(&self) -> f64 {
+        self.z_top
+    }
+
     /// Estimates the intensity reflected toward `wo` (unit vector toward the eye) for unit light
     /// from `wi` with `samples` primary rays; deterministic for a given `seed`. Zero, with no
     /// rays, when either direction is at or below the horizon.
@@ -415,7 +420,7 @@ impl RayTracer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::truth::Face;
+    use crate::Face;
 
     /// Asserts that `got`, channel `c` of `est`, is `want` within four standard errors plus
     /// 0.2% of `want` (the closed forms' own rounding is far below); returns that tolerance.
@@ -427,11 +432,11 @@ mod tests {
         );
         tol
     }
-    use crate::fabric::Fabric;
-    use crate::facet::FacetModel;
-    use crate::truth::description::Finish;
-    use crate::truth::intersect::{LocalRay, SegmentShape};
-    use crate::weave::Group;
+    use crate::description::Finish;
+    use crate::intersect::{LocalRay, SegmentShape};
+    use clothbake_fabric::fabric::Fabric;
+    use clothbake_fabric::weave::Group;
+    use clothbake_fabric::FacetModel;
     use std::f64::consts::PI;
 
     fn fabric(json: &str) -> Fabric {

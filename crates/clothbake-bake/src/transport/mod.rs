@@ -10,20 +10,27 @@
 //!   a cell multiplies by its own I_1: its noise stays a fixed fraction of I_1 toward the
 //!   horizon, where I_1 falls faster than between two nodes.
 //! * Each node is a pure function of its indices: [`Transport::multiple`] seeded by the node's
-//!   direction pair (`clothbake_core::transport::pair_seed`). Nodes related by a symmetry of
+//!   direction pair ([`pair_seed`]). Nodes related by a symmetry of
 //!   the fabric take the value of their orbit's representative. The nodes a set of rows needs
 //!   are computed in parallel before the rows ([`Multiple::prepare`]), each once; so the table
 //!   is bit-identical for any thread count, shard split and resume.
 
+mod orders;
+
+pub use orders::{
+    bounces_name, max_order, pair_seed, Transport, ALL_BOUNCES, DEFAULT_PATHS, DEFAULT_SEED,
+    MAX_ORDER,
+};
+
 use crate::directions::{direction, row_cell};
 use crate::orbit::{representative, usable_symmetries};
 use clothbake_core::symmetry::Symmetry;
-use clothbake_core::transport::{bounces_name, max_order, Transport};
 use clothbake_core::{
-    AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FacetModel, Kernel, RayTracer, Rgb,
-    SecondaryOptions, UnitVec3, Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FacetModel, Kernel, Rgb, SecondaryOptions, UnitVec3,
+    Variant,
 };
 use clothbake_loader::Grid;
+use clothbake_truth::RayTracer;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -1,7 +1,7 @@
 //! The Monte Carlo estimate of the tracers: [`Estimate`], the batch sums and the ratio estimator
 //! with its standard error.
 
-use crate::reflect::Reflection;
+use clothbake_fabric::Reflection;
 
 /// Number of independent batches the samples are split into to estimate the standard error.
 pub const BATCHES: usize = 16;

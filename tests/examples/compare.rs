@@ -1,6 +1,7 @@
 //! Quick look: analytic vs ray-traced on a few directions of one table.
-//! `cargo run --release -p clothbake-core --example compare -- tables/twill.json 20 20000`
-use clothbake_core::{validate, Fabric, FacetModel};
+//! `cargo run --release -p clothbake-tests --example compare -- tables/twill.json 20 20000`
+use clothbake_core::{directions, Fabric, FacetModel};
+use clothbake_tests::validate;
 use std::path::Path;
 
 fn main() {
@@ -25,7 +26,7 @@ fn main() {
             .map(|&p| (l, clothbake_core::UnitVec3::from_degrees(60.0, p)))
             .collect()
     } else {
-        validate::direction_set(n, 70.0)
+        directions::direction_set(n, 70.0)
     };
     let nb = if std::env::var("ROW").is_ok() {
         clothbake_core::Variant::Thesis
@@ -37,9 +38,9 @@ fn main() {
         FacetModel::Huo,
         nb,
         if std::env::var("CAPS").is_ok() {
-            clothbake_core::Caps::Shaded
+            clothbake_truth::Caps::Shaded
         } else {
-            clothbake_core::Caps::Excluded
+            clothbake_truth::Caps::Excluded
         },
         &pairs,
         s,

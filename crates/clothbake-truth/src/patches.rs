@@ -10,10 +10,10 @@
 
 use super::estimate::{batch_ratio, BatchSums, BATCHES};
 use super::raytracer::RayTracer;
-use crate::reflect::Reflection;
-use crate::rng::Rng;
-use crate::vec3::UnitVec3;
-use crate::weave::Group;
+use clothbake_bsdf::rng::Rng;
+use clothbake_bsdf::vec3::UnitVec3;
+use clothbake_fabric::weave::Group;
+use clothbake_fabric::Reflection;
 
 /// The truth over one crossing cell.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -50,7 +50,7 @@ fn nearest(pos: &[f64], period: f64, y: f64) -> (usize, f64) {
 impl RayTracer {
     /// Row-major index (weft row, then warp column) of the cell a counted hit at `point` on
     /// segment `seg` belongs to (see the module docs).
-    fn cell_of(&self, seg: u32, point: crate::vec3::Vec3) -> usize {
+    fn cell_of(&self, seg: u32, point: clothbake_bsdf::vec3::Vec3) -> usize {
         let c = &self.yarns.cylinders[seg as usize];
         let (wx, wy) = (&self.yarns.threads.0, &self.yarns.threads.1);
         let (px, py) = self.yarns.period;

@@ -78,7 +78,11 @@ pub struct LocalRay {
 impl LocalRay {
     /// The ray `o + t d` (period coordinates) in the frame of a warp segment (`warp`: u = x,
     /// v = y) or a weft one (u = y, v = x).
-    pub fn in_frame(warp: bool, o: crate::vec3::Vec3, d: crate::vec3::Vec3) -> LocalRay {
+    pub fn in_frame(
+        warp: bool,
+        o: clothbake_bsdf::vec3::Vec3,
+        d: clothbake_bsdf::vec3::Vec3,
+    ) -> LocalRay {
         if warp {
             LocalRay {
                 o: [o.x, o.y, o.z],

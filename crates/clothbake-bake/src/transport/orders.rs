@@ -1,7 +1,7 @@
 //! Full light transport (`--bounces N`, `--bounces all`; docs/science/transport.md): the direct
 //! reflection I_1 from the analytic model (thesis eqs 4.1-4.11, exact on its own terms and
 //! smooth) plus every later bounce, orders 2 to N, estimated by the ground truth's path tracer
-//! ([`crate::truth::pathtracer`]) on the explicit micro-geometry: every yarn, parallel and
+//! (`clothbake_truth::pathtracer`) on the explicit micro-geometry: every yarn, parallel and
 //! perpendicular, with the floor (z = 0, which has no material in a fabric description) and the
 //! sky absorbing. The multiple-bounce part uses the radiometric kernel (the rendering equation);
 //! the thesis's printed kernel means nothing past the second bounce.
@@ -14,10 +14,9 @@
 //! Deterministic: the path tracer's seed for a direction pair is hashed from the pair's bits
 //! and a base seed ([`pair_seed`]), never from time or thread.
 
-use crate::rng::mix64;
-use crate::truth::{PathEstimate, PathOptions, RayTracer};
-use crate::vec3::UnitVec3;
-use crate::Kernel;
+use clothbake_core::rng::mix64;
+use clothbake_core::{Kernel, UnitVec3};
+use clothbake_truth::{PathEstimate, PathOptions, RayTracer};
 
 /// `--bounces all` as a bounce count.
 pub const ALL_BOUNCES: u32 = u32::MAX;
@@ -155,11 +154,11 @@ impl Transport {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fabric::Fabric;
-    use crate::facet::FacetModel;
+    use clothbake_core::fabric::Fabric;
+    use clothbake_core::facet::FacetModel;
 
     fn twill() -> Fabric {
-        crate::fabric::thesis_twill()
+        clothbake_core::fabric::thesis_twill()
     }
 
     #[test]

@@ -7,9 +7,9 @@
 use super::facets::Terms;
 use super::raytracer::RayTracer;
 use super::yarns::Yarns;
-use crate::fabric::Fabric;
-use crate::facet::FacetModel;
-use crate::weave::{Group, Weave};
+use clothbake_fabric::fabric::Fabric;
+use clothbake_fabric::weave::{Group, Weave};
+use clothbake_fabric::FacetModel;
 
 /// The facet material of one thread, as the truth shades it.
 #[derive(Clone, Copy, Debug, PartialEq)]

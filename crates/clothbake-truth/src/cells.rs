@@ -4,8 +4,8 @@
 
 use super::intersect::{LocalRay, SegmentShape, Surface};
 use super::yarns::{Face, Yarns};
-use crate::vec3::Vec3;
-use crate::weave::Group;
+use clothbake_bsdf::vec3::Vec3;
+use clothbake_fabric::weave::Group;
 
 /// One cell of the walk over the periodic grid: the period copy it lies in, its index within
 /// that copy's cells, and the ray parameter at which the ray leaves it.

@@ -26,8 +26,8 @@ use super::intersect::Surface;
 use super::pathtracer::uniform_hemisphere;
 use super::raytracer::{Contact, RayTracer};
 use super::yarns::Face;
-use crate::rng::Rng;
-use crate::vec3::{UnitVec3, Vec3};
+use clothbake_bsdf::rng::Rng;
+use clothbake_bsdf::vec3::{UnitVec3, Vec3};
 use std::f64::consts::PI;
 
 /// Where the light from one direction goes on the two-faced cloth, per unit irradiance: each
@@ -64,7 +64,7 @@ impl RayTracer {
             return Some(*c);
         }
         let cyl = self.cylinder(c);
-        let warp = cyl.group == crate::weave::Group::Warp;
+        let warp = cyl.group == clothbake_fabric::weave::Group::Warp;
         let (pa, period) = if warp {
             (c.point.x, self.yarns.period.0)
         } else {
@@ -177,7 +177,7 @@ impl RayTracer {
 
     /// The openness along `w` (either side): the share of `samples` stratified rays parallel
     /// to `-w`, spread over one period, that cross the cloth without meeting a yarn.
-    /// Deterministic for a seed; 0 within [`crate::vec3::HORIZON_COS`] of the plane.
+    /// Deterministic for a seed; 0 within [`clothbake_bsdf::vec3::HORIZON_COS`] of the plane.
     pub fn openness(&self, w: UnitVec3, samples: usize, seed: u64) -> f64 {
         if !(w.above_horizon() || w.below_horizon()) || samples == 0 {
             return 0.0;
@@ -453,8 +453,8 @@ impl RayTracer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fabric::Fabric;
-    use crate::facet::FacetModel;
+    use clothbake_fabric::fabric::Fabric;
+    use clothbake_fabric::FacetModel;
 
     /// An open plain weave: threads of radius r at spacing s both ways, axes at height h,
     /// Lewis facets with the given diffuse albedo, specular share and translucency.

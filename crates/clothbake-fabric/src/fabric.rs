@@ -878,9 +878,9 @@ fn material(cx: &Ctx<'_>, name: &str, m: Option<&MaterialFile>) -> Result<Materi
     Ok(out)
 }
 
-/// The thesis's 2/1 twill (Fig. 4.7: radius 1.5, spacing 3.1), for the crate's unit tests.
-#[cfg(test)]
-pub(crate) fn thesis_twill() -> Fabric {
+/// The thesis's 2/1 twill (Fig. 4.7: radius 1.5, spacing 3.1, the default finish): the fabric
+/// the unit tests of the model and the truth start from.
+pub fn thesis_twill() -> Fabric {
     Fabric::from_json_str(
         r#"{"pattern": [[1,1,0],[0,1,1],[1,0,1]],
             "warp": {"radius": 1.5, "spacing": 3.1}, "weft": {"radius": 1.5, "spacing": 3.1}}"#,
