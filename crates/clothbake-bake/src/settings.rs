@@ -348,7 +348,7 @@ impl Settings {
             }
         } else {
             Method::Analytic {
-                variant: self.variant.unwrap_or(Variant::Refined),
+                variant: self.variant.unwrap_or_default(),
             }
         };
         let grid = self.grid.unwrap_or(DEFAULT_GRID);

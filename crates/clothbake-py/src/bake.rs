@@ -9,7 +9,7 @@ use clothbake_bake::job::{self, Hooks, Job, JobError, Target};
 use clothbake_bake::output::Format;
 use clothbake_bake::settings::{parse_orders, parse_sampling, Bounces, Naming, Settings};
 use clothbake_bake::shard::parse_shard_id_as;
-use clothbake_core::{Kernel, Variant};
+use clothbake_core::Kernel;
 use clothbake_loader::{Grid, Precision, StoredTable};
 use clothbake_truth::Caps;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};

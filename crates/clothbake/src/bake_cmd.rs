@@ -6,9 +6,11 @@
 //! then write the table atomically through the loader. Ctrl-C raises the cancel flag: the bake
 //! stops and nothing is written (exit 130; a second Ctrl-C exits at once; `signals`).
 
-use crate::cli::{BakeOpts, Faces, FormatArg, Method as MethodArg, PrecisionArg, ShardArg};
+use crate::cli::{BakeOpts, Faces, FormatArg, Method as MethodArg, ShardArg};
 use crate::error::{table_error, CliError};
-use crate::eval_cmd::load_fabric;
+use crate::resolve::{
+    self, output_format, preflight, progress_bar, thousands, thread_count, thread_pool,
+};
 use crate::signals;
 use clothbake_bake::checkpoint::DEFAULT_INTERVAL;
 use clothbake_bake::job::{self, Hooks, Job, JobError, Target};
@@ -19,8 +21,6 @@ use clothbake_bake::BakeOptions;
 use clothbake_core::Variant;
 use clothbake_loader::Precision;
 use clothbake_truth::Caps;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -43,53 +43,6 @@ pub struct Plan {
     pub shard: Option<(ShardId, Option<String>)>,
     /// Time between checkpoints.
     pub checkpoint_every: Duration,
-}
-
-fn ext_format(p: &Path) -> Option<FormatArg> {
-    match p.extension()?.to_str()?.to_ascii_lowercase().as_str() {
-        "exr" => Some(FormatArg::Exr),
-        "bin" => Some(FormatArg::Bin),
-        _ => None,
-    }
-}
-
-/// The table format and EXR precision from `--format`, the output's extension and
-/// `--precision` (shared by `bake` and `merge`).
-pub fn output_format(
-    format: Option<FormatArg>,
-    output: Option<&Path>,
-    precision: Option<PrecisionArg>,
-) -> Result<(FormatArg, Precision), CliError> {
-    let format = match (format, output) {
-        (Some(f), Some(out)) => match ext_format(out) {
-            Some(e) if e != f => {
-                return Err(CliError::new(
-                    format!(
-                        "--format {} but the output {} ends in .{}",
-                        f.ext(),
-                        out.display(),
-                        e.ext()
-                    ),
-                    format!("name the output *.{} or drop --format", f.ext()),
-                ))
-            }
-            _ => f,
-        },
-        (Some(f), None) => f,
-        (None, Some(out)) => ext_format(out).unwrap_or(FormatArg::Exr),
-        (None, None) => FormatArg::Exr,
-    };
-    let precision = match (precision, format) {
-        (Some(_), FormatArg::Bin) => {
-            return Err(CliError::new(
-                "--precision applies only to EXR tables: binary tables always hold f32",
-                "drop --precision or write an EXR table (--format exr)",
-            ))
-        }
-        (Some(PrecisionArg::F32), _) => Precision::F32,
-        _ => Precision::F16,
-    };
-    Ok((format, precision))
 }
 
 /// Checks the option combinations and resolves the defaults; reads no file.
@@ -183,69 +136,9 @@ pub fn plan_with_env(
     })
 }
 
-/// Refuses outputs that would fail or do harm only after the work (bake, merge, render, plot,
-/// export): an input given as an output, two outputs to one file, a folder or special file,
-/// an existing file without --force, a missing folder, a folder we may not write into (the
-/// library's check, [`clothbake_bake::output::preflight`], as one line); each output's `what`
-/// names it (`table`, `PNG image`).
-pub fn preflight(outputs: &[(&Path, &str)], force: bool, inputs: &[&Path]) -> Result<(), CliError> {
-    clothbake_bake::output::preflight(outputs, force, inputs).map_err(|e| table_error(&e))
-}
-
 /// The bake's progress line: cells evaluated, with their rate.
 const BAKE_BAR: &str = "{elapsed_precise} [{wide_bar}] {percent:>3}% {human_pos}/{human_len} \
                         cells evaluated, {rate}, ETA {eta}";
-
-/// A progress bar of `total` steps drawn with `template` on stderr, or none with --quiet or
-/// when stderr is not a terminal (shared by bake and render). `{rate}` in the template shows
-/// the steps per second with thousands grouped.
-pub fn progress_bar(total: u64, template: &str, quiet: bool) -> Option<ProgressBar> {
-    if quiet || !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-    let style = ProgressStyle::with_template(template)
-        .expect("valid template")
-        .with_key(
-            "rate",
-            |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
-                let _ = write!(w, "{} cells/s", thousands(s.per_sec().round() as u64));
-            },
-        )
-        .progress_chars("=> ");
-    bar.set_style(style);
-    Some(bar)
-}
-
-/// Groups digits by thousands: 4194304 -> 4,194,304.
-pub fn thousands(n: u64) -> String {
-    let digits = n.to_string().into_bytes();
-    let groups: Vec<&str> = digits
-        .rchunks(3)
-        .rev()
-        .map(|g| std::str::from_utf8(g).expect("ASCII digits"))
-        .collect();
-    groups.join(",")
-}
-
-/// The worker thread count: `--threads N` if given, else every core.
-pub fn thread_count(arg: Option<usize>) -> usize {
-    arg.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-}
-
-/// A rayon pool of `threads` workers, or the one-line error that says to give fewer (shared by
-/// bake, export and render).
-pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, CliError> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| {
-            CliError::new(
-                format!("cannot start {threads} worker threads: {e}"),
-                "give fewer with --threads N",
-            )
-        })
-}
 
 /// A job's error as the CLI's one line (exit 130 for an interrupted bake).
 fn job_error(e: JobError) -> CliError {
@@ -272,9 +165,9 @@ fn job_error(e: JobError) -> CliError {
 /// Runs a bake and returns the summary line for stdout (empty with --quiet).
 pub fn run(weave: &Path, o: &BakeOpts) -> Result<String, CliError> {
     let plan = plan(weave, o)?;
-    let fabric = load_fabric(&plan.weave, &o.draft, &o.material)?;
+    let fabric = resolve::fabric(&plan.weave, &o.draft, &o.material)?;
     if let Some(v) = o.variant {
-        crate::eval_cmd::checked_variant(&plan.weave, &fabric, v)?;
+        resolve::variant(&plan.weave, &fabric, v)?;
     }
     let what = if plan.shard.is_some() {
         "shard"
@@ -410,18 +303,5 @@ pub fn invocation() -> String {
         "cargo run --release -p clothbake --".into()
     } else {
         std::env::current_exe().map_or_else(|_| "clothbake".into(), |e| e.display().to_string())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn digit_groups() {
-        assert_eq!(thousands(0), "0");
-        assert_eq!(thousands(999), "999");
-        assert_eq!(thousands(1000), "1,000");
-        assert_eq!(thousands(4194304), "4,194,304");
     }
 }

@@ -744,6 +744,24 @@ impl From<VariantArg> for Variant {
     }
 }
 
+impl From<Variant> for VariantArg {
+    fn from(v: Variant) -> VariantArg {
+        match v {
+            Variant::Thesis => VariantArg::Thesis,
+            Variant::Refined => VariantArg::Refined,
+            Variant::Sliced => VariantArg::Sliced,
+            Variant::Sliced3d => VariantArg::Sliced3d,
+        }
+    }
+}
+
+/// The model's own default ([`Variant::default`]): written once, in clothbake-core.
+impl Default for VariantArg {
+    fn default() -> VariantArg {
+        Variant::default().into()
+    }
+}
+
 /// `--caps` values (mirrors `clothbake_core::Caps`).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CapsArg {
@@ -1148,7 +1166,7 @@ pub struct ModelArgs {
 
     /// Analytic variant: eq. 3.6 on the rectangle top as printed (thesis) or averaged over the
     /// arc's true heights (refined, the default; see docs/science/model.md).
-    #[arg(long, value_enum, default_value_t = VariantArg::Refined)]
+    #[arg(long, value_enum, default_value_t = VariantArg::default())]
     pub variant: VariantArg,
 }
 

@@ -1,24 +1,20 @@
 //! `clothbake eval`: the reflection of a fabric for one light and one eye direction.
 
-use crate::cli::{DraftArgs, EvalArgs, Faces, MaterialArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
+use crate::cli::{EvalArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
 use crate::report::{self, Report};
+use crate::resolve;
 use clothbake_bake::transport::Transport;
 use clothbake_core::interreflection::Ranges;
 use clothbake_core::{
-    AnalyticBsdf, AnalyticModel, Bsdf, Component, Fabric, FabricError, FacetModel, Footprint,
-    Level, PlainNaming, Reflection, Secondary, SecondaryMethod, SecondaryOptions, UnitVec3,
-    Variant,
+    AnalyticBsdf, AnalyticModel, Bsdf, Component, Fabric, FacetModel, Footprint, Level, Reflection,
+    Secondary, SecondaryMethod, SecondaryOptions, UnitVec3, Variant,
 };
 use clothbake_truth::pathtracer::PathOptions;
 use clothbake_truth::{Caps, RayTracer};
-use std::path::Path;
 
 /// Runs `clothbake eval` and returns the text to print on stdout.
 pub fn run(args: &EvalArgs) -> Result<String, CliError> {
-    if args.faces == Faces::Two {
-        return crate::two_faced_cmd::run(args);
-    }
     for (flag, d) in [("--wi", args.wi), ("--wo", args.wo)] {
         d.check_upper()
             .map_err(|e| CliError::line(format!("{flag}: {e}")))?;
@@ -64,7 +60,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     }
     let kernel = opts.kernel;
     let secondary = (args.bounces.bounces == 2).then_some(opts);
-    let fabric = load_fabric(&args.weave, &args.draft, &args.material)?;
+    let fabric = resolve::fabric(&args.weave, &args.draft, &args.material)?;
     let facet = FacetModel::from(args.model.facet);
     let (wi, wo) = (args.wi.unit(), args.wo.unit());
     let horizon = !(args.wi.above_horizon() && args.wo.above_horizon());
@@ -79,7 +75,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     });
     let (reflection, raytrace) = match args.method {
         Method::Analytic => {
-            let variant = checked_variant(&args.weave, &fabric, args.model.variant)?;
+            let variant = resolve::variant(&args.weave, &fabric, args.model.variant)?;
             let model = AnalyticModel::with_variant(&fabric, facet, variant);
             let coverage = if horizon { 0.0 } else { model.coverage(wo) };
             let at = args.at.map(|p| (p, model.cells().cell_at(p)));
@@ -307,93 +303,9 @@ pub fn describe_secondary(o: &SecondaryOptions) -> String {
     format!("{how}, {} kernel", o.kernel.name())
 }
 
-/// The analytic variant `v` for the fabric of `weave`, refused where it does not take the
-/// period (`clothbake_core::check_variant`: sliced3d's size limit).
-pub fn checked_variant(
-    weave: &Path,
-    fabric: &Fabric,
-    v: impl Into<Variant>,
-) -> Result<Variant, CliError> {
-    let v = v.into();
-    clothbake_core::check_variant(fabric, v)
-        .map_err(|(problem, fix)| CliError::new(format!("{}: {problem}", weave.display()), fix))?;
-    Ok(v)
-}
-
-/// Reads the fabric of `--weave` (JSON or WIF draft, with the draft's size flags; or a shipped
-/// fabric's name, [`crate::fabrics`]) and applies the material overrides.
-pub fn load_fabric(weave: &Path, draft: &DraftArgs, m: &MaterialArgs) -> Result<Fabric, CliError> {
-    if draft.any() && !crate::fabrics::is_draft(weave) {
-        return Err(CliError::new(
-            format!(
-                "--radius and --spacing apply only to a WIF draft (*.wif), and {} is a fabric file, which gives its sizes itself",
-                weave.display()
-            ),
-            "drop them, or edit radius and spacing in the fabric file",
-        ));
-    }
-    let fabric = crate::fabrics::read(weave, &draft.options())?;
-    Ok(apply_material(fabric, m)?)
-}
-
-/// Replaces the facet-material fields given on the command line, in both yarn groups; fields not
-/// given keep each group's value from the file. `--albedo` also replaces per-thread albedos.
-/// (The values were range-checked by the parsers.)
-pub fn apply_material(fabric: Fabric, m: &MaterialArgs) -> Result<Fabric, FabricError> {
-    if m.albedo.is_none()
-        && m.specular.is_none()
-        && m.exponent.is_none()
-        && m.translucency.is_none()
-    {
-        return Ok(fabric);
-    }
-    fabric.with_groups(
-        |_, g| {
-            if let Some(a) = m.albedo {
-                g.material.albedo = a;
-                g.threads.iter_mut().for_each(|y| y.albedo = None);
-            }
-            if let Some(s) = m.specular {
-                g.material.specular = s;
-            }
-            if let Some(n) = m.exponent {
-                g.material.exponent = n;
-            }
-            if let Some(t) = m.translucency {
-                g.material.translucency = t;
-            }
-        },
-        &PlainNaming("the material options"),
-    )
-}
-
 #[cfg(test)]
 mod tests {
-    use super::*;
     use crate::cli::Direction;
-
-    #[test]
-    fn material_overrides_keep_unset_fields() {
-        let f = Fabric::from_json_str(
-            r#"{"pattern": [[1,0],[0,1]],
-                "warp": {"radius": 1.5, "spacing": 3.1, "material": {"specular": 0.1}},
-                "weft": {"radius": 1.5, "spacing": 3.1, "material": {"specular": 0.2}}}"#,
-            "t",
-        )
-        .unwrap();
-        let m = MaterialArgs {
-            albedo: Some([0.1, 0.2, 0.3]),
-            specular: None,
-            exponent: Some(4.0),
-            translucency: Some(0.5),
-        };
-        let f = apply_material(f, &m).unwrap();
-        assert_eq!(f.warp().material.albedo, [0.1, 0.2, 0.3]);
-        assert_eq!(f.weft().material.exponent, 4.0);
-        assert_eq!(f.weft().material.translucency, 0.5);
-        assert_eq!(f.warp().material.specular, 0.1);
-        assert_eq!(f.weft().material.specular, 0.2);
-    }
 
     #[test]
     fn horizon_direction() {

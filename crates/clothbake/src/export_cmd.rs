@@ -5,10 +5,9 @@
 //! (glTF, MaterialX, USD, Blender: `fitted_cmd`), each written atomically.
 //! Formats and conventions: `docs/guide/export.md`.
 
-use crate::bake_cmd::preflight;
 use crate::cli::{ExportArgs, Faces};
 use crate::error::CliError;
-use crate::eval_cmd::apply_material;
+use crate::resolve::{self, preflight};
 use clothbake_bake::memory;
 use clothbake_bake::two_faced::TwoFaced;
 use clothbake_core::symmetry::{symmetries, Symmetry};
@@ -90,7 +89,7 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             }
             let (fabric, facet, variant) = model_of(args, weave)?;
             let tf = TwoFaced::new(&fabric, facet, variant.into())?;
-            let threads = crate::bake_cmd::thread_count(args.run.threads);
+            let threads = resolve::thread_count(args.run.threads);
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
@@ -195,14 +194,11 @@ fn model_of(
     args: &ExportArgs,
     weave: &std::path::Path,
 ) -> Result<(Fabric, FacetModel, crate::cli::VariantArg), CliError> {
-    let fabric = apply_material(
-        crate::fabrics::read(weave, &Default::default())?,
-        &args.material,
-    )?;
+    let fabric = resolve::fabric_of(weave, &args.material)?;
     refuse_existing(args)?;
     let facet = FacetModel::from(args.facet.unwrap_or(crate::cli::FacetArg::Huo));
-    let variant = args.variant.unwrap_or(crate::cli::VariantArg::Refined);
-    crate::eval_cmd::checked_variant(weave, &fabric, variant)?;
+    let variant = args.variant.unwrap_or_default();
+    resolve::variant(weave, &fabric, variant)?;
     Ok((fabric, facet, variant))
 }
 
@@ -231,8 +227,8 @@ fn refuse_model_options(args: &ExportArgs) -> Result<(), CliError> {
 
 /// Checks every output before any work is done ([`preflight`]).
 fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
-    crate::fitted_cmd::check_stems(args)?;
-    let fitted = crate::fitted_cmd::outputs(args);
+    crate::export_fitted::check_stems(args)?;
+    let fitted = crate::export_fitted::outputs(args);
     let mut outputs: Vec<(&std::path::Path, &str)> = [
         (&args.rgl, "RGL file"),
         (&args.rgl_spectral, "spectral RGL file"),
@@ -261,13 +257,13 @@ fn write_all(
     half_turn: bool,
     held: u64,
 ) -> Result<String, CliError> {
-    let threads = crate::bake_cmd::thread_count(args.run.threads);
+    let threads = resolve::thread_count(args.run.threads);
     let g = args.rgl_res.0;
     let n_cells = cells
         .as_ref()
         .map_or(1, |c| (c.u_edges.len() - 1) * (c.v_edges.len() - 1));
     check_memory(args, threads, held, n_cells)?;
-    let pool = crate::bake_cmd::thread_pool(threads)?;
+    let pool = resolve::thread_pool(threads)?;
     let mut summary = String::new();
     let src = Source {
         average: brdf,
@@ -275,7 +271,7 @@ fn write_all(
     };
     // Fitted on the pool; written from this thread, where the command's outputs are batched
     // (moved into place together).
-    summary += &crate::fitted_cmd::write(args, &src, name, &pool)?;
+    summary += &crate::export_fitted::write(args, &src, name, &pool)?;
     // One evaluation of the slices serves both RGL files.
     let mut slices = None;
     for (out, colour) in [
@@ -401,7 +397,7 @@ fn check_memory(
         .merl
         .as_ref()
         .map_or(0, |_| merl::peak_bytes(args.phi_samples, threads));
-    let fitted = if crate::fitted_cmd::wanted(args) {
+    let fitted = if crate::export_fitted::wanted(args) {
         clothbake_export::fitted::material::Fitted::peak_bytes(cells)
     } else {
         0

@@ -1,4 +1,7 @@
-//! `clothbake`: the command-line front end of clothbake-core.
+//! `clothbake`: the command-line front end. `cli` parses (clap), `resolve` turns the parsed
+//! flags into what the work needs (the fabric, the model's variant, the checked outputs, the
+//! thread pool), and one `*_cmd` module per command does the work; `main` dispatches and
+//! prints. Commands never import each other.
 //!
 //! Every failure is one line `clothbake: <cause>; <fix>` on stderr with exit status 2 (130 for
 //! an interrupted command). `clothbake diff` exits 1 when the tables differ beyond its tolerance.
@@ -9,13 +12,14 @@ mod diff_cmd;
 mod error;
 mod eval_cmd;
 mod export_cmd;
+mod export_fitted;
 mod fabrics;
-mod fitted_cmd;
 mod help_cmd;
 mod info_cmd;
 mod merge_cmd;
 mod render_cmd;
 mod report;
+mod resolve;
 mod signals;
 mod two_faced_cmd;
 
@@ -69,6 +73,9 @@ fn run() -> Result<u8, CliError> {
         Err(e) => return Err(parse_error(&e)),
     };
     let (out, code) = match cli.command {
+        Some(Command::Eval(args)) if args.faces == cli::Faces::Two => {
+            (two_faced_cmd::run(&args)?, 0)
+        }
         Some(Command::Eval(args)) => (eval_cmd::run(&args)?, 0),
         Some(Command::Bake(args)) => (bake_cmd::run(&args.weave, &args.opts)?, 0),
         Some(Command::Info(args)) => (info_cmd::run(&args)?, 0),

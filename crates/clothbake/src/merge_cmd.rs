@@ -5,9 +5,9 @@
 //! then writes the table atomically through the loader. Any failure: one line naming the shard
 //! and the cause, exit 2, nothing written.
 
-use crate::bake_cmd::{output_format, preflight};
 use crate::cli::{FormatArg, MergeArgs};
 use crate::error::CliError;
+use crate::resolve::{output_format, preflight};
 use clothbake_bake::memory;
 use clothbake_bake::merge::{merge, orbits_of};
 use clothbake_bake::output::{write_table, Format};

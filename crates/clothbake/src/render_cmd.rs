@@ -1,12 +1,11 @@
 //! `clothbake render` and `clothbake plot`: the command-line side of `clothbake_render` and
 //! `clothbake_render::plot` (building the shader, checking outputs, progress, summary line).
 
-use crate::bake_cmd::{preflight, progress_bar};
 use crate::cli::{
     BrdfArgs, ComponentArg, Exposure, Faces, PlotArgs, PlotKind, RenderArgs, SceneArg, TonemapArg,
 };
 use crate::error::{table_error, CliError};
-use crate::eval_cmd::apply_material;
+use crate::resolve::{self, preflight, progress_bar};
 use clothbake_core::{FacetModel, Vec3};
 use clothbake_render::camera::{Camera, CameraError};
 use clothbake_render::plot::{self, Plot, Source};
@@ -28,11 +27,8 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
         ComponentArg::Secondary => Component::Secondary,
         ComponentArg::Iss => Component::SecondarySpecular,
     };
-    let fabric = apply_material(
-        crate::fabrics::read(weave, &Default::default())?,
-        &b.material,
-    )?;
-    let variant = crate::eval_cmd::checked_variant(weave, &fabric, b.model.variant)?;
+    let fabric = resolve::fabric_of(weave, &b.material)?;
+    let variant = resolve::variant(weave, &fabric, b.model.variant)?;
     if b.bounces.bounces > 2 {
         // Full transport: the analytic terms plus the path-traced orders (docs/science/transport.md),
         // whole only.
@@ -119,11 +115,8 @@ fn two_faced_shader(a: &RenderArgs) -> Result<Shader, CliError> {
             format!("drop {flag}, or drop --faces two"),
         ));
     }
-    let fabric = apply_material(
-        crate::fabrics::read(weave, &Default::default())?,
-        &a.brdf.material,
-    )?;
-    let variant = crate::eval_cmd::checked_variant(weave, &fabric, a.brdf.model.variant)?;
+    let fabric = resolve::fabric_of(weave, &a.brdf.material)?;
+    let variant = resolve::variant(weave, &fabric, a.brdf.model.variant)?;
     Shader::two_faced(&fabric, FacetModel::from(a.brdf.model.facet), variant)
         .map_err(CliError::line)
 }
@@ -156,10 +149,7 @@ fn truth_shader(a: &RenderArgs) -> Result<Shader, CliError> {
         max_bounces: (b.bounces.bounces as usize).min(clothbake_bake::transport::MAX_ORDER),
         ..clothbake_truth::PathOptions::default()
     });
-    let fabric = apply_material(
-        crate::fabrics::read(weave, &Default::default())?,
-        &b.material,
-    )?;
+    let fabric = resolve::fabric_of(weave, &b.material)?;
     Ok(Shader::truth(
         &fabric,
         FacetModel::from(b.model.facet),
@@ -298,8 +288,8 @@ pub fn run_render(a: &RenderArgs) -> Result<String, CliError> {
         irradiance: a.irradiance.unwrap_or(std::f64::consts::PI),
         ambient: a.ambient,
     };
-    let threads = crate::bake_cmd::thread_count(a.run.threads);
-    let pool = crate::bake_cmd::thread_pool(threads)?;
+    let threads = resolve::thread_count(a.run.threads);
+    let pool = resolve::thread_pool(threads)?;
     let start = Instant::now();
     let bar = progress_bar(u64::from(h), RENDER_BAR, a.run.quiet);
     let shown = AtomicU64::new(0);

@@ -4,7 +4,7 @@
 
 use crate::cli::{EvalArgs, Method, DEFAULT_SAMPLES, DEFAULT_SEED};
 use crate::error::CliError;
-use crate::eval_cmd::load_fabric;
+use crate::resolve;
 use clothbake_bake::two_faced::{TwoFaced, MAX_BOUNCES};
 use clothbake_core::{Bsdf, FacetModel, UnitVec3};
 use clothbake_truth::RayTracer;
@@ -49,12 +49,11 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     }
     let (wi, wo) = (args.wi.unit(), args.wo.unit());
     let sided = |w: UnitVec3| w.above_horizon() || w.below_horizon();
-    let fabric = load_fabric(&args.weave, &args.draft, &args.material)?;
+    let fabric = resolve::fabric(&args.weave, &args.draft, &args.material)?;
     let facet = FacetModel::from(args.model.facet);
     let (f, std_err, openness, how) = match args.method {
         Method::Analytic => {
-            let variant =
-                crate::eval_cmd::checked_variant(&args.weave, &fabric, args.model.variant)?;
+            let variant = resolve::variant(&args.weave, &fabric, args.model.variant)?;
             let tf = TwoFaced::new(&fabric, facet, variant)?;
             (
                 tf.f(wi, wo),
