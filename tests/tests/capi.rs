@@ -92,7 +92,7 @@ fn the_c_program_agrees_with_the_rust_loader() {
             f(s.pdf)
         )
         .unwrap();
-        writeln!(cases, "P {} {} {}", v3(wo), v3(wi), f(b.pdf(wo, wi))).unwrap();
+        writeln!(cases, "P {} {} {}", v3(wo), v3(wi), f(b.pdf(wi, wo))).unwrap();
         // Points of the period (any real numbers) through footprints from a point to beyond a
         // period; doubles printed to round-trip.
         let (u, v) = (x as f64 * 0.37 - 20.0, x as f64 * 0.23);

@@ -280,8 +280,8 @@ impl Bsdf for TwoFaced {
     }
 
     /// |cos(theta_i)| / (2 pi) on either side.
-    fn pdf(&self, wo: UnitVec3, wi: UnitVec3) -> f64 {
-        two_sided_pdf(wo, wi)
+    fn pdf(&self, wi: UnitVec3, wo: UnitVec3) -> f64 {
+        two_sided_pdf(wi, wo)
     }
 }
 
@@ -401,7 +401,7 @@ mod tests {
         for _ in 0..2000 {
             let s = tf.sample(wo, [rng.next_f64(), rng.next_f64()]).unwrap();
             sides[usize::from(s.wi.z > 0.0)] += 1;
-            assert_eq!(s.pdf, tf.pdf(wo, s.wi));
+            assert_eq!(s.pdf, tf.pdf(s.wi, wo));
             assert!(s.weight().iter().all(|&x| x >= 0.0));
         }
         assert!(sides[0] > 900 && sides[1] > 900, "{sides:?}");

@@ -168,7 +168,9 @@ impl Local {
 }
 
 /// A bidirectional reflectance distribution: f_r, a sampler of incident directions and its
-/// density, on local-frame unit directions.
+/// density, on local-frame unit directions. Every method that takes both directions takes
+/// them in one order, `(wi, wo)`: toward the light, then toward the eye (`f`, `pdf`, `f_at`);
+/// `sample` takes `wo` and returns a `wi`.
 pub trait Bsdf: Sync {
     /// f(wi, wo) in 1/sr, RGB, over the whole sphere: reflection where `wi` and `wo` are on
     /// the same side of the cloth, transmission where they are on opposite sides (the
@@ -231,8 +233,8 @@ pub trait Bsdf: Sync {
 
     /// The density per unit solid angle with which [`Bsdf::sample`] draws `wi` for `wo`. The
     /// default is that of [`cosine_sample`], cos(theta_i) / pi.
-    fn pdf(&self, wo: UnitVec3, wi: UnitVec3) -> f64 {
-        default_pdf(wo, wi)
+    fn pdf(&self, wi: UnitVec3, wo: UnitVec3) -> f64 {
+        default_pdf(wi, wo)
     }
 }
 
@@ -252,7 +254,7 @@ pub fn default_sample<B: Bsdf + ?Sized>(b: &B, wo: UnitVec3, u: [f64; 2]) -> Opt
         return None;
     }
     let wi = cosine_sample(u);
-    let pdf = default_pdf(wo, wi);
+    let pdf = default_pdf(wi, wo);
     (pdf > 0.0).then(|| BsdfSample {
         wi,
         f: b.f(wi, wo),
@@ -261,7 +263,7 @@ pub fn default_sample<B: Bsdf + ?Sized>(b: &B, wo: UnitVec3, u: [f64; 2]) -> Opt
 }
 
 /// The default [`Bsdf::pdf`]: cos(theta_i) / pi above the horizon, else 0.
-pub fn default_pdf(wo: UnitVec3, wi: UnitVec3) -> f64 {
+pub fn default_pdf(wi: UnitVec3, wo: UnitVec3) -> f64 {
     if !(wo.above_horizon() && wi.above_horizon()) {
         return 0.0;
     }
@@ -282,7 +284,7 @@ pub fn two_sided_sample<B: Bsdf + ?Sized>(b: &B, wo: UnitVec3, u: [f64; 2]) -> O
     } else {
         w.mirror_z()
     };
-    let pdf = two_sided_pdf(wo, wi);
+    let pdf = two_sided_pdf(wi, wo);
     (pdf > 0.0).then(|| BsdfSample {
         wi,
         f: b.f(wi, wo),
@@ -292,7 +294,7 @@ pub fn two_sided_sample<B: Bsdf + ?Sized>(b: &B, wo: UnitVec3, u: [f64; 2]) -> O
 
 /// The density of [`two_sided_sample`]: |cos(theta_i)| / (2 pi) on either side, 0 for a
 /// direction in the plane.
-pub fn two_sided_pdf(wo: UnitVec3, wi: UnitVec3) -> f64 {
+pub fn two_sided_pdf(wi: UnitVec3, wo: UnitVec3) -> f64 {
     let sided = |w: UnitVec3| w.above_horizon() || w.below_horizon();
     if !(sided(wi) && sided(wo)) {
         return 0.0;
@@ -334,7 +336,7 @@ mod tests {
             let u = [(k as f64 + 0.5) / 64.0, ((k * 37) % 64) as f64 / 64.0];
             let s = b.sample(wo, u).unwrap();
             assert!(s.wi.above_horizon());
-            assert!((s.pdf - b.pdf(wo, s.wi)).abs() < 1e-15);
+            assert!((s.pdf - b.pdf(s.wi, wo)).abs() < 1e-15);
             for w in s.weight() {
                 assert!((w - 0.7).abs() < 1e-12, "{w}");
             }
@@ -390,7 +392,7 @@ mod tests {
             for j in 0..np {
                 let p = (j as f64 + 0.5) * 2.0 * PI / np as f64;
                 let wi = UnitVec3::from_spherical(t, p);
-                s += Lambert(1.0).pdf(UnitVec3::Z, wi) * t.sin();
+                s += Lambert(1.0).pdf(wi, UnitVec3::Z) * t.sin();
             }
         }
         s *= (PI / 2.0 / nt as f64) * (2.0 * PI / np as f64);

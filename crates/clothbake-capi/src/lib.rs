@@ -313,7 +313,8 @@ pub unsafe extern "C" fn clothbake_pdf(
     const F: &str = "clothbake_pdf";
     guard(-1, || {
         let b = brdf(h, F)?;
-        let p = b.pdf(vec3(wo, F, "wo")?, vec3(wi, F, "wi")?);
+        let (o, i) = (vec3(wo, F, "wo")?, vec3(wi, F, "wi")?);
+        let p = b.pdf(i, o);
         if pdf.is_null() {
             return Err(format!("{F}: pdf is NULL; pass room for 1 float"));
         }

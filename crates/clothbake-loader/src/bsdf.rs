@@ -71,9 +71,9 @@ impl Bsdf for Brdf {
         bsdf_sample(self, self.sample(f32s(wo), u[0] as f32, u[1] as f32), wo)
     }
 
-    fn pdf(&self, wo: UnitVec3, wi: UnitVec3) -> f64 {
+    fn pdf(&self, wi: UnitVec3, wo: UnitVec3) -> f64 {
         if !self.has_sampling() {
-            return clothbake_bsdf::default_pdf(wo, wi);
+            return clothbake_bsdf::default_pdf(wi, wo);
         }
         f64::from(Brdf::pdf(self, f32s(wo), f32s(wi)))
     }

@@ -615,7 +615,7 @@ impl Brdf {
         let (theta_o, phi_o) = theta_phi(wo);
         let (theta, phi) = sampler.sample(theta_o, phi_o, u1, u2);
         let wi = direction(theta, phi);
-        let pdf = self.pdf(wo, wi);
+        let pdf = self.pdf(wi, wo);
         if pdf.is_nan() || pdf <= 0.0 {
             return Sample { wi, ..none };
         }
@@ -630,7 +630,7 @@ impl Brdf {
 
     /// The density of [`Brdf::sample`] drawing `wi` for `wo`, per unit solid angle; 0 when
     /// either is below the horizon or sampling was not built.
-    pub fn pdf(&self, wo: [f32; 3], wi: [f32; 3]) -> f32 {
+    pub fn pdf(&self, wi: [f32; 3], wo: [f32; 3]) -> f32 {
         let Some(sampler) = self.sampler() else {
             return 0.0;
         };

@@ -270,7 +270,7 @@ impl TwoFacedBrdf {
         } else {
             [s.wi[0], s.wi[1], -s.wi[2]]
         };
-        let pdf = self.pdf(wo, wi);
+        let pdf = self.pdf(wi, wo);
         if pdf.is_nan() || pdf <= 0.0 {
             return Sample { wi, ..none };
         }
@@ -284,14 +284,14 @@ impl TwoFacedBrdf {
     }
 
     /// The density of [`TwoFacedBrdf::sample`] drawing `wi` for `wo`, per unit solid angle.
-    pub fn pdf(&self, wo: [f32; 3], wi: [f32; 3]) -> f32 {
+    pub fn pdf(&self, wi: [f32; 3], wo: [f32; 3]) -> f32 {
         if !(sided(wo) && sided(wi) && self.blocks[0].has_sampling()) {
             return 0.0;
         }
         let (up_i, up_o) = (wi[2] > 0.0, wo[2] > 0.0);
         let p = self.reflect_odds(wo);
         let choice = if up_i == up_o { p } else { 1.0 - p };
-        choice * self.blocks[block_of(up_i, up_o)].pdf(side_frame(wo), side_frame(wi))
+        choice * self.blocks[block_of(up_i, up_o)].pdf(side_frame(wi), side_frame(wo))
     }
 }
 
@@ -390,9 +390,9 @@ impl Bsdf for TwoFacedBrdf {
         crate::bsdf::bsdf_sample(self, s, wo)
     }
 
-    fn pdf(&self, wo: UnitVec3, wi: UnitVec3) -> f64 {
+    fn pdf(&self, wi: UnitVec3, wo: UnitVec3) -> f64 {
         if !self.blocks[0].has_sampling() {
-            return clothbake_bsdf::two_sided_pdf(wo, wi);
+            return clothbake_bsdf::two_sided_pdf(wi, wo);
         }
         f64::from(TwoFacedBrdf::pdf(self, f32s(wo), f32s(wi)))
     }

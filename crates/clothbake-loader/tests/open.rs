@@ -78,8 +78,8 @@ fn same_lookups(a: &Brdf, b: &Brdf, pairs: usize, seed: u64) {
     for (i, o) in wi.iter().zip(&wo) {
         assert_eq!(bits(a.eval(*i, *o)), bits(b.eval(*i, *o)), "{i:?} {o:?}");
         assert_eq!(
-            a.pdf(*o, *i).to_bits(),
-            b.pdf(*o, *i).to_bits(),
+            a.pdf(*i, *o).to_bits(),
+            b.pdf(*i, *o).to_bits(),
             "{i:?} {o:?}"
         );
     }

@@ -82,7 +82,7 @@ fn hemisphere_integral(n_mu: usize, n_phi: usize, f: impl Fn([f32; 3]) -> [f64; 
 fn the_pdf_integrates_to_one_over_the_hemisphere() {
     let b = brdf();
     for wo in outgoing() {
-        let total = hemisphere_integral(800, 1600, |wi| [f64::from(b.pdf(wo, wi)); 3])[0];
+        let total = hemisphere_integral(800, 1600, |wi| [f64::from(b.pdf(wi, wo)); 3])[0];
         assert!((total - 1.0).abs() < 2e-3, "wo {wo:?}: integral {total}");
     }
 }
@@ -111,7 +111,7 @@ fn bin_probability(b: &Brdf, wo: [f32; 3], mu: (f64, f64), phi: (f64, f64)) -> f
             let dp = (phi.1.min(p_hi) - phi.0.max(p_lo)).max(0.0);
             if dp > 0.0 {
                 let centre = f32s(dir(0.5 * (t_lo + t_hi), 0.5 * (p_lo + p_hi)));
-                p += f64::from(b.pdf(wo, centre)) * dm * dp;
+                p += f64::from(b.pdf(centre, wo)) * dm * dp;
             }
         }
     }
@@ -182,7 +182,7 @@ fn the_weight_is_f_cos_over_pdf_and_the_pdf_is_pdf_of_wi() {
     for wo in outgoing() {
         for _ in 0..2000 {
             let s = b.sample(wo, rng.next() as f32, rng.next() as f32);
-            assert_eq!(s.pdf, b.pdf(wo, s.wi));
+            assert_eq!(s.pdf, b.pdf(s.wi, wo));
             let f = b.eval(s.wi, wo);
             for (w, f) in s.weight.iter().zip(f) {
                 let want = f * s.wi[2] / s.pdf;
@@ -230,7 +230,7 @@ fn no_sample_below_the_horizon_or_without_cdfs() {
     let b = brdf();
     let s = b.sample([0.0, 0.6, -0.8], 0.3, 0.3);
     assert_eq!((s.pdf, s.weight), (0.0, [0.0; 3]));
-    assert_eq!(b.pdf([0.0, 0.0, 1.0], [0.0, 0.6, -0.8]), 0.0);
+    assert_eq!(b.pdf([0.0, 0.6, -0.8], [0.0, 0.0, 1.0]), 0.0);
     let t = Table::new(
         Metadata::new("t", GRID, "{}", "{}", "none"),
         vec![0.5; GRID.len() * 3],

@@ -250,7 +250,7 @@ fn over_sphere(n: usize, mut f: impl FnMut([f64; 3], f64)) {
 /// The density over the sphere by [`over_sphere`].
 fn integral_of_pdf(b: &TwoFacedBrdf, wo: [f32; 3]) -> f64 {
     let mut sum = 0.0;
-    over_sphere(200, |w, d| sum += f64::from(b.pdf(wo, f32s(w))) * d);
+    over_sphere(200, |w, d| sum += f64::from(b.pdf(f32s(w), wo)) * d);
     sum
 }
 
@@ -275,7 +275,7 @@ fn samples_carry_their_density_and_estimate_the_albedo() {
         for _ in 0..n {
             let smp = b.sample(wo32, u(), u());
             assert!(smp.pdf > 0.0);
-            let pdf = b.pdf(wo32, smp.wi);
+            let pdf = b.pdf(smp.wi, wo32);
             assert!((pdf - smp.pdf).abs() <= 1e-4 * pdf, "{} vs {pdf}", smp.pdf);
             est += f64::from(smp.weight[1]) / n as f64;
             sides[usize::from(smp.wi[2] > 0.0)] += 1;

@@ -328,7 +328,7 @@ impl PyTable {
             wo32.par_iter()
                 .zip(wi32.par_iter())
                 .with_min_len(PAR_CHUNK)
-                .map(|(&o, &i)| self.brdf.pdf(o, i))
+                .map(|(&o, &i)| self.brdf.pdf(i, o))
                 .collect()
         });
         to_array1(py, p, single_i && single_o)
@@ -398,7 +398,7 @@ impl PyTable {
     fn pdf1(&self, wo: [f64; 3], wi: [f64; 3]) -> PyResult<f32> {
         check_unit("wo", 0, wo)?;
         check_unit("wi", 0, wi)?;
-        Ok(self.brdf.pdf(wo.map(|x| x as f32), wi.map(|x| x as f32)))
+        Ok(self.brdf.pdf(wi.map(|x| x as f32), wo.map(|x| x as f32)))
     }
 
     /// Writes the table atomically: OpenEXR (`.exr`, precision "f16" or "f32") or the binary
