@@ -99,7 +99,8 @@ pub fn compare_with(
     samples: usize,
     seed: u64,
 ) -> Report {
-    let model = AnalyticModel::with_variant(fabric, facet, variant);
+    let model = AnalyticModel::with_variant(fabric, facet, variant)
+        .expect("the fabrics compared are within every variant's limits");
     let tracer = RayTracer::new(fabric, facet).with_caps(caps);
     let mean = |v: [f64; 3]| (v[0] + v[1] + v[2]) / 3.0;
     let rows = pairs

@@ -58,7 +58,8 @@ fn the_batch_gives_the_bits_of_single_evaluations() {
     let mut compared = 0;
     for (k, (name, fabric)) in fabrics.iter().enumerate() {
         for variant in [Variant::Refined, Variant::Thesis] {
-            let m = AnalyticModel::with_variant(fabric, FacetModel::Huo, variant);
+            let m = AnalyticModel::with_variant(fabric, FacetModel::Huo, variant)
+                .expect("the variant takes the period");
             let p = pairs(k as u64);
             let mut out = vec![Reflection::default(); p.len()];
             m.intensity_batch(&p, &mut out);

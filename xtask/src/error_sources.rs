@@ -47,8 +47,13 @@ pub fn run(root: &Path) {
     for path in fabric_files(&root.join("tables")).unwrap() {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         let f = Fabric::from_path(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let models = [Variant::Refined, Variant::Sliced, Variant::Sliced3d]
-            .map(|v| (v, AnalyticModel::with_variant(&f, FacetModel::Huo, v)));
+        let models = [Variant::Refined, Variant::Sliced, Variant::Sliced3d].map(|v| {
+            (
+                v,
+                AnalyticModel::with_variant(&f, FacetModel::Huo, v)
+                    .expect("the variant takes the period"),
+            )
+        });
         let t = RayTracer::new(&f, FacetModel::Huo);
         // Per pair: the truth's four quantities, then each variant's four differences.
         let rows: Vec<[[f64; 4]; 3]> = pairs

@@ -519,6 +519,7 @@ pub fn check_memory(
         };
         let two = job.options.bounces == 2;
         let k = clothbake_core::AnalyticModel::with_variant(job.fabric, job.options.facet, variant)
+            .map_err(|e| invalid(e, e.fix()))?
             .classes_with(two) as u64;
         3 + clothbake_loader::spatial::lanes(two) as u64 * k
     } else {

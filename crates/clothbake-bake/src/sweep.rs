@@ -177,6 +177,16 @@ pub enum BakeError {
     Invalid(String),
 }
 
+/// The analytic model of a bake, its variant checked against the period.
+fn analytic_model(
+    fabric: &Fabric,
+    facet: FacetModel,
+    variant: Variant,
+) -> Result<AnalyticModel, BakeError> {
+    AnalyticModel::with_variant(fabric, facet, variant)
+        .map_err(|e| BakeError::Invalid(format!("{e}; {}", e.fix())))
+}
+
 impl std::fmt::Display for BakeError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
@@ -548,8 +558,7 @@ impl Baker {
         let eval: CellFn = match (opts.method, multiple.clone()) {
             _ if two_faced.is_some() => batched(two_faced.clone().expect("matched")),
             (Method::Analytic { variant }, None) if opts.spatial => {
-                let m =
-                    with_grid_arcs(AnalyticModel::with_variant(fabric, opts.facet, variant), &g);
+                let m = with_grid_arcs(analytic_model(fabric, opts.facet, variant)?, &g);
                 let layout = crate::spatial::layout(&m, &g, secondary.is_some())
                     .map_err(BakeError::Invalid)?;
                 syms.clear();
@@ -583,12 +592,12 @@ impl Baker {
                 })
             }
             (Method::Analytic { variant }, Some(mb)) => {
-                let ft = crate::transport::FullTransport::with(fabric, opts.facet, variant, mb);
+                let ft = crate::transport::FullTransport::with(fabric, opts.facet, variant, mb)
+                    .map_err(|e| BakeError::Invalid(format!("{e}; {}", e.fix())))?;
                 per_cell(move |_, wi, wo, out| out.push(ft.f(wi, wo).map(|x| x as f32)))
             }
             (Method::Analytic { variant }, None) => {
-                let m =
-                    with_grid_arcs(AnalyticModel::with_variant(fabric, opts.facet, variant), &g);
+                let m = with_grid_arcs(analytic_model(fabric, opts.facet, variant)?, &g);
                 // One bounce: four pairs at a time (AnalyticBsdf::f_batch), the same bits.
                 batched(Arc::new(AnalyticBsdf::new(m, secondary)))
             }
@@ -893,7 +902,8 @@ mod tests {
     fn a_sliced3d_bake_keeps_its_grids_arcs_with_the_same_bits() {
         let f = twill();
         let g = Grid::new(5, 8, 4, 12);
-        let plain = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d);
+        let plain = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d)
+            .expect("the variant takes the period");
         let kept = with_grid_arcs(plain.clone(), &g);
         // 5 x 8 incident and 4 x 12 outgoing directions, none shared.
         assert_eq!(kept.open_arcs_kept(), 5 * 8 + 4 * 12);
@@ -902,7 +912,8 @@ mod tests {
             AnalyticBsdf::new(kept, Some(SecondaryOptions::default())),
         );
         let both = AnalyticBsdf::new(
-            AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d),
+            AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d)
+                .expect("the variant takes the period"),
             Some(SecondaryOptions::default()),
         );
         let direct = AnalyticBsdf::new(with_grid_arcs(both.model().clone(), &g), None);

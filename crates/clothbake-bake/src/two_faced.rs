@@ -20,6 +20,7 @@ use clothbake_core::openness::openness;
 use clothbake_core::{two_sided_pdf, two_sided_sample, BsdfSample};
 use clothbake_core::{
     AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FabricError, FacetModel, Rgb, UnitVec3, Variant,
+    VariantError,
 };
 use clothbake_loader::Axis;
 use clothbake_truth::RayTracer;
@@ -202,11 +203,49 @@ pub struct TwoFaced {
     rest: Rest,
 }
 
+/// Why a two-faced cloth cannot be built: its back is not a valid fabric ([`Fabric::back`]), or
+/// the model's variant does not take its period.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TwoFacedError {
+    /// The back (the inverted weave) is not a valid fabric.
+    Back(FabricError),
+    /// The variant does not take the period ([`Variant::check`]).
+    Variant(VariantError),
+}
+
+impl std::fmt::Display for TwoFacedError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TwoFacedError::Back(e) => e.fmt(f),
+            TwoFacedError::Variant(e) => write!(f, "{e}; {}", e.fix()),
+        }
+    }
+}
+
+impl std::error::Error for TwoFacedError {}
+
+impl From<FabricError> for TwoFacedError {
+    fn from(e: FabricError) -> Self {
+        TwoFacedError::Back(e)
+    }
+}
+
+impl From<VariantError> for TwoFacedError {
+    fn from(e: VariantError) -> Self {
+        TwoFacedError::Variant(e)
+    }
+}
+
 impl TwoFaced {
     /// The two-faced cloth of `fabric` with `facet` terms and the model's `variant` for the
     /// direct reflection, its rest on the default grid ([`NODES`], [`PATHS`]). An error where
-    /// the fabric's back is not a valid fabric ([`Fabric::back`]).
-    pub fn new(fabric: &Fabric, facet: FacetModel, variant: Variant) -> Result<Self, FabricError> {
+    /// the fabric's back is not a valid fabric ([`Fabric::back`]) or the variant does not take
+    /// the period.
+    pub fn new(
+        fabric: &Fabric,
+        facet: FacetModel,
+        variant: Variant,
+    ) -> Result<Self, TwoFacedError> {
         TwoFaced::with_grid(fabric, facet, variant, NODES, PATHS)
     }
 
@@ -218,13 +257,17 @@ impl TwoFaced {
         variant: Variant,
         nodes: (u32, u32),
         paths: usize,
-    ) -> Result<Self, FabricError> {
+    ) -> Result<Self, TwoFacedError> {
         let back = fabric.back()?;
-        let model =
-            |f: &Fabric| AnalyticBsdf::new(AnalyticModel::with_variant(f, facet, variant), None);
+        let model = |f: &Fabric| -> Result<AnalyticBsdf, VariantError> {
+            Ok(AnalyticBsdf::new(
+                AnalyticModel::with_variant(f, facet, variant)?,
+                None,
+            ))
+        };
         Ok(TwoFaced {
-            front: model(fabric),
-            back: model(&back),
+            front: model(fabric)?,
+            back: model(&back)?,
             rest: Rest::new(
                 RayTracer::two_faced(fabric, facet),
                 facet == FacetModel::Lewis,

@@ -35,7 +35,8 @@ fn check_copies(name: &str, bounces: u32) {
     let syms = symmetries(&f);
     assert!(!syms.is_empty(), "{name} should have a symmetry");
     assert!(evaluated < small().len(), "{name}: no cell was copied");
-    let m = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Refined);
+    let m = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Refined)
+        .expect("the variant takes the period");
     let sec = (bounces == 2).then(SecondaryOptions::default);
     let g = small();
     let eval = |ti, pi, to, po| {

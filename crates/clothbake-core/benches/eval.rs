@@ -72,7 +72,8 @@ fn analytic(c: &mut Criterion) {
     // The variants side by side, one pair at a time (docs/science/model.md, "The sliced variant" and
     // "The sliced3d variant").
     for variant in [Variant::Refined, Variant::Sliced, Variant::Sliced3d] {
-        let m = AnalyticModel::with_variant(&fabric, FacetModel::Huo, variant);
+        let m = AnalyticModel::with_variant(&fabric, FacetModel::Huo, variant)
+            .expect("the variant takes the period");
         c.bench_function(
             &format!("analytic_variant/twill/{}/random", variant.name()),
             |b| {

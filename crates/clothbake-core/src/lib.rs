@@ -33,8 +33,8 @@ pub use clothbake_fabric::reflection as reflect;
 pub use clothbake_fabric::{fabric, source, weave, wif, yarn};
 
 pub use analytic::{
-    check_variant, AnalyticModel, CellClass, ClassTerms, LocalReflection, SecondaryMethod,
-    SecondaryOptions, Variant, SLICED3D_MAX_CELLS,
+    AnalyticModel, CellClass, ClassTerms, LocalReflection, SecondaryMethod, SecondaryOptions,
+    Variant, VariantError, SLICED3D_MAX_CELLS,
 };
 pub use brdf::{AnalyticBsdf, Component};
 pub use cells::{Cell, CellGrid, PeriodPoint};

@@ -181,8 +181,8 @@ pub fn bake(
         spatial,
     };
     if let Some(v) = settings.variant {
-        clothbake_core::check_variant(&fabric.fabric, v)
-            .map_err(|(problem, fix)| bad("variant", format!("{problem}; {fix}")))?;
+        v.check(&fabric.fabric)
+            .map_err(|e| bad("variant", format!("{e}; {}", e.fix())))?;
     }
     let options = settings
         .options(Naming::Python)

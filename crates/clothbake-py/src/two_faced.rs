@@ -70,9 +70,9 @@ impl PyTwoFaced {
         }
         let facet = facet_model(facet)?;
         let variant = variant_of(variant)?;
-        clothbake_core::check_variant(fabric, variant).map_err(|(problem, fix)| {
-            PyValueError::new_err(format!("variant: {problem}; {fix}"))
-        })?;
+        variant
+            .check(fabric)
+            .map_err(|e| PyValueError::new_err(format!("variant: {e}; {}", e.fix())))?;
         let cloth = TwoFaced::with_grid(fabric, facet, variant, nodes, paths)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         py.detach(|| cloth.prepare());

@@ -109,12 +109,11 @@ impl Shader {
         component: Component,
     ) -> Result<Shader, String> {
         let one_bounce = secondary.is_none();
-        let mut bsdf = AnalyticBsdf::new(
-            AnalyticModel::with_variant(fabric, facet, variant),
-            secondary,
-        )
-        .with_component(component)
-        .ok_or("the secondary reflection's components need two bounces")?;
+        let model = AnalyticModel::with_variant(fabric, facet, variant)
+            .map_err(|e| format!("{e}; {}", e.fix()))?;
+        let mut bsdf = AnalyticBsdf::new(model, secondary)
+            .with_component(component)
+            .ok_or("the secondary reflection's components need two bounces")?;
         if one_bounce {
             if let Some(y) = clothbake_core::point::yarns(fabric, facet) {
                 bsdf = bsdf.with_yarns(y);

@@ -51,6 +51,22 @@ impl From<clothbake_core::FabricError> for CliError {
     }
 }
 
+impl From<clothbake_core::VariantError> for CliError {
+    fn from(e: clothbake_core::VariantError) -> Self {
+        CliError::new(e.to_string(), e.fix())
+    }
+}
+
+impl From<clothbake_bake::two_faced::TwoFacedError> for CliError {
+    fn from(e: clothbake_bake::two_faced::TwoFacedError) -> Self {
+        use clothbake_bake::two_faced::TwoFacedError;
+        match e {
+            TwoFacedError::Back(e) => e.into(),
+            TwoFacedError::Variant(e) => e.into(),
+        }
+    }
+}
+
 impl From<clothbake_loader::TableError> for CliError {
     fn from(e: clothbake_loader::TableError) -> Self {
         table_error(&e)

@@ -76,7 +76,7 @@ pub fn run(args: &EvalArgs) -> Result<String, CliError> {
     let (reflection, raytrace) = match args.method {
         Method::Analytic => {
             let variant = resolve::variant(&args.weave, &fabric, args.model.variant)?;
-            let model = AnalyticModel::with_variant(&fabric, facet, variant);
+            let model = AnalyticModel::with_variant(&fabric, facet, variant)?;
             let coverage = if horizon { 0.0 } else { model.coverage(wo) };
             let at = args.at.map(|p| (p, model.cells().cell_at(p)));
             // With --at the footprint's reflection replaces the period's in the report.

@@ -108,19 +108,21 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
             let secondary = args.bounces.options()?;
             let secondary = (args.bounces.bounces == 2).then_some(secondary);
             let (fabric, facet, variant) = model_of(args, weave)?;
-            let model = AnalyticModel::with_variant(&fabric, facet, variant.into());
+            let model = AnalyticModel::with_variant(&fabric, facet, variant.into())?;
             let variant_name = model.variant().name();
             let analytic = AnalyticBsdf::new(model, secondary);
             let (u_edges, v_edges) = analytic.model().cells().edge_fractions();
             // Full transport: the analytic terms plus the path-traced orders (docs/science/transport.md).
-            let full = (args.bounces.bounces > 2).then(|| {
-                clothbake_bake::transport::FullTransport::new(
-                    &fabric,
-                    facet,
-                    variant.into(),
-                    args.bounces.bounces,
-                )
-            });
+            let full = (args.bounces.bounces > 2)
+                .then(|| {
+                    clothbake_bake::transport::FullTransport::new(
+                        &fabric,
+                        facet,
+                        variant.into(),
+                        args.bounces.bounces,
+                    )
+                })
+                .transpose()?;
             let brdf: &dyn Bsdf = match &full {
                 Some(f) => f,
                 None => &analytic,

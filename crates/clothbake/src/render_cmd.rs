@@ -47,7 +47,7 @@ fn model_shader(weave: &Path, b: &BrdfArgs) -> Result<Shader, CliError> {
             FacetModel::from(b.model.facet),
             variant,
             b.bounces.bounces,
-        );
+        )?;
         return Ok(Shader::new(Box::new(ft)));
     }
     Shader::model(

@@ -23,8 +23,8 @@ use std::path::Path;
 /// period (`clothbake_core::check_variant`: sliced3d's size limit).
 pub fn variant(weave: &Path, fabric: &Fabric, v: impl Into<Variant>) -> Result<Variant, CliError> {
     let v = v.into();
-    clothbake_core::check_variant(fabric, v)
-        .map_err(|(problem, fix)| CliError::new(format!("{}: {problem}", weave.display()), fix))?;
+    v.check(fabric)
+        .map_err(|e| CliError::new(format!("{}: {e}", weave.display()), e.fix()))?;
     Ok(v)
 }
 

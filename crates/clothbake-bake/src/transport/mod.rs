@@ -27,7 +27,7 @@ use crate::orbit::{representative, usable_symmetries};
 use clothbake_core::symmetry::Symmetry;
 use clothbake_core::{
     AnalyticBsdf, AnalyticModel, Bsdf, Fabric, FacetModel, Kernel, Rgb, SecondaryOptions, UnitVec3,
-    Variant,
+    Variant, VariantError,
 };
 use clothbake_loader::Grid;
 use clothbake_truth::RayTracer;
@@ -308,8 +308,14 @@ pub struct FullTransport {
 }
 
 impl FullTransport {
-    /// Full transport of `fabric` with `bounces` (> 2) on the coarse grid [`COARSE`].
-    pub fn new(fabric: &Fabric, facet: FacetModel, variant: Variant, bounces: u32) -> Self {
+    /// Full transport of `fabric` with `bounces` (> 2) on the coarse grid [`COARSE`]; refused
+    /// where the variant does not take the period.
+    pub fn new(
+        fabric: &Fabric,
+        facet: FacetModel,
+        variant: Variant,
+        bounces: u32,
+    ) -> Result<Self, VariantError> {
         FullTransport::with(
             fabric,
             facet,
@@ -324,12 +330,12 @@ impl FullTransport {
         facet: FacetModel,
         variant: Variant,
         multiple: Arc<Multiple>,
-    ) -> Self {
+    ) -> Result<Self, VariantError> {
         let model = AnalyticBsdf::new(
-            AnalyticModel::with_variant(fabric, facet, variant),
+            AnalyticModel::with_variant(fabric, facet, variant)?,
             multiple.control(),
         );
-        FullTransport { model, multiple }
+        Ok(FullTransport { model, multiple })
     }
 }
 

@@ -172,7 +172,8 @@ mod tests {
         let mut rng = Rng::new(11);
         for name in ["twill.json", "gingham.wif"] {
             let f = Fabric::from_path(&dir.join(name)).expect(name);
-            let plain = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d);
+            let plain = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d)
+                .expect("the variant takes the period");
             let mut dirs: Vec<UnitVec3> = (0..10).map(|_| random_direction(&mut rng)).collect();
             let kept = dirs[..7].to_vec();
             dirs.push(UnitVec3::from_degrees(95.0, 30.0));
@@ -211,7 +212,8 @@ mod tests {
         }
         // The wrong arcs kept: the values follow them.
         let f = Fabric::from_path(&dir.join("twill.json")).expect("twill");
-        let plain = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d);
+        let plain = AnalyticModel::with_variant(&f, FacetModel::Huo, Variant::Sliced3d)
+            .expect("the variant takes the period");
         let (a, b) = (
             UnitVec3::from_degrees(70.0, 20.0),
             UnitVec3::from_degrees(60.0, 200.0),
@@ -227,10 +229,12 @@ mod tests {
         let wider = twill.replace("\"spacing\": 3.1", "\"spacing\": 3.3");
         assert_ne!(wider, twill);
         let wider = Fabric::from_json_str(&wider, "wider.json").expect("wider twill");
-        let wider = AnalyticModel::with_variant(&wider, FacetModel::Huo, Variant::Sliced3d);
+        let wider = AnalyticModel::with_variant(&wider, FacetModel::Huo, Variant::Sliced3d)
+            .expect("the variant takes the period");
         assert_eq!(wider.open_arc_slices(), plain.open_arc_slices());
         let satin = Fabric::from_path(&dir.join("satin5.json")).expect("satin");
-        let satin = AnalyticModel::with_variant(&satin, FacetModel::Huo, Variant::Sliced3d);
+        let satin = AnalyticModel::with_variant(&satin, FacetModel::Huo, Variant::Sliced3d)
+            .expect("the variant takes the period");
         let mut model = plain.clone();
         model.keep_open_arcs([wider.open_arcs(a), satin.open_arcs(a)]);
         assert_eq!(model.open_arcs_kept(), 0);

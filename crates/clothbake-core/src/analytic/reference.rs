@@ -409,7 +409,8 @@ mod tests {
                 (FacetModel::Huo, Variant::Thesis),
                 (FacetModel::Lewis, Variant::Refined),
             ] {
-                let m = AnalyticModel::with_variant(fabric, facet, variant);
+                let m = AnalyticModel::with_variant(fabric, facet, variant)
+                    .expect("the variant takes the period");
                 let n = if facet == FacetModel::Lewis {
                     100
                 } else {
