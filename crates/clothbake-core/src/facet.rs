@@ -4,9 +4,9 @@
 //! reflected radiance: I = pi f(l, e) (n.l) for a facet BRDF f. It is split into a part that
 //! scales with the diffuse albedo (returned without the albedo) and a specular part (white).
 
-use crate::lanes::Real;
 use crate::vec3::Vec3;
 use crate::yarn::Material;
+pub use clothbake_point::facet::CosineFacet;
 
 /// The intensity a facet reflects: `diffuse` times the RGB albedo, plus `specular`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -36,7 +36,7 @@ pub fn intensity_cos(model: FacetModel, m: &Material, nl: f64, ne: f64, le: f64)
     }
     FacetIntensity {
         diffuse: nl,
-        specular: CosineFacet::new(model, m).specular(nl, ne, le),
+        specular: cosine_facet(model, m).specular(nl, ne, le),
     }
 }
 
@@ -46,98 +46,17 @@ impl Facet for FacetModel {
     }
 }
 
-/// The specular term of a facet model bound to one material, from cosines: the one place of the
-/// facet formulas. Huo (eq. 4.8): rho_s (N.H)^n with N.H = (N.L + N.E) / |L + E| and
-/// |L + E|^2 = 2 + 2 L.E. Lewis: rho_s (n + 2) / 2 (R.E)^n N.L with R.E = 2 (N.L)(N.E) - L.E.
-/// Built once per material so that loops evaluating it many times skip the set-up.
-#[derive(Clone, Copy, Debug)]
-pub struct CosineFacet {
-    model: FacetModel,
-    /// rho_s (Huo) or rho_s (n + 2) / 2 (Lewis).
-    scale: f64,
-    power: Power,
+/// The specular term of `model` bound to material `m` ([`CosineFacet`], the one place of the
+/// formulas, in clothbake-point: the point level shares it).
+pub fn cosine_facet(model: FacetModel, m: &Material) -> CosineFacet {
+    CosineFacet::new(point_facet(model), m.specular, m.exponent)
 }
 
-/// x^n: square-and-multiply for integer 0 <= n <= 64 (several times faster than `powf`, which
-/// the hot loops of the secondary reflection feel), `powf` otherwise.
-#[derive(Clone, Copy, Debug)]
-enum Power {
-    Int(u32),
-    Real(f64),
-}
-
-impl Power {
-    fn new(n: f64) -> Power {
-        if n.fract() == 0.0 && (0.0..=64.0).contains(&n) {
-            Power::Int(n as u32)
-        } else {
-            Power::Real(n)
-        }
-    }
-
-    #[inline(always)]
-    fn of<T: Real>(self, x: T) -> T {
-        match self {
-            Power::Int(n) => {
-                let (mut acc, mut base, mut k) = (T::splat(1.0), x, n);
-                while k > 0 {
-                    if k & 1 == 1 {
-                        acc = acc * base;
-                    }
-                    base = base * base;
-                    k >>= 1;
-                }
-                acc
-            }
-            Power::Real(n) => x.powf(n),
-        }
-    }
-}
-
-impl CosineFacet {
-    /// The specular term of `model` for material `m`.
-    pub fn new(model: FacetModel, m: &Material) -> CosineFacet {
-        let scale = match model {
-            FacetModel::Huo => m.specular,
-            FacetModel::Lewis => m.specular * 0.5 * (m.exponent + 2.0),
-        };
-        CosineFacet {
-            model,
-            scale,
-            power: Power::new(m.exponent),
-        }
-    }
-
-    /// True when the specular term is zero everywhere (rho_s = 0).
-    pub fn is_zero(&self) -> bool {
-        self.scale == 0.0
-    }
-
-    /// Specular intensity for unit light, from N.L > 0 and N.E > 0 (the caller checks them: the
-    /// term is zero otherwise) and L.E; for one value (`f64`) or two lanes
-    /// ([`crate::lanes::F64x2`]) alike.
-    #[inline(always)]
-    pub fn specular<T: Real>(&self, nl: T, ne: T, le: T) -> T {
-        let scale = T::splat(self.scale);
-        match self.model {
-            FacetModel::Huo => {
-                // (N.H)^2 = (N.L + N.E)^2 / (2 + 2 L.E): an even integer exponent needs no
-                // square root. |L + E| = 0 (L = -E) gives 0.
-                let two = T::splat(2.0);
-                let hh = two + two * le;
-                let s = nl + ne;
-                let nh2 = (s * s / hh.max(T::splat(f64::MIN_POSITIVE))).min(T::splat(1.0));
-                let v = match self.power {
-                    Power::Int(n) if n % 2 == 0 => scale * Power::Int(n / 2).of(nh2),
-                    p => scale * p.of(nh2.sqrt()),
-                };
-                v.where_positive(hh)
-            }
-            FacetModel::Lewis => {
-                let re = (T::splat(2.0) * nl * ne - le).max(T::splat(0.0));
-                scale * self.power.of(re) * nl
-            }
-        }
+/// The point level's name of a facet model.
+pub fn point_facet(model: FacetModel) -> clothbake_point::Facet {
+    match model {
+        FacetModel::Huo => clothbake_point::Facet::Huo,
+        FacetModel::Lewis => clothbake_point::Facet::Lewis,
     }
 }
 

@@ -8,62 +8,9 @@
 
 use std::ops::{Add, Div, Mul, Sub};
 
-/// The arithmetic of the facet terms, for `f64` and [`F64x2`].
-pub trait Real:
-    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
-{
-    /// Every lane `x`.
-    fn splat(x: f64) -> Self;
-    /// Square root per lane.
-    fn sqrt(self) -> Self;
-    /// Lane-wise minimum (`o` where either is NaN).
-    fn min(self, o: Self) -> Self;
-    /// Lane-wise maximum (`o` where either is NaN).
-    fn max(self, o: Self) -> Self;
-    /// `self` where `cond > 0`, else 0 (also for a NaN `cond`).
-    fn where_positive(self, cond: Self) -> Self;
-    /// `self^n` per lane (`powf`).
-    fn powf(self, n: f64) -> Self;
-}
-
-impl Real for f64 {
-    #[inline(always)]
-    fn splat(x: f64) -> Self {
-        x
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        f64::sqrt(self)
-    }
-    #[inline(always)]
-    fn min(self, o: Self) -> Self {
-        if self < o {
-            self
-        } else {
-            o
-        }
-    }
-    #[inline(always)]
-    fn max(self, o: Self) -> Self {
-        if self > o {
-            self
-        } else {
-            o
-        }
-    }
-    #[inline(always)]
-    fn where_positive(self, cond: Self) -> Self {
-        if cond > 0.0 {
-            self
-        } else {
-            0.0
-        }
-    }
-    #[inline(always)]
-    fn powf(self, n: f64) -> Self {
-        f64::powf(self, n)
-    }
-}
+/// The number type of the facet formulas ([`clothbake_point::facet::Real`]), implemented here
+/// for the lanes.
+pub use clothbake_point::facet::Real;
 
 #[cfg(target_arch = "x86_64")]
 mod imp {

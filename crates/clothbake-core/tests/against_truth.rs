@@ -1,7 +1,8 @@
 //! The model's pieces held against the ground truth's independent ones: the facet terms, the
 //! placement of the yarns and the second bounce. Each is a cross-check, not a definition: a
 //! disagreement is a bug in one of the two. The truth (clothbake-truth) is only a
-//! dev-dependency of the model, so these live here, outside both crates' code.
+//! dev-dependency of the model, so these live here, outside both crates' code. The facet terms
+//! are the point level's too (clothbake_point::facet holds the one formula).
 
 use clothbake_bsdf::rng::Rng;
 use clothbake_core::facet::{Facet, FacetModel};
@@ -64,6 +65,21 @@ fn agree_with_the_models_facets() {
                 (a.specular - b.specular).abs() < 1e-12 * (1.0 + b.specular),
                 "{mine:?} {n:?} {l:?} {e:?}: {a:?} vs {b:?}"
             );
+            // The point level's terms are the same formula (clothbake_point::facet): the truth's
+            // copy holds them too, per channel.
+            let finish = clothbake_point::Finish {
+                albedo: f.albedo,
+                specular: f.specular,
+                exponent,
+            };
+            let p = clothbake_core::facet::point_facet(model).intensity(&finish, n, l, e);
+            for (k, got) in p.iter().enumerate() {
+                let want = a.diffuse * f.albedo[k] + a.specular;
+                assert!(
+                    (got - want).abs() < 1e-12 * (1.0 + want),
+                    "{mine:?} point level: {p:?} vs {a:?}"
+                );
+            }
             both += usize::from(a.specular > 0.0);
         }
     }

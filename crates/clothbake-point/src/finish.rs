@@ -4,10 +4,10 @@
 //! * Huo (thesis eqs 4.6, 4.8): I = rho_d N.L + rho_s (N.H)^n, H = (L + E) / |L + E|;
 //! * Lewis's modified Phong: I = rho_d N.L + rho_s (n + 2) / 2 (R.E)^n N.L, R = 2 (N.L) N - L.
 //!
-//! Both are zero unless the point faces the light and the eye. This crate ships to renderers
-//! without the model, so it carries the two formulas itself; a test in clothbake-core holds
-//! them against the model's `facet` module.
+//! Both are zero unless the point faces the light and the eye. The specular terms are
+//! [`crate::facet`]'s, the formulas the analytic model evaluates too.
 
+use crate::facet::CosineFacet;
 use clothbake_bsdf::{Rgb, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -50,45 +50,17 @@ impl Finish {
     }
 }
 
-/// `x^n` for x in [0, 1]: `powi` for a whole n (the shipped exponents), `powf` otherwise.
-#[inline]
-fn power(x: f64, n: f64) -> f64 {
-    if n.fract() == 0.0 && n <= f64::from(i32::MAX) {
-        x.powi(n as i32)
-    } else {
-        x.powf(n)
-    }
-}
-
 impl Facet {
     /// The intensity a facet of unit normal `n` reflects toward the unit `e` for unit light
-    /// from the unit `l`, RGB: the albedo times N.L plus the specular term; zero unless
-    /// N.L > 0 and N.E > 0.
+    /// from the unit `l`, RGB: the albedo times N.L plus the specular term
+    /// ([`CosineFacet`], the model's own formula); zero unless N.L > 0 and N.E > 0.
     #[inline]
     pub fn intensity(self, f: &Finish, n: Vec3, l: Vec3, e: Vec3) -> Rgb {
         let (nl, ne) = (n.dot(l), n.dot(e));
         if nl <= 0.0 || ne <= 0.0 {
             return [0.0; 3];
         }
-        let s = if f.specular == 0.0 {
-            0.0
-        } else {
-            match self {
-                Facet::Huo => {
-                    let h = l + e;
-                    let len = h.length();
-                    if len > 0.0 {
-                        f.specular * power((n.dot(h) / len).clamp(0.0, 1.0), f.exponent)
-                    } else {
-                        0.0
-                    }
-                }
-                Facet::Lewis => {
-                    let re = (n * (2.0 * nl) - l).dot(e).clamp(0.0, 1.0);
-                    f.specular * 0.5 * (f.exponent + 2.0) * power(re, f.exponent) * nl
-                }
-            }
-        };
+        let s = CosineFacet::new(self, f.specular, f.exponent).specular(nl, ne, l.dot(e));
         f.albedo.map(|a| a * nl + s)
     }
 }
@@ -120,16 +92,5 @@ mod tests {
         // Facing away from the light or the eye: nothing.
         assert_eq!(Facet::Huo.intensity(&f, n, d(95.0), e), [0.0; 3]);
         assert_eq!(Facet::Lewis.intensity(&f, n, l, d(-91.0)), [0.0; 3]);
-    }
-
-    #[test]
-    fn whole_powers_agree_with_powf() {
-        for n in 0..=40 {
-            for x in [0.0, 0.3, 0.99, 1.0] {
-                let (a, b) = (power(x, n as f64), f64::powf(x, n as f64));
-                assert!((a - b).abs() <= 1e-13 * b.max(1e-300), "{x}^{n}");
-            }
-        }
-        assert_eq!(power(0.5, 2.5), 0.5f64.powf(2.5));
     }
 }

@@ -18,6 +18,7 @@
 //! ray. Frame as everywhere in clothbake: +X weft, +Y warp, +Z normal; `wi` toward the light,
 //! `wo` toward the eye.
 
+pub mod facet;
 mod finish;
 mod grid;
 mod period;

@@ -263,8 +263,8 @@ impl<'a> OverC2<'a> {
             endless,
             whole: 0.0,
             facets: (
-                CosineFacet::new(pair.facet, &pair.m1),
-                CosineFacet::new(pair.facet, &pair.m2),
+                crate::facet::cosine_facet(pair.facet, &pair.m1),
+                crate::facet::cosine_facet(pair.facet, &pair.m2),
             ),
             shared,
             own_rule,
