@@ -4,6 +4,10 @@
 //! A unit's constants are read from a [`UnitLanes`], lane by lane: one unit in every lane when
 //! the lanes hold four pairs, up to four units when they hold one pair's units. Either way each
 //! lane does the scalar arithmetic of its own pair and unit.
+//!
+//! One file of 1,270 lines on purpose: it is the crate's one file of AVX2 intrinsics, each
+//! function the lane form of a scalar one in `evaluate.rs`, and it is read and reviewed as a
+//! whole against them (the lanes' tests hold every lane to the scalar bits).
 
 use crate::analytic::{AnalyticModel, ClassTerms, SliceSums, Sums, Unit, Variant, EPS};
 use crate::lanes::{F64x4 as F, Mask4 as M};
