@@ -3,7 +3,7 @@
 //! cell, the averaged part against the averaged bake, footprints against the average, and the
 //! table through both file formats.
 
-use clothbake_bake::{bake, BakeOptions};
+use clothbake_bake::{bake, BakeBounces, BakeOptions};
 use clothbake_core::{AnalyticModel, Cell, Fabric, FacetModel, SecondaryOptions, UnitVec3};
 use clothbake_loader::{Brdf, Grid, Options, Table};
 use clothbake_tests::fixtures::{grid, tables};
@@ -26,7 +26,7 @@ fn baked_with(f: &Fabric, spatial: bool, bounces: u32) -> Table {
     let opts = BakeOptions {
         grid: table_grid(),
         spatial,
-        bounces,
+        bounces: BakeBounces::of(bounces, Default::default()),
         ..BakeOptions::default()
     };
     bake(f, &opts, &|_| {}, &AtomicBool::new(false))

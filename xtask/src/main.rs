@@ -356,7 +356,7 @@ fn bench_bake(bounces_2: bool) {
     );
     if bounces_2 {
         let opts = BakeOptions {
-            bounces: 2,
+            bounces: clothbake_bake::BakeBounces::Two(Default::default()),
             ..BakeOptions::default()
         };
         let (t, evaluated) = timed_bake(&f, &opts, cores);

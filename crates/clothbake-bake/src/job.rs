@@ -517,7 +517,7 @@ pub fn check_memory(
             crate::sweep::Method::Analytic { variant } => variant,
             crate::sweep::Method::Raytrace { .. } => Default::default(),
         };
-        let two = job.options.bounces == 2;
+        let two = job.options.bounces.count() == 2;
         let k = clothbake_core::AnalyticModel::with_variant(job.fabric, job.options.facet, variant)
             .map_err(|e| invalid(e, e.fix()))?
             .classes_with(two) as u64;
@@ -527,7 +527,7 @@ pub fn check_memory(
     };
     // A sliced3d model's open arcs kept for the grid's directions (`with_grid_arcs`): at most
     // their budget.
-    let arcs = match (job.options.method, g.faces, job.options.bounces) {
+    let arcs = match (job.options.method, g.faces, job.options.bounces.count()) {
         (
             crate::sweep::Method::Analytic {
                 variant: clothbake_core::Variant::Sliced3d,
@@ -671,7 +671,10 @@ mod tests {
         let budget = crate::sweep::OPEN_ARCS_BUDGET as f64;
         // The need is rounded to a megabyte.
         assert!((more - budget).abs() < 2e6, "{more} more than refined");
-        let three = |o: BakeOptions| BakeOptions { bounces: 3, ..o };
+        let three = |o: BakeOptions| BakeOptions {
+            bounces: crate::sweep::BakeBounces::Paths(3),
+            ..o
+        };
         let more = need(&Job::new(&f, three(sliced3d))) - need(&Job::new(&f, three(refined)));
         assert!(more.abs() < 2e6, "{more} more with three bounces");
     }

@@ -2,7 +2,7 @@
 //! resolved into [`BakeOptions`] by one set of rules, with messages in the caller's spelling
 //! ([`Naming`]).
 
-use crate::sweep::{check_options, BakeOptions, Method, DEFAULT_GRID};
+use crate::sweep::{check_options, BakeBounces, BakeOptions, Method, DEFAULT_GRID};
 use clothbake_core::interreflection::{Orders, Ranges, Sampling, ORDERS_FAST};
 use clothbake_core::{FacetModel, Kernel, SecondaryMethod, SecondaryOptions, Variant};
 use clothbake_loader::{Faces, Grid};
@@ -375,8 +375,7 @@ impl Settings {
             },
             facet: self.facet,
             method,
-            bounces: self.bounces.bounces,
-            secondary,
+            bounces: BakeBounces::of(self.bounces.bounces, secondary),
             spatial: self.spatial,
             paths: self.paths.unwrap_or(crate::two_faced::PATHS),
         };

@@ -64,18 +64,56 @@ pub struct BakeOptions {
     pub facet: FacetModel,
     /// Evaluation method.
     pub method: Method,
-    /// Bounces: 1 (direct reflection I_1 only), 2 (I_1 + the secondary reflection I_2), or more
-    /// (`clothbake_bake::transport::ALL_BOUNCES` for all): I_1 plus the path-traced orders 2 to N
-    /// ([`crate::transport`]).
-    pub bounces: u32,
-    /// How I_2 is computed; used only when `bounces == 2`.
-    pub secondary: SecondaryOptions,
+    /// What the bake adds to the direct reflection, with the settings only that kind has.
+    pub bounces: BakeBounces,
     /// A spatially varying table (docs/science/spatial.md): the classes of the period's cells beside
     /// the average. Analytic model, one or two bounces.
     pub spatial: bool,
     /// A two-faced bake's eye rays per node of its path-traced rest
     /// ([`crate::two_faced::PATHS`] by default); unused by one-faced bakes.
     pub paths: usize,
+}
+
+/// The bounces a bake follows (docs/science/transport.md): each kind carries the settings that
+/// apply to it, so that a bake of one bounce cannot hold second-bounce options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BakeBounces {
+    /// The direct reflection I_1 alone (thesis ch. 4).
+    One,
+    /// I_1 plus the thesis's secondary reflection I_2 (ch. 5), computed as these options say.
+    Two(SecondaryOptions),
+    /// I_1 plus the path-traced orders 2 to N: N > 2, or
+    /// [`ALL_BOUNCES`](crate::transport::ALL_BOUNCES) for every order ([`crate::transport`]).
+    Paths(u32),
+}
+
+impl BakeBounces {
+    /// The kind for a bounce count (1, 2, N > 2 or `ALL_BOUNCES`); `secondary` is used for 2.
+    /// A count of 0 gives `Paths(0)`, which the bake refuses.
+    pub fn of(count: u32, secondary: SecondaryOptions) -> BakeBounces {
+        match count {
+            1 => BakeBounces::One,
+            2 => BakeBounces::Two(secondary),
+            n => BakeBounces::Paths(n),
+        }
+    }
+
+    /// The bounce count: 1, 2, N or `ALL_BOUNCES`.
+    pub fn count(self) -> u32 {
+        match self {
+            BakeBounces::One => 1,
+            BakeBounces::Two(_) => 2,
+            BakeBounces::Paths(n) => n,
+        }
+    }
+
+    /// The secondary reflection's options, with two bounces.
+    pub fn secondary(self) -> Option<SecondaryOptions> {
+        match self {
+            BakeBounces::Two(s) => Some(s),
+            _ => None,
+        }
+    }
 }
 
 impl Default for BakeOptions {
@@ -86,8 +124,7 @@ impl Default for BakeOptions {
             method: Method::Analytic {
                 variant: Variant::default(),
             },
-            bounces: 1,
-            secondary: SecondaryOptions::default(),
+            bounces: BakeBounces::One,
             spatial: false,
             paths: crate::two_faced::PATHS,
         }
@@ -137,13 +174,12 @@ impl BakeOptions {
                 v["caps"] = json!(caps.name());
             }
         }
-        v["bounces"] = json!(self.bounces);
-        if self.bounces > 2 {
-            v["bounces"] = json!(crate::transport::bounces_name(self.bounces));
-            v["transport"] = crate::transport::describe(&self.grid, self.bounces);
+        v["bounces"] = json!(self.bounces.count());
+        if let BakeBounces::Paths(n) = self.bounces {
+            v["bounces"] = json!(crate::transport::bounces_name(n));
+            v["transport"] = crate::transport::describe(&self.grid, n);
         }
-        if self.bounces == 2 {
-            let s = self.secondary;
+        if let BakeBounces::Two(s) = self.bounces {
             let mut sec = match s.method {
                 SecondaryMethod::Analytic { ranges, orders } => json!({
                     "method": "analytic",
@@ -216,7 +252,9 @@ pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
         .validate()
         .map_err(|e| BakeError::Invalid(e.to_string()))?;
     if opts.grid.faces == Faces::Two
-        && (opts.spatial || opts.bounces != 1 || !matches!(opts.method, Method::Analytic { .. }))
+        && (opts.spatial
+            || opts.bounces != BakeBounces::One
+            || !matches!(opts.method, Method::Analytic { .. }))
     {
         return Err(BakeError::Invalid(
             "--faces two bakes the two-faced cloth's model (docs/science/transmission.md): the analytic \
@@ -231,7 +269,10 @@ pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
             opts.paths
         )));
     }
-    if opts.spatial && (opts.bounces > 2 || !matches!(opts.method, Method::Analytic { .. })) {
+    if opts.spatial
+        && (matches!(opts.bounces, BakeBounces::Paths(_))
+            || !matches!(opts.method, Method::Analytic { .. }))
+    {
         return Err(BakeError::Invalid(
             "--spatial bakes the analytic model's direct and secondary reflection; give \
              --bounces 1 or 2 and --method analytic with --spatial (the path-traced orders of \
@@ -239,7 +280,7 @@ pub fn check_options(opts: &BakeOptions) -> Result<(), BakeError> {
                 .into(),
         ));
     }
-    match (opts.bounces, opts.method) {
+    match (opts.bounces.count(), opts.method) {
         (1, _) | (2.., Method::Analytic { .. }) => Ok(()),
         (2.., Method::Raytrace { .. }) => Err(BakeError::Invalid(
             "the ray tracer bakes the direct reflection only; use --bounces 1 with --method \
@@ -538,10 +579,12 @@ impl Baker {
         check_options(opts)?;
         let g = opts.grid;
         let mut syms = usable_symmetries(fabric, &g);
-        let secondary = (opts.bounces == 2).then_some(opts.secondary);
+        let secondary = opts.bounces.secondary();
         let mut spatial = None;
-        let multiple = (opts.bounces > 2)
-            .then(|| Arc::new(Multiple::new(fabric, opts.facet, &g, opts.bounces)));
+        let multiple = match opts.bounces {
+            BakeBounces::Paths(n) => Some(Arc::new(Multiple::new(fabric, opts.facet, &g, n))),
+            _ => None,
+        };
         let two_faced = match (g.faces, opts.method) {
             (Faces::Two, Method::Analytic { variant }) => Some(Arc::new(
                 TwoFaced::with_grid(
@@ -643,7 +686,7 @@ impl Baker {
             None => Orbits::new(&g, &syms),
         };
         // A spatial table of one bounce carries its period's yarns: its point level.
-        let yarns = (spatial.is_some() && opts.bounces == 1)
+        let yarns = (spatial.is_some() && opts.bounces == BakeBounces::One)
             .then(|| clothbake_core::point::period(fabric, opts.facet))
             .flatten()
             .filter(|p| p.yarns().len() <= clothbake_core::point::TABLE_YARNS);
@@ -798,7 +841,7 @@ mod tests {
         assert_eq!(v["grid"]["n_phi_o"], 64);
         assert!(v.get("secondary").is_none());
         let o = BakeOptions {
-            bounces: 2,
+            bounces: BakeBounces::Two(SecondaryOptions::default()),
             ..BakeOptions::default()
         };
         let v = o.to_json();
@@ -807,11 +850,10 @@ mod tests {
         assert_eq!(v["secondary"]["ranges"], "full");
         assert_eq!(v["secondary"]["orders"]["theta"], Orders::default().theta);
         let o = BakeOptions {
-            bounces: 2,
-            secondary: SecondaryOptions {
+            bounces: BakeBounces::Two(SecondaryOptions {
                 method: SecondaryMethod::Sampling(Sampling::default()),
                 kernel: Kernel::Thesis,
-            },
+            }),
             ..BakeOptions::default()
         };
         let v = o.to_json();
@@ -840,14 +882,14 @@ mod tests {
         for (o, needle) in [
             (
                 BakeOptions {
-                    bounces: 0,
+                    bounces: BakeBounces::Paths(0),
                     ..BakeOptions::default()
                 },
                 "--bounces 1",
             ),
             (
                 BakeOptions {
-                    bounces: 2,
+                    bounces: BakeBounces::Two(SecondaryOptions::default()),
                     method: Method::Raytrace {
                         samples: 1,
                         seed: 1,

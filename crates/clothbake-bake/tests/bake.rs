@@ -1,7 +1,7 @@
 //! The bake library: copied (symmetric) cells equal directly evaluated ones, and the table does
 //! not depend on the number of threads.
 
-use clothbake_bake::{bake, direction, BakeOptions, DEFAULT_GRID};
+use clothbake_bake::{bake, direction, BakeBounces, BakeOptions, DEFAULT_GRID};
 use clothbake_core::symmetry::symmetries;
 use clothbake_core::{AnalyticModel, Fabric, FacetModel, SecondaryOptions, Variant};
 use clothbake_loader::{Grid, Table};
@@ -28,7 +28,7 @@ fn check_copies(name: &str, bounces: u32) {
     let f = fabric(name);
     let o = BakeOptions {
         grid: small(),
-        bounces,
+        bounces: BakeBounces::of(bounces, Default::default()),
         ..BakeOptions::default()
     };
     let (t, evaluated) = bake_on(2, &f, &o);
@@ -108,7 +108,7 @@ fn thread_count_does_not_change_the_table() {
     for bounces in [1, 2] {
         let o = BakeOptions {
             grid: small(),
-            bounces,
+            bounces: BakeBounces::of(bounces, Default::default()),
             ..BakeOptions::default()
         };
         let (a, _) = bake_on(1, &f, &o);

@@ -136,11 +136,11 @@ fn the_multiple_part_is_the_same_for_any_thread_count_and_row_split() {
 
 #[test]
 fn a_full_transport_bake_is_bit_identical_for_any_thread_count_and_row_split() {
-    use clothbake_bake::{bake, BakeOptions, Baker};
+    use clothbake_bake::{bake, BakeBounces, BakeOptions, Baker};
     let f = fabric("twill");
     let o = BakeOptions {
         grid: Grid::new(2, 4, 2, 4),
-        bounces: ALL_BOUNCES,
+        bounces: BakeBounces::Paths(ALL_BOUNCES),
         ..BakeOptions::default()
     };
     let none = AtomicBool::new(false);

@@ -27,7 +27,7 @@ use std::time::{Duration, Instant};
 
 use clothbake_bake::job::{self, Hooks, Job, Target};
 use clothbake_bake::shard::{read_part, ShardId};
-use clothbake_bake::{bake, BakeOptions};
+use clothbake_bake::{bake, BakeBounces, BakeOptions};
 use clothbake_core::Fabric;
 use clothbake_loader::{
     read_table, write_binary, write_exr, Brdf, Grid, Metadata, Options, Precision, Table,
@@ -399,7 +399,7 @@ fn spatial_tables() -> Vec<Table> {
             let opts = BakeOptions {
                 grid: GRID,
                 spatial: true,
-                bounces,
+                bounces: BakeBounces::of(bounces, Default::default()),
                 ..BakeOptions::default()
             };
             bake(&fabric, &opts, &|_| {}, &AtomicBool::new(false))
