@@ -2,7 +2,7 @@
 //! (`--table`, through the loader's lookup) as an RGL `.bsdf` (RGB for Mitsuba 3, spectral for
 //! pbrt-v4 and Mitsuba's spectral variants), a MERL binary, a Klems BSDF XML for daylighting
 //! tools (with the datasheet figures), and/or fitted standard materials
-//! (glTF, MaterialX, USD, Blender: `fitted_cmd`), each written atomically.
+//! (glTF, MaterialX, USD, Blender: `export_fitted`), each written atomically.
 //! Formats and conventions: `docs/guide/export.md`.
 
 use crate::cli::{ExportArgs, Faces};

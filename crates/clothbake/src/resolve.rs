@@ -20,7 +20,7 @@ use std::io::IsTerminal;
 use std::path::Path;
 
 /// The analytic variant `v` for the fabric of `weave`, refused where it does not take the
-/// period (`clothbake_core::check_variant`: sliced3d's size limit).
+/// period (`Variant::check`: sliced3d's size limit).
 pub fn variant(weave: &Path, fabric: &Fabric, v: impl Into<Variant>) -> Result<Variant, CliError> {
     let v = v.into();
     v.check(fabric)

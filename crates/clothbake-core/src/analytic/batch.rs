@@ -4,7 +4,7 @@
 //! ([`AnalyticModel::intensity`]; the terms summed afterwards in the units' and slices' order,
 //! as the scalar evaluation sums them).
 //!
-//! Each function in `avx2.rs` is the lane form of the scalar one in `analytic.rs`, `arc.rs` or
+//! Each function in `avx2.rs` is the lane form of the scalar one in `evaluate.rs`, `arc.rs` or
 //! `shadowing.rs` it names, with the same arithmetic in the same order: branches become
 //! selects (both sides computed, each lane keeping its own), a table's active occluder is
 //! chosen by a chain of selects over the table's entries, and terms a lane skips add an exact

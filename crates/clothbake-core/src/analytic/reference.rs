@@ -1,7 +1,7 @@
 //! Test oracle: the direct model as evaluated before issue 22's speed work, kept verbatim in its
 //! straightforward form (every angle from the standard library's `atan2`/`asin`, every arc end's
 //! sine and cosine from `sin`/`cos`, nothing hoisted out of the per-unit loop). The fast path in
-//! `analytic.rs`, `arc.rs` and `shadowing.rs` must agree with it to 1e-6 relative on every
+//! `analytic/`, `arc.rs` and `shadowing.rs` must agree with it to 1e-6 relative on every
 //! shipped fabric (the test at the end).
 
 use super::{frame, meet, overlap, AnalyticModel, Unit, Variant, EPS};
