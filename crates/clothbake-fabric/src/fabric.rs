@@ -266,11 +266,11 @@ impl Fabric {
         weft: YarnGroup,
         naming: &dyn Naming,
     ) -> Result<Fabric, FabricError> {
-        check_period(weave.n_warp(), weave.n_weft()).map_err(|(problem, fix)| FabricError {
+        check_period(weave.n_warp(), weave.n_weft()).map_err(|e| FabricError {
             file: naming.file().to_string(),
             field: naming.field(Group::Warp, Field::Pattern, 0),
-            problem,
-            fix,
+            problem: e.to_string(),
+            fix: e.fix(),
         })?;
         let fabric = Fabric {
             name,
@@ -723,31 +723,80 @@ impl Fabric {
     }
 }
 
-/// Whether a period of `columns` warp threads by `rows` weft threads is within [`MAX_THREADS`]
-/// and [`MAX_CELLS`]; else what is wrong and how to fix it.
-pub fn check_period(columns: usize, rows: usize) -> Result<(), (String, String)> {
-    let fix = format!(
-        "give one repeat of the weave, at most {MAX_THREADS} threads per group and {MAX_CELLS} cells (docs/reference/limits.md)"
-    );
-    if columns > MAX_THREADS || rows > MAX_THREADS {
-        let (n, what) = if columns > MAX_THREADS {
-            (columns, "warp threads (columns)")
-        } else {
-            (rows, "weft threads (rows)")
-        };
-        return Err((
-            format!("the period has {n} {what}, more than the {MAX_THREADS} clothbake takes"),
-            fix,
-        ));
-    }
-    let cells = columns * rows;
-    if cells > MAX_CELLS {
-        return Err((
-            format!(
-                "the period has {columns} x {rows} = {cells} cells, more than the {MAX_CELLS} clothbake takes"
+/// A period larger than clothbake takes ([`check_period`]): the message says what, [`fix`]
+/// what to do.
+///
+/// [`fix`]: PeriodTooLarge::fix
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PeriodTooLarge {
+    /// More than [`MAX_THREADS`] threads of one group.
+    Threads {
+        /// The group with too many.
+        group: Group,
+        /// Its threads.
+        count: usize,
+    },
+    /// More than [`MAX_CELLS`] crossings.
+    Cells {
+        /// Warp threads (columns).
+        columns: usize,
+        /// Weft threads (rows).
+        rows: usize,
+    },
+}
+
+impl fmt::Display for PeriodTooLarge {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            PeriodTooLarge::Threads { group, count } => {
+                let what = match group {
+                    Group::Warp => "warp threads (columns)",
+                    Group::Weft => "weft threads (rows)",
+                };
+                write!(
+                    f,
+                    "the period has {count} {what}, more than the {MAX_THREADS} clothbake takes"
+                )
+            }
+            PeriodTooLarge::Cells { columns, rows } => write!(
+                f,
+                "the period has {columns} x {rows} = {} cells, more than the {MAX_CELLS} clothbake \
+                 takes",
+                columns * rows
             ),
-            fix,
-        ));
+        }
+    }
+}
+
+impl std::error::Error for PeriodTooLarge {}
+
+impl PeriodTooLarge {
+    /// What to do instead.
+    pub fn fix(&self) -> String {
+        format!(
+            "give one repeat of the weave, at most {MAX_THREADS} threads per group and {MAX_CELLS} \
+             cells (docs/reference/limits.md)"
+        )
+    }
+}
+
+/// Whether a period of `columns` warp threads by `rows` weft threads is within [`MAX_THREADS`]
+/// and [`MAX_CELLS`].
+pub fn check_period(columns: usize, rows: usize) -> Result<(), PeriodTooLarge> {
+    if columns > MAX_THREADS {
+        return Err(PeriodTooLarge::Threads {
+            group: Group::Warp,
+            count: columns,
+        });
+    }
+    if rows > MAX_THREADS {
+        return Err(PeriodTooLarge::Threads {
+            group: Group::Weft,
+            count: rows,
+        });
+    }
+    if columns * rows > MAX_CELLS {
+        return Err(PeriodTooLarge::Cells { columns, rows });
     }
     Ok(())
 }
@@ -892,6 +941,42 @@ pub fn thesis_twill() -> Fabric {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn periods_beyond_the_limits_are_refused() {
+        assert!(check_period(1024, 1024).is_ok());
+        assert!(check_period(MAX_THREADS, 16).is_ok());
+        let e = check_period(MAX_THREADS + 1, 1).unwrap_err();
+        assert_eq!(
+            e,
+            PeriodTooLarge::Threads {
+                group: Group::Warp,
+                count: MAX_THREADS + 1
+            }
+        );
+        assert!(e.to_string().contains("65537 warp threads"), "{e}");
+        assert!(e.fix().contains("docs/reference/limits.md"), "{}", e.fix());
+        let e = check_period(16, MAX_THREADS + 1).unwrap_err();
+        assert!(e.to_string().contains("65537 weft threads (rows)"), "{e}");
+        let e = check_period(1025, 1024).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains(&format!("1049600 cells, more than the {MAX_CELLS}")),
+            "{e}"
+        );
+        // The one constructor refuses such a period, naming the field, before any work on it.
+        let rows = vec![vec![true, false]; MAX_CELLS / 2 + 1];
+        let e = Fabric::from_json_str(
+            &format!(
+                r#"{{"pattern": {:?}, "warp": {{"radius": 1, "spacing": 2}}, "weft": {{"radius": 1, "spacing": 2}}}}"#,
+                rows.iter().map(|r| r.iter().map(|&b| b as u8).collect::<Vec<_>>()).collect::<Vec<_>>()
+            ),
+            "big.json",
+        )
+        .unwrap_err();
+        assert_eq!(e.field, "pattern");
+        assert!(e.problem.contains("weft threads (rows)"), "{e}");
+    }
 
     const OK: &str = r#"{"pattern": [[1,0],[0,1]],
         "warp": {"radius": 1.5, "spacing": 3.1},

@@ -575,33 +575,6 @@ mod tests {
         }
     }
 
-    #[test]
-    fn periods_beyond_the_limits_are_refused() {
-        use crate::fabric::{check_period, MAX_CELLS, MAX_THREADS};
-        assert!(check_period(1024, 1024).is_ok());
-        assert!(check_period(MAX_THREADS, 16).is_ok());
-        let (problem, fix) = check_period(MAX_THREADS + 1, 1).unwrap_err();
-        assert!(problem.contains("65537 warp threads"), "{problem}");
-        assert!(fix.contains("docs/reference/limits.md"), "{fix}");
-        let (problem, _) = check_period(1025, 1024).unwrap_err();
-        assert!(
-            problem.contains(&format!("1049600 cells, more than the {MAX_CELLS}")),
-            "{problem}"
-        );
-        // The one constructor refuses such a period, naming the field, before any work on it.
-        let rows = vec![vec![true, false]; MAX_CELLS / 2 + 1];
-        let e = Fabric::from_json_str(
-            &format!(
-                r#"{{"pattern": {:?}, "warp": {{"radius": 1, "spacing": 2}}, "weft": {{"radius": 1, "spacing": 2}}}}"#,
-                rows.iter().map(|r| r.iter().map(|&b| b as u8).collect::<Vec<_>>()).collect::<Vec<_>>()
-            ),
-            "big.json",
-        )
-        .unwrap_err();
-        assert_eq!(e.field, "pattern");
-        assert!(e.problem.contains("weft threads (rows)"), "{e}");
-    }
-
     /// One pair's units (or slices) in AVX2 lanes (`intensity`) and four pairs in lanes
     /// (`intensity_batch`) give the bits of the unit-by-unit evaluation, on every shipped
     /// fabric and draft, every variant, random pairs with the edge pairs (the pole, the symmetry

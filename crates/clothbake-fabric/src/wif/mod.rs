@@ -748,12 +748,12 @@ pub fn parse(text: &str, file: &str, opts: &WifOptions) -> Result<Fabric, WifErr
             && row[a] == row[b]
             && (0..px).all(|i| over(i, a) == over(i, b))
     });
-    check_period(px, py).map_err(|(problem, fix)| {
+    check_period(px, py).map_err(|e| {
         d.err(
             "WARP",
             d.section("WARP").map(|s| s.line),
-            format!("the draft's repeat is {px} ends x {py} picks: {problem}"),
-            fix,
+            format!("the draft's repeat is {px} ends x {py} picks: {e}"),
+            e.fix(),
         )
     })?;
     let rows: Vec<Vec<bool>> = (0..py)
