@@ -468,3 +468,68 @@ fn a_grid_that_does_not_fit_in_memory_is_refused_up_front() {
         assert_eq!(listing(&d), ["big.shard"]);
     }
 }
+
+/// Issue 53, problem 4: a large specular exponent with `--bounces 2` aborted ("memory
+/// allocation of 743612802624 bytes failed", exit 134) from about 1e17 up, from the option and
+/// from a fabric file. Every exponent the fabric schema takes now runs, in bounded memory: eval
+/// (both facets), a bake (which leaves no lock) and a fabric file at 1e300.
+#[test]
+fn a_large_exponent_with_two_bounces_runs() {
+    let d = fresh_dir("exponent");
+    let i2 = |out: &Output| -> f64 {
+        let s = succeeds(out);
+        // The row `I_2  R G B` (not the header line `I_2 by ...`).
+        s.lines()
+            .filter(|l| l.starts_with("I_2 "))
+            .find_map(|l| l.split_whitespace().nth(1)?.parse().ok())
+            .unwrap_or_else(|| panic!("{s}"))
+    };
+    for facet in ["huo", "lewis"] {
+        let out = run_in(
+            &d,
+            &[
+                "eval",
+                "--weave",
+                "basket",
+                "--exponent",
+                "1e20",
+                "--bounces",
+                "2",
+                "--wi",
+                "30,0",
+                "--wo",
+                "45,180",
+                "--facet",
+                facet,
+            ],
+        );
+        let v = i2(&out);
+        assert!(v.is_finite() && v > 0.0, "{facet}: I_2 {v}");
+    }
+    let json = std::fs::read_to_string(fabric("basket")).unwrap();
+    let big = json.replace("\"exponent\": 10", "\"exponent\": 1e300");
+    assert_ne!(big, json);
+    std::fs::write(d.join("big.json"), big).unwrap();
+    let out = run_in(
+        &d,
+        &[
+            "eval",
+            "--weave",
+            "big.json",
+            "--bounces",
+            "2",
+            "--wi",
+            "30,0",
+            "--wo",
+            "45,180",
+        ],
+    );
+    assert!(i2(&out).is_finite());
+    succeeds(&bake_in(
+        &d,
+        "basket",
+        RES,
+        &["--exponent", "1e20", "--bounces", "2", "-o", "t.bin", "-q"],
+    ));
+    assert_eq!(listing(&d), ["big.json", "t.bin"]);
+}
