@@ -533,3 +533,105 @@ fn a_large_exponent_with_two_bounces_runs() {
     ));
     assert_eq!(listing(&d), ["big.json", "t.bin"]);
 }
+
+/// Issue 53, problem 1: a fitted export's texture maps (`<stem>.base.png`, `.scalars.png`,
+/// `.tangent.png` beside the MaterialX and USD files) are outputs like the others, checked as
+/// one set before the fit: a map that names the file of another output is refused with and
+/// without --force, naming both, and nothing is written or replaced. A MaterialX and a USD file
+/// of one stem in one folder share their maps, however the folder is spelled.
+#[test]
+fn a_texture_map_that_names_another_output_is_refused_before_the_fit() {
+    let d = fresh_dir("maps");
+    let cases: [(&[&str], &[&str]); 4] = [
+        (
+            &["--gltf", "x.base.png", "--mtlx", "x.mtlx"],
+            &[
+                "x.base.png: cannot write the texture map of x.mtlx",
+                "the glTF file is written to the same file",
+            ],
+        ),
+        (
+            &["--blender", "x.tangent.png", "--usd", "x.usda"],
+            &[
+                "x.tangent.png: cannot write the texture map of x.usda",
+                "the Blender module is written to the same file",
+            ],
+        ),
+        (
+            &[
+                "--rgl",
+                "./x.scalars.png",
+                "--mtlx",
+                "x.mtlx",
+                "--usd",
+                "x.usda",
+            ],
+            &[
+                "x.scalars.png: cannot write the texture map of x.mtlx and x.usda",
+                "the RGL file is written to the same file",
+            ],
+        ),
+        (
+            &["--usd", "a.usda", "--mtlx", "a.base.png"],
+            &[
+                "a.base.png: cannot write the texture map of a.usda",
+                "the MaterialX file is written to the same file",
+            ],
+        ),
+    ];
+    for (outputs, needles) in cases {
+        for force in [false, true] {
+            let mut args = vec!["export", "--weave", "plain"];
+            args.extend_from_slice(outputs);
+            if force {
+                args.push("--force");
+            }
+            let start = std::time::Instant::now();
+            let e = fails_with(&run_in(&d, &args), needles);
+            assert!(e.contains("give each output its own path"), "{e}");
+            assert!(
+                start.elapsed().as_secs() < 3,
+                "{args:?}: refused after the fit"
+            );
+            assert_eq!(listing(&d), Vec::<String>::new(), "{args:?}");
+        }
+    }
+    // An existing file at the map's path is left alone, even with --force.
+    std::fs::write(d.join("x.base.png"), b"mine").unwrap();
+    let out = run_in(
+        &d,
+        &[
+            "export",
+            "--weave",
+            "plain",
+            "--gltf",
+            "x.base.png",
+            "--mtlx",
+            "x.mtlx",
+            "--force",
+        ],
+    );
+    fails_with(
+        &out,
+        &["x.base.png: cannot write the texture map of x.mtlx"],
+    );
+    assert_eq!(std::fs::read(d.join("x.base.png")).unwrap(), b"mine");
+    std::fs::remove_file(d.join("x.base.png")).unwrap();
+    // One stem in one folder, spelled two ways: one set of maps, written once.
+    succeeds(&run_in(
+        &d,
+        &[
+            "export", "--weave", "plain", "--mtlx", "x.mtlx", "--usd", "./x.usda", "-q",
+        ],
+    ));
+    assert_eq!(
+        listing(&d),
+        [
+            "x.base.png",
+            "x.mtlx",
+            "x.scalars.png",
+            "x.tangent.png",
+            "x.usda"
+        ]
+    );
+}
