@@ -240,7 +240,7 @@ fn refuse_existing(args: &ExportArgs) -> Result<(), CliError> {
     .into_iter()
     .filter_map(|(p, what)| Some((p.as_deref()?, what)))
     .collect();
-    outputs.extend(fitted.iter().map(|(p, what)| (p.as_path(), *what)));
+    outputs.extend(fitted.iter().map(|(p, what)| (p.as_path(), what.as_str())));
     let inputs: Vec<&std::path::Path> = [&args.weave, &args.table]
         .into_iter()
         .filter_map(|p| p.as_deref())

@@ -3,6 +3,7 @@
 
 use crate::cli::ExportArgs;
 use crate::error::CliError;
+use clothbake_bake::output::same_file;
 use clothbake_export::fits::Fits;
 use clothbake_export::fitted::material::{Fitted, Source};
 use clothbake_export::fitted::microfacet::Albedos;
@@ -12,10 +13,14 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// The outputs of the fitted targets with what each is, for the existing-file check; the
-/// maps beside the MaterialX and USD files included when the material may be textured.
-pub fn outputs(args: &ExportArgs) -> Vec<(PathBuf, &'static str)> {
-    let mut out: Vec<(PathBuf, &'static str)> = Vec::new();
+/// The outputs of the fitted targets with what each is, for the check of the command's outputs
+/// as one set; the maps beside the MaterialX and USD files included (whether or not the
+/// material turns out textured: that is known only after the fit), each named with the file
+/// that refers to it. Nothing is merged here: a map that names the same file as another output
+/// is a clash the check reports (only the maps that the MaterialX and the USD file share, by
+/// one stem in one folder, are one output: [`map_stems`]).
+pub fn outputs(args: &ExportArgs) -> Vec<(PathBuf, String)> {
+    let mut out: Vec<(PathBuf, String)> = Vec::new();
     for (p, what) in [
         (&args.gltf, "glTF file"),
         (&args.mtlx, "MaterialX file"),
@@ -23,15 +28,17 @@ pub fn outputs(args: &ExportArgs) -> Vec<(PathBuf, &'static str)> {
         (&args.blender, "Blender module"),
     ] {
         if let Some(p) = p {
-            out.push((p.clone(), what));
+            out.push((p.clone(), what.to_string()));
         }
     }
-    for stem in map_stems(args) {
-        for m in openpbr::map_names(&stem.1) {
-            let path = stem.0.join(m);
-            if !out.iter().any(|(p, _)| *p == path) {
-                out.push((path, "texture map"));
-            }
+    for (dir, stem, owners) in map_stems(args) {
+        let of = owners
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" and ");
+        for m in openpbr::map_names(&stem) {
+            out.push((dir.join(m), format!("texture map of {of}")));
         }
     }
     out
@@ -43,14 +50,21 @@ fn stem(p: &Path) -> String {
         .map_or_else(|| "cloth".into(), |s| s.to_string_lossy().into_owned())
 }
 
-/// The folders and stems of the MaterialX and USD outputs (their maps' names).
-fn map_stems(args: &ExportArgs) -> Vec<(PathBuf, String)> {
-    let mut v: Vec<(PathBuf, String)> = Vec::new();
+/// The folders and stems of the MaterialX and USD outputs (their maps' names), with the
+/// outputs that refer to them: one entry for a MaterialX and a USD file of one stem in one
+/// folder, however the folder is spelled (`x.mtlx` and `./x.usda` share their maps).
+fn map_stems(args: &ExportArgs) -> Vec<(PathBuf, String, Vec<PathBuf>)> {
+    let mut v: Vec<(PathBuf, String, Vec<PathBuf>)> = Vec::new();
     for p in [&args.mtlx, &args.usd].into_iter().flatten() {
         let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
         let stem = stem(p);
-        if !v.contains(&(dir.clone(), stem.clone())) {
-            v.push((dir, stem));
+        let probe = dir.join(openpbr::map_names(&stem)[0].as_str());
+        let shared = v
+            .iter_mut()
+            .find(|(d, s, _)| same_file(&d.join(openpbr::map_names(s)[0].as_str()), &probe));
+        match shared {
+            Some((_, _, owners)) => owners.push(p.clone()),
+            None => v.push((dir, stem, vec![p.clone()])),
         }
     }
     v
@@ -137,7 +151,7 @@ pub fn write(
     if want_openpbr {
         let m = &fits.openpbr;
         let maps = (!m.is_uniform()).then(|| openpbr::OpenPbrMaps::new(m));
-        for (dir, stem) in map_stems(args) {
+        for (dir, stem, _) in map_stems(args) {
             if let Some(maps) = &maps {
                 let names = openpbr::map_names(&stem);
                 // MaterialX and USD put texture coordinate (0, 0) at the lower left.

@@ -468,3 +468,170 @@ fn a_grid_that_does_not_fit_in_memory_is_refused_up_front() {
         assert_eq!(listing(&d), ["big.shard"]);
     }
 }
+
+/// Issue 53, problem 4: a large specular exponent with `--bounces 2` aborted ("memory
+/// allocation of 743612802624 bytes failed", exit 134) from about 1e17 up, from the option and
+/// from a fabric file. Every exponent the fabric schema takes now runs, in bounded memory: eval
+/// (both facets), a bake (which leaves no lock) and a fabric file at 1e300.
+#[test]
+fn a_large_exponent_with_two_bounces_runs() {
+    let d = fresh_dir("exponent");
+    let i2 = |out: &Output| -> f64 {
+        let s = succeeds(out);
+        // The row `I_2  R G B` (not the header line `I_2 by ...`).
+        s.lines()
+            .filter(|l| l.starts_with("I_2 "))
+            .find_map(|l| l.split_whitespace().nth(1)?.parse().ok())
+            .unwrap_or_else(|| panic!("{s}"))
+    };
+    for facet in ["huo", "lewis"] {
+        let out = run_in(
+            &d,
+            &[
+                "eval",
+                "--weave",
+                "basket",
+                "--exponent",
+                "1e20",
+                "--bounces",
+                "2",
+                "--wi",
+                "30,0",
+                "--wo",
+                "45,180",
+                "--facet",
+                facet,
+            ],
+        );
+        let v = i2(&out);
+        assert!(v.is_finite() && v > 0.0, "{facet}: I_2 {v}");
+    }
+    let json = std::fs::read_to_string(fabric("basket")).unwrap();
+    let big = json.replace("\"exponent\": 10", "\"exponent\": 1e300");
+    assert_ne!(big, json);
+    std::fs::write(d.join("big.json"), big).unwrap();
+    let out = run_in(
+        &d,
+        &[
+            "eval",
+            "--weave",
+            "big.json",
+            "--bounces",
+            "2",
+            "--wi",
+            "30,0",
+            "--wo",
+            "45,180",
+        ],
+    );
+    assert!(i2(&out).is_finite());
+    succeeds(&bake_in(
+        &d,
+        "basket",
+        RES,
+        &["--exponent", "1e20", "--bounces", "2", "-o", "t.bin", "-q"],
+    ));
+    assert_eq!(listing(&d), ["big.json", "t.bin"]);
+}
+
+/// Issue 53, problem 1: a fitted export's texture maps (`<stem>.base.png`, `.scalars.png`,
+/// `.tangent.png` beside the MaterialX and USD files) are outputs like the others, checked as
+/// one set before the fit: a map that names the file of another output is refused with and
+/// without --force, naming both, and nothing is written or replaced. A MaterialX and a USD file
+/// of one stem in one folder share their maps, however the folder is spelled.
+#[test]
+fn a_texture_map_that_names_another_output_is_refused_before_the_fit() {
+    let d = fresh_dir("maps");
+    let cases: [(&[&str], &[&str]); 4] = [
+        (
+            &["--gltf", "x.base.png", "--mtlx", "x.mtlx"],
+            &[
+                "x.base.png: cannot write the texture map of x.mtlx",
+                "the glTF file is written to the same file",
+            ],
+        ),
+        (
+            &["--blender", "x.tangent.png", "--usd", "x.usda"],
+            &[
+                "x.tangent.png: cannot write the texture map of x.usda",
+                "the Blender module is written to the same file",
+            ],
+        ),
+        (
+            &[
+                "--rgl",
+                "./x.scalars.png",
+                "--mtlx",
+                "x.mtlx",
+                "--usd",
+                "x.usda",
+            ],
+            &[
+                "x.scalars.png: cannot write the texture map of x.mtlx and x.usda",
+                "the RGL file is written to the same file",
+            ],
+        ),
+        (
+            &["--usd", "a.usda", "--mtlx", "a.base.png"],
+            &[
+                "a.base.png: cannot write the texture map of a.usda",
+                "the MaterialX file is written to the same file",
+            ],
+        ),
+    ];
+    for (outputs, needles) in cases {
+        for force in [false, true] {
+            let mut args = vec!["export", "--weave", "plain"];
+            args.extend_from_slice(outputs);
+            if force {
+                args.push("--force");
+            }
+            let start = std::time::Instant::now();
+            let e = fails_with(&run_in(&d, &args), needles);
+            assert!(e.contains("give each output its own path"), "{e}");
+            assert!(
+                start.elapsed().as_secs() < 3,
+                "{args:?}: refused after the fit"
+            );
+            assert_eq!(listing(&d), Vec::<String>::new(), "{args:?}");
+        }
+    }
+    // An existing file at the map's path is left alone, even with --force.
+    std::fs::write(d.join("x.base.png"), b"mine").unwrap();
+    let out = run_in(
+        &d,
+        &[
+            "export",
+            "--weave",
+            "plain",
+            "--gltf",
+            "x.base.png",
+            "--mtlx",
+            "x.mtlx",
+            "--force",
+        ],
+    );
+    fails_with(
+        &out,
+        &["x.base.png: cannot write the texture map of x.mtlx"],
+    );
+    assert_eq!(std::fs::read(d.join("x.base.png")).unwrap(), b"mine");
+    std::fs::remove_file(d.join("x.base.png")).unwrap();
+    // One stem in one folder, spelled two ways: one set of maps, written once.
+    succeeds(&run_in(
+        &d,
+        &[
+            "export", "--weave", "plain", "--mtlx", "x.mtlx", "--usd", "./x.usda", "-q",
+        ],
+    ));
+    assert_eq!(
+        listing(&d),
+        [
+            "x.base.png",
+            "x.mtlx",
+            "x.scalars.png",
+            "x.tangent.png",
+            "x.usda"
+        ]
+    );
+}

@@ -3,8 +3,8 @@
 //! at the maximum reflection point (eqs 5.17-5.19), or adaptively along C1.
 
 use super::axial::{
-    axial_nodes, int_cos2, int_cos3, line_integral, lobe_width, AxialEnd, AxialNodes, Line, Lobe,
-    Parts,
+    axial_capacity, axial_nodes, int_cos2, int_cos3, line_integral, lobe_width, AxialEnd,
+    AxialNodes, Line, Lobe, Parts,
 };
 use super::peak::{peak, peak_in, shift_near};
 use super::rules::{cut_points, graded_panels, share, Orders, Ranges};
@@ -116,14 +116,23 @@ fn live_panels(pair: &Pair, s: &Setting, kinks: &[f64]) -> ([(f64, f64); 20], us
     (live, n_live)
 }
 
+/// The most any scaled order may be: 2^40. The orders are node *budgets* shared by panels in
+/// proportion to their lengths, and every panel's rule has at most [`crate::quad::GL_MAX`]
+/// nodes, so a budget past 2^40 changes only panels thinner than 16 / 2^40 of their range
+/// (none of the rules makes such panels). It is reached beyond an exponent of about 1.5e23
+/// (11 sqrt(n / 15) = 2^40); below that the orders, and so the results, are those of the
+/// unbounded rule. It keeps every size made from an order finite for any exponent the fabric
+/// schema takes (finite, up to 1.8e308).
+pub(super) const MAX_ORDER: usize = 1 << 40;
+
 /// The orders (theta, beta, axial) for the sharper of the two lobes: sharper lobes need more
 /// nodes across C2 and along the axis, so the orders scale by sqrt(n / 15) beyond n = 15 (the
-/// lobe width goes as 1 / sqrt(n)).
-fn scaled_orders(pair: &Pair, orders: Orders) -> (usize, usize, usize) {
+/// lobe width goes as 1 / sqrt(n)), up to [`MAX_ORDER`].
+pub(super) fn scaled_orders(pair: &Pair, orders: Orders) -> (usize, usize, usize) {
     let boost = (pair.m1.exponent.max(pair.m2.exponent) / 15.0)
         .sqrt()
         .max(1.0);
-    let scaled = |o: usize| (o as f64 * boost).ceil() as usize;
+    let scaled = |o: usize| ((o as f64 * boost).ceil() as usize).min(MAX_ORDER);
     (
         scaled(orders.theta),
         scaled(orders.beta),
@@ -248,7 +257,7 @@ impl<'a> OverC2<'a> {
         let own_rule = std::cell::RefCell::new(AxialNodes::with_capacity(if endless {
             0
         } else {
-            4 * nu + 4
+            axial_capacity(nu)
         }));
         let mut c2 = OverC2 {
             pair,

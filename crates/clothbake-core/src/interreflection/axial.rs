@@ -127,6 +127,15 @@ pub(super) fn axial_nodes(
     }
 }
 
+/// Room for the rule [`axial_nodes`] makes for a line of finite extent (plain panels) of
+/// `order`: at most four panels (two lobe centres cut the range, a panel between them is
+/// halved), each of at most [`crate::quad::GL_MAX`] nodes, whatever the order. The order grows
+/// with the exponent (sqrt(n / 15)); sized from it unbounded, this was 4 order + 4 nodes, 744 GB
+/// at n = 1e20.
+pub(super) fn axial_capacity(order: usize) -> usize {
+    4 * order.min(crate::quad::GL_MAX) + 4
+}
+
 /// Width in u = atan(y / D) of a specular lobe of exponent `n` along the axis: a cosine-power
 /// lobe cos^n x falls as exp(-n x^2 / 2), width 1 / sqrt(n) (Lewis, R.E); Huo's N.H holds the
 /// half angle, which doubles it.

@@ -280,6 +280,62 @@ mod tests {
         assert!((r.x * w.z - r.z * w.x).abs() < 1e-9 && r.dot(-w) > 0.0);
     }
 
+    /// Issue 53: the orders grow as sqrt(n / 15) and the rule of a line of finite extent was
+    /// sized from them, 744 GB at n = 1e20 (an abort); past about 1e37 the size overflowed.
+    /// Every exponent the fabric schema takes (finite, >= 0) now gives finite parts with the
+    /// rules' bounded sizes, both facets, both kernels, lines of finite extent and endless.
+    #[test]
+    fn any_exponent_gives_finite_parts_quickly() {
+        let start = std::time::Instant::now();
+        for n in [1e17, 1e20, 1e23, 1e38, 1e300, f64::MAX] {
+            for facet in [FacetModel::Huo, FacetModel::Lewis] {
+                for kernel in [Kernel::Thesis, Kernel::Radiometric] {
+                    let mut pair = pf_pair(kernel, n);
+                    pair.facet = facet;
+                    for (wi, wo) in [((30.0, 0.0), (45.0, 180.0)), ((40.0, 180.0), (35.0, 20.0))] {
+                        for axial in [(-10.0, 10.0), (f64::NEG_INFINITY, f64::INFINITY)] {
+                            let mut s = setting(
+                                UnitVec3::from_degrees(wi.0, wi.1),
+                                UnitVec3::from_degrees(wo.0, wo.1),
+                            );
+                            s.axial = axial;
+                            let v = analytic(&pair, &s, Ranges::Full, Orders::default());
+                            let t = v.total();
+                            assert!(
+                                t.iter().all(|x| x.is_finite() && *x >= 0.0) && t[0] > 0.0,
+                                "n {n:e}, {facet:?}, {kernel:?}, {wi:?} {wo:?}: {t:?}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        // 96 evaluations; a few milliseconds each in a debug build.
+        assert!(start.elapsed().as_secs() < 20, "{:?}", start.elapsed());
+    }
+
+    /// The bound on the orders is reached only past n = 1.5e23, so every exponent that ran
+    /// before keeps its rule (and its results); the axial rule's room is at most 68 nodes.
+    #[test]
+    fn the_orders_bound_leaves_smaller_exponents_alone() {
+        for n in [10.0, 1e4, 1e16, 1e17, 1e23] {
+            let pair = pf_pair(Kernel::Radiometric, n);
+            let boost = (n / 15.0f64).sqrt().max(1.0);
+            let o = Orders::default();
+            let free = |k: usize| (k as f64 * boost).ceil() as usize;
+            assert_eq!(
+                analytic::scaled_orders(&pair, o),
+                (free(o.theta), free(o.beta), free(o.axial)),
+                "n {n:e}"
+            );
+        }
+        let pair = pf_pair(Kernel::Radiometric, 1e300);
+        let m = analytic::MAX_ORDER;
+        assert_eq!(analytic::scaled_orders(&pair, Orders::default()), (m, m, m));
+        assert_eq!(axial::axial_capacity(3), 16);
+        assert_eq!(axial::axial_capacity(m), 68);
+    }
+
     #[test]
     fn analytic_converges_to_two_level_sampling() {
         for kernel in [Kernel::Thesis, Kernel::Radiometric] {
