@@ -3,7 +3,7 @@
 //! Every value (cell and channel) of table A is compared with the same value of table B. A value
 //! is within tolerance when `|a - b| <= abs + rel * |a|`.
 
-use clothbake_loader::{Grid, Table};
+use clothbake_loader::{Faces, Grid, Metadata, Table};
 
 /// Default relative tolerance of `clothbake diff`: about 8 units in the last place of an f32,
 /// so that two bakes of the same model agree even across platforms whose maths libraries round
@@ -165,6 +165,13 @@ impl std::fmt::Display for GridMismatch {
         .iter()
         .filter(|(_, x, y)| x != y)
         .map(|(n, x, y)| format!("{n} {x} vs {y}"))
+        .chain((a.faces != b.faces).then(|| {
+            let name = |f: Faces| match f {
+                Faces::One => "one",
+                Faces::Two => "two",
+            };
+            format!("faces {} vs {}", name(a.faces), name(b.faces))
+        }))
         .collect();
         write!(
             f,
@@ -172,6 +179,121 @@ impl std::fmt::Display for GridMismatch {
             differ.join(", ")
         )
     }
+}
+
+/// What else a table carries that changes what it renders, field by field: one line for each
+/// field of `a` and `b` that differs, naming it and saying how (empty when they agree): the
+/// two-faced cloth's openness, a spatial table's cells, classes, albedos and visible areas, and
+/// the yarns of its point level. The values themselves are [`compare`]'s.
+pub fn carried_differences(a: &Metadata, b: &Metadata) -> Vec<String> {
+    let mut out = Vec::new();
+    let presence = |out: &mut Vec<String>, field: &str, x: bool, y: bool| -> bool {
+        match (x, y) {
+            (true, false) => out.push(format!("{field}: A has it, B has none")),
+            (false, true) => out.push(format!("{field}: B has it, A has none")),
+            _ => return x,
+        }
+        false
+    };
+    if presence(
+        &mut out,
+        "openness",
+        a.openness.is_some(),
+        b.openness.is_some(),
+    ) {
+        let (x, y) = (
+            a.openness.as_deref().unwrap(),
+            b.openness.as_deref().unwrap(),
+        );
+        out.extend(values_differ("openness", x, y, "values"));
+    }
+    if presence(
+        &mut out,
+        "spatial",
+        a.spatial.is_some(),
+        b.spatial.is_some(),
+    ) {
+        let (x, y) = (a.spatial.as_ref().unwrap(), b.spatial.as_ref().unwrap());
+        if x.classes != y.classes {
+            out.push(format!("spatial.classes: {} vs {}", x.classes, y.classes));
+        }
+        if x.secondary != y.secondary {
+            out.push(format!(
+                "spatial.secondary: {} vs {} (the classes hold the second bounce)",
+                x.secondary, y.secondary
+            ));
+        }
+        let f32s = |v: &[f64]| v.iter().map(|&e| e as f32).collect::<Vec<f32>>();
+        out.extend(values_differ(
+            "spatial.u_edges",
+            &f32s(&x.u_edges),
+            &f32s(&y.u_edges),
+            "edges",
+        ));
+        out.extend(values_differ(
+            "spatial.v_edges",
+            &f32s(&x.v_edges),
+            &f32s(&y.v_edges),
+            "edges",
+        ));
+        let classes = |v: &[u32]| v.iter().map(|&c| c as f32).collect::<Vec<f32>>();
+        out.extend(values_differ(
+            "spatial.cell_class",
+            &classes(&x.cell_class),
+            &classes(&y.cell_class),
+            "cells",
+        ));
+        let flat3 = |v: &[[f32; 3]]| v.iter().flatten().copied().collect::<Vec<f32>>();
+        out.extend(values_differ(
+            "spatial.cell_albedo",
+            &flat3(&x.cell_albedo),
+            &flat3(&y.cell_albedo),
+            "values",
+        ));
+        out.extend(values_differ(
+            "spatial.visible",
+            &x.visible,
+            &y.visible,
+            "values",
+        ));
+        let flat6 = |v: &[[[f32; 3]; 2]]| {
+            v.iter()
+                .flat_map(|s| s.iter().flatten())
+                .copied()
+                .collect::<Vec<f32>>()
+        };
+        out.extend(values_differ(
+            "spatial.cell_neighbours",
+            &flat6(&x.cell_neighbours),
+            &flat6(&y.cell_neighbours),
+            "values",
+        ));
+    }
+    if presence(&mut out, "yarns", a.yarns.is_some(), b.yarns.is_some()) && a.yarns != b.yarns {
+        out.push("yarns: the point level's yarns or finishes differ".into());
+    }
+    out
+}
+
+/// `field: N of M <what> differ (max |a - b| D)`, or a count mismatch; `None` when equal (bit
+/// for bit).
+fn values_differ(field: &str, a: &[f32], b: &[f32], what: &str) -> Option<String> {
+    if a.len() != b.len() {
+        return Some(format!("{field}: {} vs {} {what}", a.len(), b.len()));
+    }
+    let (mut n, mut max) = (0usize, 0.0f64);
+    for (&x, &y) in a.iter().zip(b) {
+        if x.to_bits() != y.to_bits() {
+            n += 1;
+            max = max.max((f64::from(x) - f64::from(y)).abs());
+        }
+    }
+    (n > 0).then(|| {
+        format!(
+            "{field}: {n} of {} {what} differ (max |a - b| {max:.3e})",
+            a.len()
+        )
+    })
 }
 
 /// Compares every value of `a` with the same value of `b` (only the averaged RGB values when
@@ -375,5 +497,86 @@ mod tests {
         let e = compare(&a, &b, Tolerance::default()).unwrap_err();
         let s = e.to_string();
         assert!(s.contains("n_theta_i 2 vs 3, n_phi_o 5 vs 6"), "{s}");
+    }
+
+    /// A spatial table of the gingham's period (8 x 8 threads of two colours), one bounce.
+    fn spatial_gingham() -> Table {
+        let f = clothbake_core::Fabric::from_path(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables/gingham.wif"),
+        )
+        .unwrap();
+        let opts = crate::BakeOptions {
+            grid: Grid::new(2, 4, 2, 4),
+            spatial: true,
+            ..crate::BakeOptions::default()
+        };
+        crate::bake(
+            &f,
+            &opts,
+            &|_| {},
+            &std::sync::atomic::AtomicBool::new(false),
+        )
+        .unwrap()
+        .table
+    }
+
+    #[test]
+    fn what_a_table_carries_is_compared_field_by_field() {
+        let a = spatial_gingham();
+        assert!(carried_differences(&a.meta, &a.meta).is_empty());
+        let sp = a.meta.spatial.as_ref().unwrap();
+        assert!(a.meta.yarns.is_some() && sp.classes > 1);
+        // Each field changed alone is named, with how much.
+        let changed = |edit: &dyn Fn(&mut Metadata)| {
+            let mut m = a.meta.clone();
+            edit(&mut m);
+            carried_differences(&a.meta, &m)
+        };
+        let d = changed(&|m| m.spatial.as_mut().unwrap().cell_albedo[3][1] += 0.25);
+        let cells = sp.cell_albedo.len();
+        assert_eq!(
+            d,
+            [format!(
+                "spatial.cell_albedo: 1 of {} values differ (max |a - b| 2.500e-1)",
+                3 * cells
+            )]
+        );
+        let d = changed(&|m| {
+            let s = m.spatial.as_mut().unwrap();
+            s.cell_class[0] = (s.cell_class[0] + 1) % s.classes;
+        });
+        assert!(d[0].starts_with("spatial.cell_class: 1 of "), "{d:?}");
+        let d = changed(&|m| m.spatial.as_mut().unwrap().visible[5] *= 0.5);
+        assert!(d[0].starts_with("spatial.visible: 1 of "), "{d:?}");
+        let d = changed(&|m| m.yarns = None);
+        assert_eq!(d, ["yarns: A has it, B has none"]);
+        let d = changed(&|m| m.spatial = None);
+        assert_eq!(d, ["spatial: A has it, B has none"]);
+        // The two-faced cloth's openness: present in one, and one value of it different.
+        let open = |m: &mut Metadata| m.openness = Some(vec![0.5; 8]);
+        let d = changed(&open);
+        assert_eq!(d, ["openness: B has it, A has none"]);
+        let mut b = a.meta.clone();
+        open(&mut b);
+        let mut c = b.clone();
+        c.openness.as_mut().unwrap()[2] = 1.0;
+        assert_eq!(
+            carried_differences(&b, &c),
+            ["openness: 1 of 8 values differ (max |a - b| 5.000e-1)"]
+        );
+    }
+
+    #[test]
+    fn a_grid_of_another_face_count_is_named() {
+        let one = Grid::new(2, 4, 2, 4);
+        let e = GridMismatch {
+            a: one,
+            b: one.two_faced(),
+        };
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with("different grids (") && msg.contains("faces one vs two"),
+            "{msg}"
+        );
     }
 }

@@ -1,11 +1,13 @@
-//! `clothbake diff A B [--tol REL] [--abs ABS]`: how far apart two tables of the same grid are.
+//! `clothbake diff A B [--tol REL] [--abs ABS]`: how far apart two tables of the same grid are,
+//! in their values and in everything else they carry that changes what they render (the
+//! openness, a spatial table's cells and classes, the yarns: `compare::carried_differences`).
 //!
-//! Exit status: 0 when every value is within `|a - b| <= ABS + REL |a|`, 1 beyond it, 2 when
-//! the tables cannot be compared (unreadable file, different grids).
+//! Exit status: 0 when every value is within `|a - b| <= ABS + REL |a|` and the rest is the
+//! same, 1 otherwise, 2 when the tables cannot be compared (unreadable file, different grids).
 
 use crate::cli::DiffArgs;
 use crate::error::CliError;
-use clothbake_bake::compare::{compare, Tolerance, DEFAULT_ABS, DEFAULT_REL};
+use clothbake_bake::compare::{carried_differences, compare, Tolerance, DEFAULT_ABS, DEFAULT_REL};
 use clothbake_loader::read_table;
 use std::fmt::Write as _;
 
@@ -20,7 +22,7 @@ pub fn run(args: &DiffArgs) -> Result<(String, u8), CliError> {
     let c = compare(&a, &b, tol).map_err(|e| {
         CliError::new(
             format!("{} and {}: {e}", args.a.display(), args.b.display()),
-            "diff compares tables of the same grid: bake both with the same --res",
+            "diff compares tables of the same grid: bake both with the same --res and --faces",
         )
     })?;
     let mut s = String::new();
@@ -54,6 +56,15 @@ pub fn run(args: &DiffArgs) -> Result<(String, u8), CliError> {
             )
         }
     );
+    let carried = carried_differences(&a.meta, &b.meta);
+    if carried.is_empty() {
+        let _ = writeln!(s, "carried    the same openness, cells, classes and yarns");
+    } else {
+        for (k, line) in carried.iter().enumerate() {
+            let head = if k == 0 { "carried   " } else { "          " };
+            let _ = writeln!(s, "{head} DIFFERENT {line}");
+        }
+    }
     let _ = writeln!(
         s,
         "abs diff   max {:.3e}  mean {:.3e}  (1/sr)",
@@ -97,14 +108,20 @@ pub fn run(args: &DiffArgs) -> Result<(String, u8), CliError> {
         "tolerance  |a - b| <= {:e} + {:e} |a|: {} of {} values beyond it",
         tol.abs, tol.rel, c.beyond, c.values
     );
-    let code = if c.within() { 0 } else { 1 };
+    let code = if c.within() && carried.is_empty() {
+        0
+    } else {
+        1
+    };
     let _ = writeln!(
         s,
         "result     {}",
-        if code == 0 {
-            "within tolerance (exit 0)"
-        } else {
-            "DIFFERENT: beyond tolerance (exit 1)"
+        match (c.within(), carried.is_empty()) {
+            (true, true) => "within tolerance (exit 0)",
+            (false, _) => "DIFFERENT: beyond tolerance (exit 1)",
+            (true, false) =>
+                "DIFFERENT: the values are within tolerance, what else the tables \
+                              carry is not (exit 1)",
         }
     );
     Ok((s, code))

@@ -181,6 +181,44 @@ fn diff_exit_statuses() {
     );
 }
 
+/// Two spatial tables whose values agree but whose cells do not: `diff` names what differs and
+/// exits 1 (it compared the values alone, and called them identical).
+#[test]
+fn diff_sees_what_a_table_carries_beside_its_values() {
+    let d = fresh_dir("diff-carried");
+    succeeds(&run_in(
+        &d,
+        &[
+            "bake",
+            "--weave",
+            "gingham",
+            "--spatial",
+            "--res",
+            "2,4,2,4",
+            "-o",
+            "a.bin",
+        ],
+    ));
+    let mut t = clothbake_loader::read_table(&d.join("a.bin")).unwrap();
+    t.meta.spatial.as_mut().unwrap().cell_albedo[0] = [0.9, 0.1, 0.1];
+    clothbake_loader::write_binary(&d.join("b.bin"), &t, false).unwrap();
+    let out = run_in(&d, &["diff", "a.bin", "b.bin"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    let s = text(&out.stdout);
+    for w in [
+        "DIFFERENT spatial.cell_albedo: 3 of",
+        "inf (identical)",
+        "what else the tables carry is not (exit 1)",
+    ] {
+        assert!(s.contains(w), "{w:?} missing in\n{s}");
+    }
+    let same = succeeds(&run_in(&d, &["diff", "a.bin", "a.bin"]));
+    assert!(
+        same.contains("carried    the same openness, cells, classes and yarns"),
+        "{same}"
+    );
+}
+
 #[test]
 fn missing_folder_writes_nothing() {
     let d = fresh_dir("missing");
