@@ -3,7 +3,7 @@
 //! Every value (cell and channel) of table A is compared with the same value of table B. A value
 //! is within tolerance when `|a - b| <= abs + rel * |a|`.
 
-use clothbake_loader::{Faces, Grid, Metadata, Table};
+use clothbake_loader::{Faces, Grid, Metadata, Spatial, Table};
 
 /// Default relative tolerance of `clothbake diff`: about 8 units in the last place of an f32,
 /// so that two bakes of the same model agree even across platforms whose maths libraries round
@@ -201,11 +201,11 @@ pub fn carried_differences(a: &Metadata, b: &Metadata) -> Vec<String> {
         a.openness.is_some(),
         b.openness.is_some(),
     ) {
-        let (x, y) = (
-            a.openness.as_deref().unwrap(),
-            b.openness.as_deref().unwrap(),
-        );
-        out.extend(values_differ("openness", x, y, "values"));
+        let wide = |m: &Metadata| -> Vec<f64> {
+            let v = m.openness.as_deref().unwrap_or_default();
+            v.iter().map(|&o| f64::from(o)).collect()
+        };
+        out.extend(values_differ("openness", &wide(a), &wide(b), "values"));
     }
     if presence(
         &mut out,
@@ -223,51 +223,31 @@ pub fn carried_differences(a: &Metadata, b: &Metadata) -> Vec<String> {
                 x.secondary, y.secondary
             ));
         }
-        let f32s = |v: &[f64]| v.iter().map(|&e| e as f32).collect::<Vec<f32>>();
-        out.extend(values_differ(
-            "spatial.u_edges",
-            &f32s(&x.u_edges),
-            &f32s(&y.u_edges),
-            "edges",
-        ));
-        out.extend(values_differ(
-            "spatial.v_edges",
-            &f32s(&x.v_edges),
-            &f32s(&y.v_edges),
-            "edges",
-        ));
-        let classes = |v: &[u32]| v.iter().map(|&c| c as f32).collect::<Vec<f32>>();
-        out.extend(values_differ(
-            "spatial.cell_class",
-            &classes(&x.cell_class),
-            &classes(&y.cell_class),
-            "cells",
-        ));
-        let flat3 = |v: &[[f32; 3]]| v.iter().flatten().copied().collect::<Vec<f32>>();
-        out.extend(values_differ(
-            "spatial.cell_albedo",
-            &flat3(&x.cell_albedo),
-            &flat3(&y.cell_albedo),
-            "values",
-        ));
-        out.extend(values_differ(
-            "spatial.visible",
-            &x.visible,
-            &y.visible,
-            "values",
-        ));
-        let flat6 = |v: &[[[f32; 3]; 2]]| {
-            v.iter()
-                .flat_map(|s| s.iter().flatten())
-                .copied()
-                .collect::<Vec<f32>>()
-        };
-        out.extend(values_differ(
-            "spatial.cell_neighbours",
-            &flat6(&x.cell_neighbours),
-            &flat6(&y.cell_neighbours),
-            "values",
-        ));
+        type Field = (&'static str, &'static str, fn(&Spatial) -> Vec<f64>);
+        let fields: [Field; 6] = [
+            ("spatial.u_edges", "edges", |s| s.u_edges.clone()),
+            ("spatial.v_edges", "edges", |s| s.v_edges.clone()),
+            ("spatial.cell_class", "cells", |s| {
+                s.cell_class.iter().map(|&c| f64::from(c)).collect()
+            }),
+            ("spatial.cell_albedo", "values", |s| {
+                s.cell_albedo
+                    .iter()
+                    .flatten()
+                    .map(|&a| f64::from(a))
+                    .collect()
+            }),
+            ("spatial.visible", "values", |s| {
+                s.visible.iter().map(|&v| f64::from(v)).collect()
+            }),
+            ("spatial.cell_neighbours", "values", |s| {
+                let flat = s.cell_neighbours.iter().flatten().flatten();
+                flat.map(|&a| f64::from(a)).collect()
+            }),
+        ];
+        for (field, what, get) in fields {
+            out.extend(values_differ(field, &get(x), &get(y), what));
+        }
     }
     if presence(&mut out, "yarns", a.yarns.is_some(), b.yarns.is_some()) && a.yarns != b.yarns {
         out.push("yarns: the point level's yarns or finishes differ".into());
@@ -276,8 +256,8 @@ pub fn carried_differences(a: &Metadata, b: &Metadata) -> Vec<String> {
 }
 
 /// `field: N of M <what> differ (max |a - b| D)`, or a count mismatch; `None` when equal (bit
-/// for bit).
-fn values_differ(field: &str, a: &[f32], b: &[f32], what: &str) -> Option<String> {
+/// for bit: the stored f32 and u32 values are exact in f64).
+fn values_differ(field: &str, a: &[f64], b: &[f64], what: &str) -> Option<String> {
     if a.len() != b.len() {
         return Some(format!("{field}: {} vs {} {what}", a.len(), b.len()));
     }
@@ -285,7 +265,7 @@ fn values_differ(field: &str, a: &[f32], b: &[f32], what: &str) -> Option<String
     for (&x, &y) in a.iter().zip(b) {
         if x.to_bits() != y.to_bits() {
             n += 1;
-            max = max.max((f64::from(x) - f64::from(y)).abs());
+            max = max.max((x - y).abs());
         }
     }
     (n > 0).then(|| {
@@ -406,7 +386,7 @@ mod tests {
     fn a_class_value_is_named_by_its_channel_and_cell() {
         // A spatial table of 2 classes with the second bounce (6 values each): value k of
         // class 1, lane 3 (plus_both), grid cell 17 is 3 n + 6 (n + 17) + 3.
-        let spatial = |g: Grid| clothbake_loader::Spatial {
+        let spatial = |g: Grid| Spatial {
             classes: 2,
             u_edges: vec![0.0, 1.0],
             v_edges: vec![0.0, 1.0],
