@@ -3,9 +3,10 @@
 //!
 //! The estimate ([`peak_bytes`]) counts what grows with the grid, with no credit for
 //! symmetry (an upper bound): the orbit map (8 bytes per (phi_i, phi_o) pair), the one buffer
-//! the rows are written into and the table is made of ([`crate::assembly`]: 12 bytes per cell
-//! of the rows baked, RGB f32, and 64 bytes per row), with `--resume` the checkpoint's values
-//! while they are read (12 bytes per cell at most), and for an OpenEXR table the encoder's
+//! the rows are written into and the table is made of ([`crate::assembly`]: 4 bytes per value
+//! of each cell of the rows baked, 3 values of an averaged table, 3 + the lanes of every class
+//! of a spatial one, and 64 bytes per row), with `--resume` the checkpoint's values while they
+//! are read (as many bytes at most), and for an OpenEXR table the encoder's
 //! block (16 lines of the image, or all of them when fewer, in the encoder's working copies:
 //! measured at 51 bytes per pixel of the block in f32 and 22 in f16, counted as 56, and 4 MiB
 //! for the rest of its state; binary tables stream from the buffer). A `sliced3d` bake adds
@@ -33,22 +34,31 @@ pub enum Kept {
 }
 
 /// The most memory a bake of `grid` needs, in bytes, when it evaluates `rows` of its
-/// (theta_i, phi_i) rows (all of them for a table, the shard's for a shard), keeps `kept`
-/// and, with `resume`, first reads a checkpoint (see the module documentation for what is
-/// counted).
-pub fn peak_bytes(grid: &Grid, rows: u64, kept: Kept, resume: bool) -> u64 {
+/// (theta_i, phi_i) rows (all of them for a table, the shard's for a shard), holds `values`
+/// f32 values a cell (3 for an averaged table; a spatial one 3 + its classes' lanes), keeps
+/// `kept` and, with `resume`, first reads a checkpoint (see the module documentation for what
+/// is counted). Only what holds values grows with `values`: the fixed allowance does not.
+pub fn peak_bytes(grid: &Grid, rows: u64, values: u64, kept: Kept, resume: bool) -> u64 {
     let pairs = u64::from(grid.n_phi_i) * u64::from(grid.n_phi_o);
     let orbits = 8 * pairs + 8 * u64::from(grid.n_phi_i);
     let cells = rows * u64::from(grid.n_theta_o) * u64::from(grid.n_phi_o);
+    let cell_bytes = 4u64.saturating_mul(values);
     // The buffer, a flag and the rows in flight per row; the checkpoint read on resuming.
-    let sweep = 12 * cells + 64 * rows + if resume { 12 * cells } else { 0 };
+    let buffer = cell_bytes.saturating_mul(cells);
+    let sweep = buffer
+        .saturating_add(64 * rows)
+        .saturating_add(if resume { buffer } else { 0 });
+    // The encoder's block: 56 bytes a pixel of three channels, as many thirds as channels.
     let writer = match kept {
         Kept::Table(Some(Format::Exr(_))) => {
-            (4 << 20) + 56 * grid.exr_width() * grid.exr_height().min(16)
+            let pixels = grid.exr_width() * grid.exr_height().min(16);
+            (4 << 20) + (56 * pixels).saturating_mul(values) / 3
         }
         Kept::Table(_) | Kept::Shard => 0,
     };
-    BASE_BYTES + orbits + sweep + writer
+    (BASE_BYTES + orbits)
+        .saturating_add(sweep)
+        .saturating_add(writer)
 }
 
 /// The most memory merging shards whose files hold `shard_bytes` in all needs, in bytes,
@@ -142,22 +152,29 @@ mod tests {
         // 2^31 cells: the values alone are 2^31 * 12 bytes = 25.8 GB.
         let g = grid([32768, 65536, 1, 1]);
         let cells = 1u64 << 31;
-        let p = peak_bytes(&g, cells, Kept::Table(Some(Format::Binary)), false);
+        let p = peak_bytes(&g, cells, 3, Kept::Table(Some(Format::Binary)), false);
         assert!(p >= 12 * cells, "{p}");
         assert_eq!(describe(51_600_000_000), "51.6 GB");
         assert_eq!(describe(980_400_000), "980 MB");
         // A shard of a quarter of the rows needs about a quarter.
-        let s = peak_bytes(&g, cells / 4, Kept::Shard, false);
+        let s = peak_bytes(&g, cells / 4, 3, Kept::Shard, false);
         assert!(s < p / 3, "{s} {p}");
         // Resuming reads the checkpoint besides the buffer.
-        let r = peak_bytes(&g, cells, Kept::Table(Some(Format::Binary)), true);
+        let r = peak_bytes(&g, cells, 3, Kept::Table(Some(Format::Binary)), true);
         assert!(r >= 24 * cells, "{r}");
     }
 
     #[test]
     fn exr_needs_more_than_binary() {
-        let of =
-            |g: &Grid, f| peak_bytes(g, u64::from(g.n_theta_i * g.n_phi_i), Kept::Table(f), false);
+        let of = |g: &Grid, f| {
+            peak_bytes(
+                g,
+                u64::from(g.n_theta_i * g.n_phi_i),
+                3,
+                Kept::Table(f),
+                false,
+            )
+        };
         for n in [[32, 64, 32, 64], [2, 1024, 2, 1024]] {
             let g = grid(n);
             let c = g.len() as u64;
