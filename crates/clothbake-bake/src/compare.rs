@@ -184,7 +184,9 @@ impl std::fmt::Display for GridMismatch {
 /// What else a table carries that changes what it renders, field by field: one line for each
 /// field of `a` and `b` that differs, naming it and saying how (empty when they agree): the
 /// two-faced cloth's openness, a spatial table's cells, classes, albedos and visible areas, and
-/// the yarns of its point level. The values themselves are [`compare`]'s.
+/// the yarns of its point level. The values themselves are [`compare`]'s. A spatial table
+/// against an averaged one is compared by its averaged values, as [`compare`] does: the cells
+/// and yarns only one of them has are not named.
 pub fn carried_differences(a: &Metadata, b: &Metadata) -> Vec<String> {
     let mut out = Vec::new();
     let presence = |out: &mut Vec<String>, field: &str, x: bool, y: bool| -> bool {
@@ -206,6 +208,11 @@ pub fn carried_differences(a: &Metadata, b: &Metadata) -> Vec<String> {
             v.iter().map(|&o| f64::from(o)).collect()
         };
         out.extend(values_differ("openness", &wide(a), &wide(b), "values"));
+    }
+    // A spatial table against an averaged one: their averaged values are what is compared
+    // (a spatial table begins with them), and the cells one of them lacks are not a difference.
+    if a.spatial.is_some() != b.spatial.is_some() {
+        return out;
     }
     if presence(
         &mut out,
@@ -530,8 +537,12 @@ mod tests {
         assert!(d[0].starts_with("spatial.visible: 1 of "), "{d:?}");
         let d = changed(&|m| m.yarns = None);
         assert_eq!(d, ["yarns: A has it, B has none"]);
-        let d = changed(&|m| m.spatial = None);
-        assert_eq!(d, ["spatial: A has it, B has none"]);
+        // Against an averaged table, the averages are what is compared.
+        let d = changed(&|m| {
+            m.spatial = None;
+            m.yarns = None;
+        });
+        assert!(d.is_empty(), "{d:?}");
         // The two-faced cloth's openness: present in one, and one value of it different.
         let open = |m: &mut Metadata| m.openness = Some(vec![0.5; 8]);
         let d = changed(&open);

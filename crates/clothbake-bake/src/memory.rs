@@ -79,19 +79,40 @@ pub fn merge_bytes(shard_bytes: u64, format: Format) -> u64 {
 }
 
 /// The memory available to this process, in bytes, where the platform says (`None`
-/// elsewhere: no check is made).
+/// elsewhere: no check is made): the least of the machine's free memory, the room under the
+/// process's cgroup limit and the room under its address-space limit (`ulimit -v`).
 pub fn available_bytes() -> Option<u64> {
     #[cfg(target_os = "linux")]
     {
         let meminfo = std::fs::read_to_string("/proc/meminfo").ok();
         let free = meminfo.as_deref().and_then(mem_available);
-        match (free, cgroup_room()) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        }
+        [free, cgroup_room(), address_space_room()]
+            .into_iter()
+            .flatten()
+            .min()
     }
     #[cfg(not(target_os = "linux"))]
     None
+}
+
+/// The room left under this process's address-space limit (RLIMIT_AS, `ulimit -v`), if one is
+/// set: the limit less the address space already mapped (`VmSize` of /proc/self/status).
+#[cfg(target_os = "linux")]
+fn address_space_room() -> Option<u64> {
+    let mut limit = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: getrlimit writes one rlimit into the struct it is given.
+    if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut limit) } != 0
+        || limit.rlim_cur == libc::RLIM_INFINITY
+    {
+        return None;
+    }
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmSize:"))?;
+    let mapped: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(limit.rlim_cur.saturating_sub(mapped.saturating_mul(1024)))
 }
 
 /// `MemAvailable` of a /proc/meminfo text, in bytes.

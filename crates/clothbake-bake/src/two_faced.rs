@@ -278,6 +278,14 @@ impl TwoFaced {
         })
     }
 
+    /// The bytes the rest's grid of `nodes` (polar by azimuth nodes per direction) holds: four
+    /// blocks of (directions x directions) nodes, allocated when the cloth is built. It grows
+    /// as the square of polar x azimuth: (64, 128) holds 8.6 GB.
+    pub fn grid_bytes(nodes: (u32, u32)) -> u64 {
+        let d = u64::from(nodes.0) * u64::from(nodes.1);
+        (4 * d * d).saturating_mul(size_of::<OnceLock<Rgb>>() as u64)
+    }
+
     /// Path-traces every node of the rest now, in parallel (otherwise each on first use).
     pub fn prepare(&self) {
         self.rest.prepare(&AtomicBool::new(false));

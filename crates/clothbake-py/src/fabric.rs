@@ -364,26 +364,27 @@ impl PyFabric {
         Ok(((l.f[0], l.f[1], l.f[2]), l.coverage))
     }
 
-    /// f_r(wi, wo) in 1/sr for one pair of unit vectors given as 3 floats each (fabric frame,
-    /// analytic model, direct reflection): the scalar path renderers call per sample.
     /// The fabric's two-faced cloth (docs/science/transmission.md): no floor, light through the gaps
     /// and through translucent yarns (the materials' `translucency`), the back the inverted
     /// weave (facet "huo" by default, as everywhere; "lewis" conserves energy, which light
     /// through the cloth makes worth having); its model's coarse grid is path-traced here (about 25 s on two cores at the
     /// default `nodes=(5, 8)` polar angles by azimuths a direction and `paths=8192` eye rays a
-    /// node; fewer for a quick look).
+    /// node; fewer for a quick look). Refused before any work where the grid's nodes would not
+    /// fit in memory; Ctrl-C stops the path tracing (KeyboardInterrupt).
     #[pyo3(signature = (facet="huo", variant="refined", nodes=(5, 8), paths=8192))]
     fn two_faced(
         &self,
         py: Python<'_>,
         facet: &str,
         variant: &str,
-        nodes: (u32, u32),
-        paths: usize,
+        nodes: (i64, i64),
+        paths: i64,
     ) -> PyResult<crate::two_faced::PyTwoFaced> {
         crate::two_faced::PyTwoFaced::build(py, &self.fabric, facet, variant, nodes, paths)
     }
 
+    /// f_r(wi, wo) in 1/sr for one pair of unit vectors given as 3 floats each (fabric frame,
+    /// analytic model, direct reflection): the scalar path renderers call per sample.
     #[pyo3(signature = (wi, wo, facet="huo"))]
     fn eval1(&self, wi: [f64; 3], wo: [f64; 3], facet: &str) -> PyResult<(f64, f64, f64)> {
         check_unit("wi", 0, wi)?;

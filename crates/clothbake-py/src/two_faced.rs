@@ -11,6 +11,8 @@ use clothbake_loader::{Options, TableError, TwoFacedBrdf};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
 
 /// The two-faced cloth of a fabric: no floor, light through the gaps and through translucent
 /// yarns, the back the inverted weave (docs/science/transmission.md). `eval` gives f (1/sr, RGB) for
@@ -38,6 +40,32 @@ fn unit(w: [f64; 3]) -> UnitVec3 {
     UnitVec3::new(Vec3::new(w[0], w[1], w[2])).unwrap_or(UnitVec3::Z)
 }
 
+/// Path-traces every node of `cloth`'s grid on the worker threads, without the GIL, while this
+/// thread looks for signals every tenth of a second: Ctrl-C stops the work and raises
+/// KeyboardInterrupt.
+fn prepare_interruptibly(py: Python<'_>, cloth: &TwoFaced) -> PyResult<()> {
+    let cancel = AtomicBool::new(false);
+    let mut signal = None;
+    py.detach(|| {
+        std::thread::scope(|s| {
+            let worker = s.spawn(|| cloth.prepare_or_cancel(&cancel));
+            while !worker.is_finished() {
+                std::thread::sleep(Duration::from_millis(100));
+                if let Err(e) = Python::attach(|py| py.check_signals()) {
+                    cancel.store(true, Ordering::SeqCst);
+                    signal = Some(e);
+                    break;
+                }
+            }
+            worker.join().expect("the path tracing does not panic")
+        })
+    });
+    match signal {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
 impl PyTwoFaced {
     /// A two-faced table in memory (a bake's), looked up through the loader.
     pub fn from_table(table: clothbake_loader::Table) -> Result<Self, TableError> {
@@ -55,18 +83,35 @@ impl PyTwoFaced {
         fabric: &Fabric,
         facet: &str,
         variant: &str,
-        nodes: (u32, u32),
-        paths: usize,
+        nodes: (i64, i64),
+        paths: i64,
     ) -> PyResult<Self> {
         if !(1..=64).contains(&nodes.0) || !(1..=128).contains(&nodes.1) {
             return Err(PyValueError::new_err(format!(
                 "nodes: {nodes:?}; give (polar, azimuth) node counts from 1 to 64 and 1 to 128"
             )));
         }
-        if !(1..=1 << 20).contains(&paths) {
+        let nodes = (nodes.0 as u32, nodes.1 as u32);
+        let max_paths = clothbake_bake::sweep::MAX_PATHS;
+        if !(1..=max_paths as i64).contains(&paths) {
             return Err(PyValueError::new_err(format!(
-                "paths: {paths}; give eye rays a node from 1 to 2^20"
+                "paths: {paths}; give eye rays a node from 1 to {max_paths} (2^24, as the \
+                 command line's --paths)"
             )));
+        }
+        let paths = paths as usize;
+        let need = TwoFaced::grid_bytes(nodes);
+        if let Some(have) = clothbake_bake::memory::available_bytes() {
+            if need > have {
+                return Err(PyValueError::new_err(format!(
+                    "nodes: {nodes:?} holds {} of path-traced nodes, but {} is available; give \
+                     fewer (the grid grows as the square of polar x azimuth nodes: the default \
+                     (5, 8) holds {})",
+                    clothbake_bake::memory::describe(need),
+                    clothbake_bake::memory::describe(have),
+                    clothbake_bake::memory::describe(TwoFaced::grid_bytes((5, 8)))
+                )));
+            }
         }
         let facet = facet_model(facet)?;
         let variant = variant_of(variant)?;
@@ -75,7 +120,7 @@ impl PyTwoFaced {
             .map_err(|e| PyValueError::new_err(format!("variant: {e}; {}", e.fix())))?;
         let cloth = TwoFaced::with_grid(fabric, facet, variant, nodes, paths)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        py.detach(|| cloth.prepare());
+        prepare_interruptibly(py, &cloth)?;
         Ok(PyTwoFaced {
             cloth: Box::new(cloth),
             name: fabric.name().to_string(),

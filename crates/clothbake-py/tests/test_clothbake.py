@@ -600,3 +600,70 @@ def test_a_two_faced_table_holds_its_cloth_over_the_sphere(tmp_path):
         clothbake.bake(fab, res=(2, 4, 2, 4), faces="three")
     with pytest.raises(ValueError, match="paths=0 is out of range"):
         clothbake.bake(fab, res=(2, 4, 2, 4), faces="two", paths=0)
+
+
+def test_two_faced_arguments_are_named_and_bounded(twill_path):
+    """Out-of-range nodes and paths are refused naming the argument (they gave conversion
+    errors), with the command line's limit on paths (2^24)."""
+    fab = clothbake.Fabric(twill_path)
+    with pytest.raises(ValueError, match=r"^nodes: \(-1, 8\)"):
+        fab.two_faced(nodes=(-1, 8), paths=1)
+    with pytest.raises(ValueError, match=r"^paths: -5; .*16777216"):
+        fab.two_faced(nodes=(1, 1), paths=-5)
+    with pytest.raises(ValueError, match=r"^paths: 16777217"):
+        fab.two_faced(nodes=(1, 1), paths=2**24 + 1)
+
+
+def _run_python(code):
+    import subprocess
+    import sys
+    return subprocess.Popen(
+        [sys.executable, "-c", code],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+
+
+def test_a_two_faced_grid_beyond_the_memory_limit_is_refused_before_it_is_allocated(twill_path):
+    """nodes=(64, 128) holds 8.6 GB of nodes: under a 6 GB address-space limit it was allocated
+    at once and aborted the interpreter; it is refused with what to do, nothing allocated."""
+    code = f"""
+import resource, clothbake
+resource.setrlimit(resource.RLIMIT_AS, (6 << 30, resource.RLIM_INFINITY))
+fab = clothbake.Fabric({str(twill_path)!r})
+try:
+    fab.two_faced(nodes=(64, 128), paths=1)
+except ValueError as e:
+    print("refused:", e)
+"""
+    p = _run_python(code)
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 0, err
+    assert out.startswith("refused: nodes: (64, 128) holds 8.6 GB"), out + err
+    assert "give fewer" in out, out
+
+
+def test_ctrl_c_stops_the_two_faced_path_tracing(twill_path):
+    """A grid of hours of path tracing stops on SIGINT with KeyboardInterrupt, in seconds (it
+    ran on, ignoring Ctrl-C)."""
+    import signal
+    import time
+    code = f"""
+import clothbake, sys
+fab = clothbake.Fabric({str(twill_path)!r})
+print("start", flush=True)
+try:
+    fab.two_faced(nodes=(32, 64), paths=64)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+    sys.exit(3)
+print("finished", flush=True)
+"""
+    p = _run_python(code)
+    assert p.stdout.readline().strip() == "start"
+    time.sleep(2.0)
+    p.send_signal(signal.SIGINT)
+    t0 = time.monotonic()
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 3, (out, err)
+    assert "interrupted" in out
+    assert time.monotonic() - t0 < 30

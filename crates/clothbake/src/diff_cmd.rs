@@ -57,7 +57,13 @@ pub fn run(args: &DiffArgs) -> Result<(String, u8), CliError> {
         }
     );
     let carried = carried_differences(&a.meta, &b.meta);
-    if carried.is_empty() {
+    if a.meta.spatial.is_some() != b.meta.spatial.is_some() {
+        let which = if a.meta.spatial.is_some() { "A" } else { "B" };
+        let _ = writeln!(
+            s,
+            "carried    only {which} is spatial: the averaged values are compared"
+        );
+    } else if carried.is_empty() {
         let _ = writeln!(s, "carried    the same openness, cells, classes and yarns");
     } else {
         for (k, line) in carried.iter().enumerate() {
