@@ -11,6 +11,20 @@ pub(crate) fn bad(option: &str, msg: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(format!("{option}: {msg}"))
 }
 
+/// A count given as a whole number (`samples=`, `paths=`): a negative one is refused naming
+/// the argument (the conversion to an unsigned number said only "can't convert negative
+/// int"); the upper bounds are the bake settings' own.
+pub(crate) fn count(name: &str, value: Option<i64>) -> PyResult<Option<usize>> {
+    match value {
+        Some(v) if v < 0 => Err(bad(
+            name,
+            format!("{v} is negative; give a whole number from 1"),
+        )),
+        Some(v) => Ok(Some(usize::try_from(v).unwrap_or(usize::MAX))),
+        None => Ok(None),
+    }
+}
+
 /// One of `words` (`name=` must be one of them), or the error naming the option.
 pub(crate) fn choice<T: Copy>(
     name: &str,

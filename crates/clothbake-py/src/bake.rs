@@ -2,7 +2,7 @@
 //! the `clothbake bake` command runs: in memory, or into a table or shard file with
 //! checkpoints and resume.
 
-use crate::args::{bad, bounces_arg, choice, facet_model, VARIANTS};
+use crate::args::{bad, bounces_arg, choice, count, facet_model, VARIANTS};
 use crate::fabric::PyFabric;
 use crate::table::{table_err, PyTable};
 use clothbake_bake::job::{self, Hooks, Job, JobError, Target};
@@ -107,7 +107,7 @@ pub fn bake(
     precision: Option<&str>,
     method: &str,
     variant: Option<&str>,
-    samples: Option<usize>,
+    samples: Option<i64>,
     seed: Option<u64>,
     caps: Option<&str>,
     secondary: Option<&str>,
@@ -117,8 +117,9 @@ pub fn bake(
     checkpoint_every: Option<f64>,
     spatial: bool,
     faces: &str,
-    paths: Option<usize>,
+    paths: Option<i64>,
 ) -> PyResult<Option<Py<PyAny>>> {
+    let (samples, paths) = (count("samples", samples)?, count("paths", paths)?);
     let bounces = bounces_arg(bounces.as_ref())?;
     let grid = Grid::new(res.0, res.1, res.2, res.3);
     grid.validate().map_err(|e| bad("res", e))?;

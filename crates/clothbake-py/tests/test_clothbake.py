@@ -667,3 +667,10 @@ print("finished", flush=True)
     assert p.returncode == 3, (out, err)
     assert "interrupted" in out
     assert time.monotonic() - t0 < 30
+
+
+def test_negative_counts_are_refused_naming_the_argument(twill_path):
+    fab = clothbake.Fabric(twill_path)
+    for name in ["paths", "samples"]:
+        with pytest.raises(ValueError, match=rf"^{name}: -5 is negative"):
+            clothbake.bake(fab, res=(1, 1, 1, 1), **{name: -5})
