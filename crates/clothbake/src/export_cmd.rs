@@ -153,7 +153,19 @@ pub fn run(args: &ExportArgs) -> Result<String, CliError> {
                 point_level: false,
                 ..Default::default()
             };
-            let lookup = clothbake_loader::Brdf::open(table, options)?;
+            let lookup = clothbake_loader::Brdf::open(table, options).map_err(|e| match e {
+                // The loader's own fix names its Rust types; here the command that works.
+                clothbake_loader::TableError::WrongKind { .. } => CliError::new(
+                    format!(
+                        "{}: a two-faced table (reflection and transmission over the sphere), \
+                         which the exports from a table do not take",
+                        table.display()
+                    ),
+                    "export the two-faced cloth from its fabric: clothbake export --weave \
+                     FABRIC --faces two --klems OUT.xml",
+                ),
+                other => other.into(),
+            })?;
             refuse_existing(args)?;
             let meta = lookup.meta();
             let g = meta.grid;

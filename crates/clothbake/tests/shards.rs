@@ -284,6 +284,15 @@ fn two_faced_bakes_are_the_same_for_any_thread_count_and_shard_split() {
         ],
     ));
     identical(&d, "one.exr", "merged.exr");
+    // An export from the table names the command that exports the two-faced cloth (it named
+    // the loader's Rust type).
+    fails_with(
+        &run_in(
+            &d,
+            &["export", "--table", "merged.exr", "--merl", "x.binary"],
+        ),
+        &["merged.exr: a two-faced table", "--faces two --klems"],
+    );
     // info: the sides, and the light from each split into reflected, transmitted and through;
     // the plain weave's gaps are narrow (threads 3 wide every 3.1): at most (1 - 3/3.1)^2 =
     // 0.001 passes straight.
