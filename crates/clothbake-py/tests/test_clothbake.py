@@ -647,8 +647,11 @@ def test_ctrl_c_stops_the_two_faced_path_tracing(twill_path):
     ran on, ignoring Ctrl-C)."""
     import signal
     import time
+    # The default handler set again: a child of a process started in the background (`cmd &`
+    # in a script) inherits SIGINT ignored, and Python keeps it so.
     code = f"""
-import clothbake, sys
+import clothbake, signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
 fab = clothbake.Fabric({str(twill_path)!r})
 print("start", flush=True)
 try:
