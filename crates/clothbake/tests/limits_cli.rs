@@ -484,25 +484,23 @@ fn a_large_exponent_with_two_bounces_runs() {
             .find_map(|l| l.split_whitespace().nth(1)?.parse().ok())
             .unwrap_or_else(|| panic!("{s}"))
     };
+    // The eval, on `weave` with `extra` flags.
+    let eval = |weave: &str, extra: &[&str]| {
+        let args = [
+            "eval",
+            "--weave",
+            weave,
+            "--bounces",
+            "2",
+            "--wi",
+            "30,0",
+            "--wo",
+            "45,180",
+        ];
+        run_in(&d, &[&args[..], extra].concat())
+    };
     for facet in ["huo", "lewis"] {
-        let out = run_in(
-            &d,
-            &[
-                "eval",
-                "--weave",
-                "basket",
-                "--exponent",
-                "1e20",
-                "--bounces",
-                "2",
-                "--wi",
-                "30,0",
-                "--wo",
-                "45,180",
-                "--facet",
-                facet,
-            ],
-        );
+        let out = eval("basket", &["--exponent", "1e20", "--facet", facet]);
         let v = i2(&out);
         assert!(v.is_finite() && v > 0.0, "{facet}: I_2 {v}");
     }
@@ -510,20 +508,7 @@ fn a_large_exponent_with_two_bounces_runs() {
     let big = json.replace("\"exponent\": 10", "\"exponent\": 1e300");
     assert_ne!(big, json);
     std::fs::write(d.join("big.json"), big).unwrap();
-    let out = run_in(
-        &d,
-        &[
-            "eval",
-            "--weave",
-            "big.json",
-            "--bounces",
-            "2",
-            "--wi",
-            "30,0",
-            "--wo",
-            "45,180",
-        ],
-    );
+    let out = eval("big.json", &[]);
     assert!(i2(&out).is_finite());
     succeeds(&bake_in(
         &d,
