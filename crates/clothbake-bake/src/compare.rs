@@ -211,53 +211,53 @@ pub fn carried_differences(a: &Metadata, b: &Metadata) -> Vec<String> {
     }
     // A spatial table against an averaged one: their averaged values are what is compared
     // (a spatial table begins with them), and the cells one of them lacks are not a difference.
-    if a.spatial.is_some() != b.spatial.is_some() {
-        return out;
-    }
-    if presence(
-        &mut out,
-        "spatial",
-        a.spatial.is_some(),
-        b.spatial.is_some(),
-    ) {
-        let (x, y) = (a.spatial.as_ref().unwrap(), b.spatial.as_ref().unwrap());
-        if x.classes != y.classes {
-            out.push(format!("spatial.classes: {} vs {}", x.classes, y.classes));
-        }
-        if x.secondary != y.secondary {
-            out.push(format!(
-                "spatial.secondary: {} vs {} (the classes hold the second bounce)",
-                x.secondary, y.secondary
-            ));
-        }
-        type Field = (&'static str, &'static str, fn(&Spatial) -> Vec<f64>);
-        let fields: [Field; 6] = [
-            ("spatial.u_edges", "edges", |s| s.u_edges.clone()),
-            ("spatial.v_edges", "edges", |s| s.v_edges.clone()),
-            ("spatial.cell_class", "cells", |s| {
-                s.cell_class.iter().map(|&c| f64::from(c)).collect()
-            }),
-            ("spatial.cell_albedo", "values", |s| {
-                s.cell_albedo
-                    .iter()
-                    .flatten()
-                    .map(|&a| f64::from(a))
-                    .collect()
-            }),
-            ("spatial.visible", "values", |s| {
-                s.visible.iter().map(|&v| f64::from(v)).collect()
-            }),
-            ("spatial.cell_neighbours", "values", |s| {
-                let flat = s.cell_neighbours.iter().flatten().flatten();
-                flat.map(|&a| f64::from(a)).collect()
-            }),
-        ];
-        for (field, what, get) in fields {
-            out.extend(values_differ(field, &get(x), &get(y), what));
-        }
+    match (&a.spatial, &b.spatial) {
+        (Some(x), Some(y)) => out.extend(spatial_differences(x, y)),
+        (None, None) => {}
+        _ => return out,
     }
     if presence(&mut out, "yarns", a.yarns.is_some(), b.yarns.is_some()) && a.yarns != b.yarns {
         out.push("yarns: the point level's yarns or finishes differ".into());
+    }
+    out
+}
+
+/// The fields of two spatial layouts that differ ([`carried_differences`]).
+fn spatial_differences(x: &Spatial, y: &Spatial) -> Vec<String> {
+    let mut out = Vec::new();
+    if x.classes != y.classes {
+        out.push(format!("spatial.classes: {} vs {}", x.classes, y.classes));
+    }
+    if x.secondary != y.secondary {
+        out.push(format!(
+            "spatial.secondary: {} vs {} (the classes hold the second bounce)",
+            x.secondary, y.secondary
+        ));
+    }
+    type Field = (&'static str, &'static str, fn(&Spatial) -> Vec<f64>);
+    let fields: [Field; 6] = [
+        ("spatial.u_edges", "edges", |s| s.u_edges.clone()),
+        ("spatial.v_edges", "edges", |s| s.v_edges.clone()),
+        ("spatial.cell_class", "cells", |s| {
+            s.cell_class.iter().map(|&c| f64::from(c)).collect()
+        }),
+        ("spatial.cell_albedo", "values", |s| {
+            s.cell_albedo
+                .iter()
+                .flatten()
+                .map(|&a| f64::from(a))
+                .collect()
+        }),
+        ("spatial.visible", "values", |s| {
+            s.visible.iter().map(|&v| f64::from(v)).collect()
+        }),
+        ("spatial.cell_neighbours", "values", |s| {
+            let flat = s.cell_neighbours.iter().flatten().flatten();
+            flat.map(|&a| f64::from(a)).collect()
+        }),
+    ];
+    for (field, what, get) in fields {
+        out.extend(values_differ(field, &get(x), &get(y), what));
     }
     out
 }

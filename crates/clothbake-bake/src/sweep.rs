@@ -19,7 +19,7 @@ use clothbake_core::interreflection::{Orders, Ranges, Sampling};
 use clothbake_core::symmetry::Symmetry;
 use clothbake_core::{
     AnalyticBsdf, AnalyticModel, Bsdf, ClassTerms, Fabric, FacetModel, SecondaryMethod,
-    SecondaryOptions, UnitVec3, Variant,
+    SecondaryOptions, UnitVec3, Variant, VariantError,
 };
 use clothbake_loader::spatial::value_index;
 use clothbake_loader::{Faces, Grid, Metadata, Table};
@@ -213,14 +213,11 @@ pub enum BakeError {
     Invalid(String),
 }
 
-/// The analytic model of a bake, its variant checked against the period.
-fn analytic_model(
-    fabric: &Fabric,
-    facet: FacetModel,
-    variant: Variant,
-) -> Result<AnalyticModel, BakeError> {
-    AnalyticModel::with_variant(fabric, facet, variant)
-        .map_err(|e| BakeError::Invalid(format!("{e}; {}", e.fix())))
+/// A variant that does not take the fabric's period (the model's constructor refuses it).
+impl From<VariantError> for BakeError {
+    fn from(e: VariantError) -> Self {
+        BakeError::Invalid(e.line())
+    }
 }
 
 impl std::fmt::Display for BakeError {
@@ -601,7 +598,10 @@ impl Baker {
         let eval: CellFn = match (opts.method, multiple.clone()) {
             _ if two_faced.is_some() => batched(two_faced.clone().expect("matched")),
             (Method::Analytic { variant }, None) if opts.spatial => {
-                let m = with_grid_arcs(analytic_model(fabric, opts.facet, variant)?, &g);
+                let m = with_grid_arcs(
+                    AnalyticModel::with_variant(fabric, opts.facet, variant)?,
+                    &g,
+                );
                 let layout = crate::spatial::layout(&m, &g, secondary.is_some())
                     .map_err(BakeError::Invalid)?;
                 syms.clear();
@@ -635,12 +635,14 @@ impl Baker {
                 })
             }
             (Method::Analytic { variant }, Some(mb)) => {
-                let ft = crate::transport::FullTransport::with(fabric, opts.facet, variant, mb)
-                    .map_err(|e| BakeError::Invalid(format!("{e}; {}", e.fix())))?;
+                let ft = crate::transport::FullTransport::with(fabric, opts.facet, variant, mb)?;
                 per_cell(move |_, wi, wo, out| out.push(ft.f(wi, wo).map(|x| x as f32)))
             }
             (Method::Analytic { variant }, None) => {
-                let m = with_grid_arcs(analytic_model(fabric, opts.facet, variant)?, &g);
+                let m = with_grid_arcs(
+                    AnalyticModel::with_variant(fabric, opts.facet, variant)?,
+                    &g,
+                );
                 // One bounce: four pairs at a time (AnalyticBsdf::f_batch), the same bits.
                 batched(Arc::new(AnalyticBsdf::new(m, secondary)))
             }

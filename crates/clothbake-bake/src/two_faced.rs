@@ -217,7 +217,7 @@ impl std::fmt::Display for TwoFacedError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             TwoFacedError::Back(e) => e.fmt(f),
-            TwoFacedError::Variant(e) => write!(f, "{e}; {}", e.fix()),
+            TwoFacedError::Variant(e) => f.write_str(&e.line()),
         }
     }
 }

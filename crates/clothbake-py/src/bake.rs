@@ -183,7 +183,7 @@ pub fn bake(
     };
     if let Some(v) = settings.variant {
         v.check(&fabric.fabric)
-            .map_err(|e| bad("variant", format!("{e}; {}", e.fix())))?;
+            .map_err(|e| bad("variant", e.line()))?;
     }
     let options = settings
         .options(Naming::Python)

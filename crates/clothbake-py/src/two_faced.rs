@@ -117,7 +117,7 @@ impl PyTwoFaced {
         let variant = variant_of(variant)?;
         variant
             .check(fabric)
-            .map_err(|e| PyValueError::new_err(format!("variant: {e}; {}", e.fix())))?;
+            .map_err(|e| PyValueError::new_err(format!("variant: {}", e.line())))?;
         let cloth = TwoFaced::with_grid(fabric, facet, variant, nodes, paths)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         prepare_interruptibly(py, &cloth)?;

@@ -109,8 +109,7 @@ impl Shader {
         component: Component,
     ) -> Result<Shader, String> {
         let one_bounce = secondary.is_none();
-        let model = AnalyticModel::with_variant(fabric, facet, variant)
-            .map_err(|e| format!("{e}; {}", e.fix()))?;
+        let model = AnalyticModel::with_variant(fabric, facet, variant).map_err(|e| e.line())?;
         let mut bsdf = AnalyticBsdf::new(model, secondary)
             .with_component(component)
             .ok_or("the secondary reflection's components need two bounces")?;

@@ -3,7 +3,6 @@
 //! active-occluder tables, and identical pieces merged into units with multiplicities D_i
 //! (eq. 4.11). [`AnalyticModel::with_variant`] is the one constructor.
 
-#[allow(unused_imports)]
 use super::*;
 
 pub(super) fn frame(g: Group) -> (Vec3, Vec3) {

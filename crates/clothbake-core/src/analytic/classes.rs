@@ -2,7 +2,6 @@
 //! crossing cell, and the cells grouped into classes whose terms differ only by the threads'
 //! albedos, for spatial tables.
 
-#[allow(unused_imports)]
 use super::*;
 
 impl AnalyticModel {

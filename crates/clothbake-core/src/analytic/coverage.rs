@@ -1,7 +1,6 @@
 //! What share of the period the eye sees a yarn at, and a lit one (the coverage a spatial
 //! table's point level and the level-of-detail hand-over use).
 
-#[allow(unused_imports)]
 use super::*;
 
 impl AnalyticModel {

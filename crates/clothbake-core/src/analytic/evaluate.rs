@@ -2,7 +2,6 @@
 //! and lit arc, the length its ends' occluders leave, the projected areas and the arc integrals
 //! of the facet terms; then the area-weighted average over the units.
 
-#[allow(unused_imports)]
 use super::*;
 
 /// A direction as the units of one group see it, computed once per evaluation rather than per

@@ -46,13 +46,8 @@ mod evaluate;
 mod secondary;
 mod variant;
 
-#[allow(unused_imports)]
 use build::*;
-#[allow(unused_imports)]
-use classes::*;
-#[allow(unused_imports)]
 use evaluate::*;
-#[allow(unused_imports)]
 use secondary::*;
 pub use variant::*;
 

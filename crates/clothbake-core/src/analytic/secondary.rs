@@ -1,7 +1,6 @@
 //! The secondary reflection of a unit (thesis ch. 5, sec. 5.4): between the piece and its
 //! parallel neighbours on both sides, analytic or by two-level sampling.
 
-#[allow(unused_imports)]
 use super::*;
 
 /// The secondary reflection from both sides, summed in the order of sec. 5.4's two

@@ -2,7 +2,6 @@
 //! takes: a [`Variant`] is checked against the fabric's period when the model is built
 //! ([`Variant::check`]), so no caller can build a model its period would exhaust.
 
-#[allow(unused_imports)]
 use super::*;
 
 /// How the length a segment's end hides is taken (thesis eq. 3.6).
@@ -68,6 +67,11 @@ impl VariantError {
     /// What to do instead.
     pub fn fix(&self) -> &'static str {
         "use the variant sliced or refined for it (docs/reference/limits.md)"
+    }
+
+    /// The one line a library error carries: what, then `; ` and the fix.
+    pub fn line(&self) -> String {
+        format!("{self}; {}", self.fix())
     }
 }
 

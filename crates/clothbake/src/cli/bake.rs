@@ -1,7 +1,6 @@
 //! `clothbake bake` and `merge`: the bake's options (grid, model, bounces, output, shards,
 //! checkpoints) and the table format.
 
-#[allow(unused_imports)]
 use super::*;
 
 /// Options of a bake (default mode and `clothbake bake`).

@@ -1,6 +1,5 @@
 //! `clothbake info`, `export` and `diff`: what reads or converts a table.
 
-#[allow(unused_imports)]
 use super::*;
 
 /// `clothbake export`.

@@ -1,7 +1,6 @@
 //! `clothbake eval` and the options every command that builds the model shares: the facet,
 //! the variant, the material and draft options, the bounces, directions.
 
-#[allow(unused_imports)]
 use super::*;
 
 /// Facet material overrides (the ranges of fabric files, see `clothbake_core::fabric`).

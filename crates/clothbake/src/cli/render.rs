@@ -1,6 +1,5 @@
 //! `clothbake render` and `plot`: the picture's scene, camera, light and tone mapping.
 
-#[allow(unused_imports)]
 use super::*;
 
 /// Where the BRDF of `render` and `plot` comes from, and the model's options.

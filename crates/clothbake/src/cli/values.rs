@@ -1,7 +1,6 @@
 //! The value parsers behind the options: numbers in their ranges, directions, grids; each
 //! error names the value and the fix.
 
-#[allow(unused_imports)]
 use super::*;
 
 pub(super) fn number(s: &str, what: &str) -> Result<f64, String> {
